@@ -1,0 +1,110 @@
+use crate::bvh::{prune_bound, Bvh, BvhSettings, BvhWorkspace};
+use crate::math::{Point3, Pose, Vector3};
+use crate::probability::normal_cdf;
+
+fn lcg_points(n: usize, seed: u64) -> Vec<Point3> {
+    let mut s = seed;
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 11) as f64) / ((1u64 << 53) as f64)
+    };
+    (0..n).map(|_| Point3::new(next(), next(), next())).collect()
+}
+
+#[test]
+fn build_is_well_formed_and_refit_follows_points() {
+    let pts = lcg_points(1000, 1);
+    let sig: Vec<f64> = (0..pts.len()).map(|i| 0.001 * (i % 7) as f64).collect();
+    let mut bvh = Bvh::build(&pts, &sig, &BvhSettings { leaf_max_points: 8 }).unwrap();
+    bvh.assert_well_formed(&pts, &sig);
+    assert!(bvh.nodes().iter().filter(|n| n.is_leaf()).all(|n| n.count <= 8));
+    let moved: Vec<Point3> = pts.iter().map(|p| p + Vector3::new(0.5, -2.0, p.x)).collect();
+    bvh.refit(&moved, &sig).unwrap();
+    bvh.assert_well_formed(&moved, &sig);
+}
+
+#[test]
+fn identical_points_do_not_break_the_build() {
+    let pts = vec![Point3::new(1.0, 1.0, 1.0); 100];
+    let sig = vec![0.0; 100];
+    let bvh = Bvh::build(&pts, &sig, &BvhSettings::default()).unwrap();
+    bvh.assert_well_formed(&pts, &sig);
+}
+
+#[test]
+fn nearest_k_matches_brute_force() {
+    let pts = lcg_points(500, 7);
+    let sig = vec![0.0; pts.len()];
+    let bvh = Bvh::build(&pts, &sig, &BvhSettings { leaf_max_points: 5 }).unwrap();
+    let mut ws = BvhWorkspace::default();
+    let mut out = Vec::new();
+    for q in lcg_points(20, 99) {
+        bvh.nearest_k(&pts, &q, 7, &mut ws, &mut out);
+        let mut brute: Vec<(f64, u32)> =
+            pts.iter().enumerate().map(|(i, p)| ((p - q).norm_squared(), i as u32)).collect();
+        brute.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let got: Vec<f64> = out.iter().map(|x| x.0).collect();
+        let want: Vec<f64> = brute[..7].iter().map(|x| x.0).collect();
+        assert_eq!(got, want);
+    }
+}
+
+#[test]
+fn prune_bound_formula() {
+    assert_eq!(prune_bound(1.0, 0.0, 0.0, 10), 0.0);
+    assert_eq!(prune_bound(0.0, 0.0, 0.0, 10), 10.0);
+    let b = prune_bound(0.3, 0.05, 0.05, 4);
+    assert!((b - 4.0 * normal_cdf(-3.0)).abs() < 1e-15);
+}
+
+#[test]
+fn traversal_without_pruning_visits_every_leaf_pair() {
+    let a = lcg_points(200, 3);
+    let b = lcg_points(150, 4);
+    let sa = vec![0.01; a.len()];
+    let sb = vec![0.01; b.len()];
+    let ta = Bvh::build(&a, &sa, &BvhSettings { leaf_max_points: 10 }).unwrap();
+    let tb = Bvh::build(&b, &sb, &BvhSettings { leaf_max_points: 10 }).unwrap();
+    let mut ws = BvhWorkspace::default();
+    let far = Pose::translation(100.0, 0.0, 0.0);
+    let all = ta.traverse_pairs(&tb, &far, 0.0, &mut ws);
+    assert_eq!(all.leaf_pairs.len(), ta.leaf_count() * tb.leaf_count());
+    let pruned = ta.traverse_pairs(&tb, &far, 1e-9, &mut ws);
+    assert!(pruned.leaf_pairs.is_empty());
+    assert_eq!(pruned.node_pairs_visited, 1);
+    assert!(pruned.pruned_bound < 1e-9);
+}
+
+#[test]
+fn traversal_keeps_every_close_point_pair() {
+    // Property: any point pair closer than the pruning distance must lie in a kept leaf pair.
+    let a = lcg_points(300, 5);
+    let b = lcg_points(300, 6);
+    let sigma = 0.01;
+    let sa = vec![sigma; a.len()];
+    let sb = vec![sigma; b.len()];
+    let ta = Bvh::build(&a, &sa, &BvhSettings { leaf_max_points: 8 }).unwrap();
+    let tb = Bvh::build(&b, &sb, &BvhSettings { leaf_max_points: 8 }).unwrap();
+    let pose = Pose::new(Vector3::new(0.9, 0.1, 0.0), Vector3::new(0.2, 0.4, 0.9));
+    let mut ws = BvhWorkspace::default();
+    let eps = 1e-3;
+    let t = ta.traverse_pairs(&tb, &pose, eps, &mut ws);
+    let mut kept = std::collections::HashSet::new();
+    for &(la, lb) in &t.leaf_pairs {
+        for &i in ta.node_points(la) {
+            for &j in tb.node_points(lb) {
+                kept.insert((i, j));
+            }
+        }
+    }
+    for (i, pa) in a.iter().enumerate() {
+        for (j, pb) in b.iter().enumerate() {
+            let d = (pose * pa - pb).norm();
+            // A pruned node pair has bound n * Phi(-gap / 2 sigma) < eps with n >= 2 and
+            // gap <= d, so any point pair whose two-point bound reaches eps must be kept.
+            if prune_bound(d, sigma, sigma, 2) >= eps {
+                assert!(kept.contains(&(i as u32, j as u32)), "pair {i},{j} at {d} pruned");
+            }
+        }
+    }
+}

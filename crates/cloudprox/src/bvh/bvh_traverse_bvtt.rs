@@ -1,0 +1,94 @@
+//! Simultaneous traversal of two hierarchies (the bounding volume test tree) with
+//! probabilistic pruning.
+
+use crate::bvh::{Bvh, BvhWorkspace};
+use crate::math::Pose;
+use crate::probability::normal_cdf;
+use crate::Real;
+
+/// What a pair traversal found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PairTraversal {
+    /// The leaf pairs `(leaf of self, leaf of other)` that were not pruned.
+    pub leaf_pairs: Vec<(u32, u32)>,
+    /// Number of node pairs tested.
+    pub node_pairs_visited: usize,
+    /// Sum of [`prune_bound`] over every pruned node pair: an upper bound on the
+    /// probability that any pruned point lies on the wrong side of a plane that
+    /// separates its node's box from the other node's box (capped at 1).
+    pub pruned_bound: Real,
+}
+
+/// Upper bound on the probability that any of `n` points of two boxes a distance
+/// `gap` apart crosses the plane between them, when no point's standard deviation
+/// exceeds `sigma_a` (first box) or `sigma_b` (second box) in any direction.
+///
+/// Two convex sets `gap` apart are separated by a slab of that width. Place the
+/// plane inside it at `gap * sigma_a / (sigma_a + sigma_b)` from the first box: a
+/// point of either box must then move at least `gap / (sigma_a + sigma_b)` of its
+/// own standard deviations along the normal to cross, and a union bound over the
+/// `n` points gives `n * Phi(-gap / (sigma_a + sigma_b))`. With no noise the
+/// bound is 0 for `gap > 0`, and it is `n / 2` for touching boxes.
+pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
+    let s = sigma_a + sigma_b;
+    let n = n as Real;
+    if s <= 0.0 {
+        return if gap > 0.0 { 0.0 } else { n };
+    }
+    n * normal_cdf(-gap / s)
+}
+
+impl Bvh {
+    /// Traverses `self` (posed by `pose`, which maps `self`'s frame into `other`'s)
+    /// and `other` together, returning the leaf pairs that could not be pruned.
+    ///
+    /// A node pair is pruned when [`prune_bound`] of the distance between their
+    /// boxes (the first one's box moved by `pose`, enclosed in an axis-aligned box,
+    /// which only makes the distance smaller and the bound safer) is below
+    /// `epsilon`. With `epsilon = 0` nothing is pruned. The larger node of a pair
+    /// is the one descended.
+    pub fn traverse_pairs(
+        &self,
+        other: &Bvh,
+        pose: &Pose,
+        epsilon: Real,
+        workspace: &mut BvhWorkspace,
+    ) -> PairTraversal {
+        let mut out = PairTraversal::default();
+        let stack = &mut workspace.pair_stack;
+        stack.clear();
+        stack.push((0, 0));
+        while let Some((ia, ib)) = stack.pop() {
+            out.node_pairs_visited += 1;
+            let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
+            let gap = na.aabb.transformed(pose).distance(&nb.aabb);
+            let bound = prune_bound(gap, na.sigma_max, nb.sigma_max, (na.count + nb.count) as usize);
+            if bound < epsilon {
+                out.pruned_bound += bound;
+                continue;
+            }
+            match (na.children, nb.children) {
+                (None, None) => out.leaf_pairs.push((ia, ib)),
+                (Some([l, r]), None) => {
+                    stack.push((l, ib));
+                    stack.push((r, ib));
+                }
+                (None, Some([l, r])) => {
+                    stack.push((ia, l));
+                    stack.push((ia, r));
+                }
+                (Some([al, ar]), Some([bl, br])) => {
+                    if na.count >= nb.count {
+                        stack.push((al, ib));
+                        stack.push((ar, ib));
+                    } else {
+                        stack.push((ia, bl));
+                        stack.push((ia, br));
+                    }
+                }
+            }
+        }
+        out.pruned_bound = out.pruned_bound.min(1.0);
+        out
+    }
+}

@@ -1,0 +1,161 @@
+//! Solving the robust SOCP with Clarabel, and the outcome as data.
+
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
+
+use crate::classify::problem::{assemble, Normalized};
+use crate::classify::{ClassifySettings, Separator};
+use crate::error::{Error, Result};
+use crate::math::{Matrix3, Point3, Vector3};
+use crate::Real;
+
+/// How a classification ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveStatus {
+    /// Clarabel converged to the requested tolerance.
+    Solved,
+    /// Clarabel converged to its reduced tolerance.
+    AlmostSolved,
+    /// Clarabel did not converge (iteration limit, numerical trouble); the separator
+    /// is the fallback plane: normal along the difference of the two class means
+    /// (in normalized coordinates), through their midpoint.
+    Fallback,
+}
+
+impl SolveStatus {
+    /// `"solved"`, `"almost_solved"` or `"fallback"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolveStatus::Solved => "solved",
+            SolveStatus::AlmostSolved => "almost_solved",
+            SolveStatus::Fallback => "fallback",
+        }
+    }
+}
+
+/// A trained separator and how the solve went.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Classification {
+    /// The surface, positive on label +1's side.
+    pub separator: Separator,
+    /// Outcome of the solve.
+    pub status: SolveStatus,
+    /// Interior-point iterations.
+    pub iterations: u32,
+    /// Optimal slacks `xi_i` in the input order (empty on fallback).
+    pub slacks: Vec<Real>,
+}
+
+/// Trains the robust separating surface for `points` with covariances `covs` and
+/// labels `+1.0` / `-1.0` (see the [module docs](crate::classify) for the problem).
+///
+/// Errors on mismatched lengths, labels other than +-1, or a set missing one of
+/// the two labels. A solver that does not converge is not an error: see
+/// [`SolveStatus::Fallback`].
+pub fn train(
+    points: &[Point3],
+    covs: &[Matrix3],
+    labels: &[Real],
+    settings: &ClassifySettings,
+) -> Result<Classification> {
+    settings.validate()?;
+    let n = points.len();
+    for (what, len) in [("covariances", covs.len()), ("labels", labels.len())] {
+        if len != n {
+            return Err(Error::Shape {
+                what: what.into(),
+                expected: n,
+                got: len,
+            });
+        }
+    }
+    if let Some(i) = labels.iter().position(|&c| c != 1.0 && c != -1.0) {
+        return Err(Error::invalid(format!(
+            "label {i} is {}, expected +1 or -1",
+            labels[i]
+        )));
+    }
+    if !labels.contains(&1.0) || !labels.contains(&-1.0) {
+        return Err(Error::invalid(
+            "training a separator needs points of both clouds",
+        ));
+    }
+    let r = settings.robust_radius()?;
+    let norm = Normalized::new(points, covs);
+    let problem = assemble(&norm, labels, settings.surface, settings.lambda, r);
+    let solver_settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(settings.solver_max_iter)
+        .tol_gap_abs(settings.solver_tol)
+        .tol_gap_rel(settings.solver_tol)
+        .tol_feas(settings.solver_tol)
+        .build()
+        .map_err(|e| Error::invalid(format!("solver settings: {e}")))?;
+    let solved = DefaultSolver::new(
+        &problem.P,
+        &problem.q,
+        &problem.A,
+        &problem.b,
+        &problem.cones,
+        solver_settings,
+    )
+    .ok()
+    .map(|mut solver| {
+        solver.solve();
+        solver.solution
+    });
+    let d = problem.dim;
+    if let Some(sol) = solved {
+        let status = match sol.status {
+            SolverStatus::Solved => Some(SolveStatus::Solved),
+            SolverStatus::AlmostSolved => Some(SolveStatus::AlmostSolved),
+            _ => None,
+        };
+        if let Some(status) = status {
+            if sol.x[..=d].iter().all(|v| v.is_finite()) {
+                return Ok(Classification {
+                    separator: Separator {
+                        surface: settings.surface,
+                        w: sol.x[..d].to_vec(),
+                        b: sol.x[d],
+                        center: norm.center,
+                        scale: norm.scale,
+                    },
+                    status,
+                    iterations: sol.iterations,
+                    slacks: sol.x[d + 1..d + 1 + n].to_vec(),
+                });
+            }
+        }
+        return Ok(fallback(&norm, labels, settings, sol.iterations));
+    }
+    Ok(fallback(&norm, labels, settings, 0))
+}
+
+fn fallback(norm: &Normalized, labels: &[Real], settings: &ClassifySettings, iterations: u32) -> Classification {
+    let mean_of = |label: Real| {
+        let (sum, cnt) = norm
+            .u
+            .iter()
+            .zip(labels)
+            .filter(|(_, &c)| c == label)
+            .fold((Vector3::zeros(), 0.0), |(s, k), (u, _)| (s + u, k + 1.0));
+        sum / cnt
+    };
+    let (ma, mb) = (mean_of(1.0), mean_of(-1.0));
+    let normal = ma - mb;
+    let mid = (ma + mb) * 0.5;
+    let mut w = vec![0.0; settings.surface.dim()];
+    w[..3].copy_from_slice(normal.as_slice());
+    Classification {
+        separator: Separator {
+            surface: settings.surface,
+            w,
+            b: -normal.dot(&mid),
+            center: norm.center,
+            scale: norm.scale,
+        },
+        status: SolveStatus::Fallback,
+        iterations,
+        slacks: Vec::new(),
+    }
+}

@@ -1,0 +1,7 @@
+//! Point clouds with per-point uncertainty, and rigid poses.
+
+mod point_cloud;
+mod pose;
+
+pub use point_cloud::PointCloud;
+pub use pose::{pose_from_matrix, pose_to_matrix};

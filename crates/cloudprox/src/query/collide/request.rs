@@ -1,0 +1,111 @@
+//! What a collision query should compute, with a validating builder.
+
+use crate::classify::ClassifySettings;
+use crate::error::{Error, Result};
+use crate::probability::{Aggregation, Thresholds};
+use crate::Real;
+
+/// Options of [`crate::query::collide`]. Build with [`CollisionRequestBuilder`] or
+/// take [`CollisionRequest::default`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CollisionRequest {
+    /// How separating surfaces are trained.
+    pub classify: ClassifySettings,
+    /// How per-point probabilities become `P` (default [`Aggregation::Max`]).
+    pub aggregation: Aggregation,
+    /// The decision thresholds (default `collision = 0.9`, `free = 0.1`).
+    pub thresholds: Thresholds,
+    /// A node pair is pruned when its crossing bound is below this (default 1e-3).
+    /// The sum of the bounds of what was pruned is reported in
+    /// [`crate::query::QueryStats::pruned_bound`].
+    pub prune_epsilon: Real,
+    /// Near regions with more points than this are split into patches along the
+    /// contact, each with its own surface (default 160).
+    pub region_max_points: usize,
+    /// `false` skips the hierarchy: every point of both clouds goes into one
+    /// region (still split into patches). The brute-force reference.
+    pub use_hierarchy: bool,
+}
+
+impl Default for CollisionRequest {
+    fn default() -> Self {
+        Self {
+            classify: ClassifySettings::default(),
+            aggregation: Aggregation::Max,
+            thresholds: Thresholds::default(),
+            prune_epsilon: 1e-3,
+            region_max_points: 160,
+            use_hierarchy: true,
+        }
+    }
+}
+
+impl CollisionRequest {
+    /// A builder starting from the defaults.
+    pub fn builder() -> CollisionRequestBuilder {
+        CollisionRequestBuilder::default()
+    }
+
+    /// Checks every field's domain.
+    pub fn validate(&self) -> Result<()> {
+        self.classify.validate()?;
+        self.thresholds.validate()?;
+        if !(self.prune_epsilon.is_finite() && (0.0..1.0).contains(&self.prune_epsilon)) {
+            return Err(Error::invalid(format!(
+                "prune_epsilon must be in [0, 1), got {}",
+                self.prune_epsilon
+            )));
+        }
+        if self.region_max_points < 8 {
+            return Err(Error::invalid(format!(
+                "region_max_points must be >= 8, got {}",
+                self.region_max_points
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Builder of [`CollisionRequest`]; [`CollisionRequestBuilder::build`] validates.
+#[derive(Debug, Clone, Default)]
+pub struct CollisionRequestBuilder {
+    inner: CollisionRequest,
+}
+
+impl CollisionRequestBuilder {
+    /// Classifier settings.
+    pub fn classify(mut self, settings: ClassifySettings) -> Self {
+        self.inner.classify = settings;
+        self
+    }
+    /// Aggregation of per-point probabilities.
+    pub fn aggregation(mut self, aggregation: Aggregation) -> Self {
+        self.inner.aggregation = aggregation;
+        self
+    }
+    /// Decision thresholds `threshold_collision` (A) and `threshold_free` (B).
+    pub fn thresholds(mut self, collision: Real, free: Real) -> Self {
+        self.inner.thresholds = Thresholds { collision, free };
+        self
+    }
+    /// Pruning bound `epsilon`.
+    pub fn prune_epsilon(mut self, epsilon: Real) -> Self {
+        self.inner.prune_epsilon = epsilon;
+        self
+    }
+    /// Largest patch.
+    pub fn region_max_points(mut self, n: usize) -> Self {
+        self.inner.region_max_points = n;
+        self
+    }
+    /// Whether to use the hierarchy (`false`: brute force).
+    pub fn use_hierarchy(mut self, yes: bool) -> Self {
+        self.inner.use_hierarchy = yes;
+        self
+    }
+    /// The validated request.
+    pub fn build(self) -> Result<CollisionRequest> {
+        self.inner.validate()?;
+        Ok(self.inner)
+    }
+}

@@ -1,0 +1,78 @@
+//! What a collision query returns: plain data with documented conventions.
+
+use crate::classify::{Separator, SolveStatus, Surface};
+use crate::math::{Point3, Vector3};
+use crate::probability::CollisionState;
+use crate::Real;
+
+/// One patch of a near region, with its own separating surface. World frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRegion {
+    /// Index of the connected near region this patch belongs to.
+    pub component: u32,
+    /// Indices of cloud A's points in the patch.
+    pub indices_a: Vec<u32>,
+    /// Indices of cloud B's points in the patch.
+    pub indices_b: Vec<u32>,
+    /// A point on the separating surface where the two clouds come closest.
+    pub point: Point3,
+    /// Unit normal of the surface at `point`, pointing from A towards B.
+    pub normal: Vector3,
+    /// Estimated signed separation of the two surfaces along the normal (metres),
+    /// negative when they interpenetrate: the sum over both sides of the 25th
+    /// percentile of the points' signed distances to the separating surface.
+    pub separation: Real,
+    /// The patch's aggregated collision probability.
+    pub probability: Real,
+    /// The trained surface (world frame; positive on A's side).
+    pub separator: Separator,
+    /// The surface family.
+    pub surface: Surface,
+    /// How the solve ended.
+    pub status: SolveStatus,
+    /// Interior-point iterations of the solve.
+    pub iterations: u32,
+}
+
+/// Counters and timings of one query.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct QueryStats {
+    /// Node pairs tested during the traversal.
+    pub node_pairs_visited: usize,
+    /// Leaf pairs kept (not pruned).
+    pub leaf_pairs: usize,
+    /// Connected near regions.
+    pub near_regions: usize,
+    /// Patches (= [`CollisionResult::regions`]) classified.
+    pub patches: usize,
+    /// Points of both clouds that went into a classifier.
+    pub points_classified: usize,
+    /// Interior-point iterations over all patches.
+    pub solver_iterations: u64,
+    /// Patches whose solve fell back (see [`SolveStatus::Fallback`]).
+    pub solver_fallbacks: usize,
+    /// Upper bound on the probability that any pruned point is on the wrong side
+    /// of a plane separating its node from the other cloud's (see
+    /// [`crate::bvh::prune_bound`]); pruned points get `p_i = 0`.
+    pub pruned_bound: Real,
+    /// Wall time of the query (seconds).
+    pub time_seconds: Real,
+}
+
+/// The answer of [`crate::query::collide`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionResult {
+    /// The pair's collision probability `P`, aggregated as requested.
+    pub probability: Real,
+    /// The decided state from `P` and the thresholds.
+    pub state: CollisionState,
+    /// Per-point probability of cloud A's points lying on the wrong side (0 for
+    /// points outside every near region).
+    pub probabilities_a: Vec<Real>,
+    /// The same for cloud B.
+    pub probabilities_b: Vec<Real>,
+    /// The classified patches of the near regions.
+    pub regions: Vec<ContactRegion>,
+    /// Counters and timings.
+    pub stats: QueryStats,
+}

@@ -1,0 +1,13 @@
+//! Proximity queries, one folder per query kind.
+//!
+//! Naming rule (as in parry): the generic entry of a query kind is a function of
+//! the kind's name in `<kind>/<kind>.rs` (`collide`); specialisations for one pair
+//! of object types are named `<kind>_<a>_<b>` in sibling files. World poses come
+//! first, each before its object: `collide(pose_a, a, pose_b, b, request)`.
+
+pub mod collide;
+
+pub use collide::{
+    collide, collide_many, CollisionRequest, CollisionRequestBuilder, CollisionResult,
+    ContactRegion, QueryStats,
+};

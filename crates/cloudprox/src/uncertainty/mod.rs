@@ -1,0 +1,18 @@
+//! Uncertainty of a point: `Sigma_i = Sigma_sensor,i + Sigma_disc,i`.
+//!
+//! - [`NoiseModel`]: the sensor part (position error), isotropic or full;
+//! - [`discretization_covariances`]: the discretization part, how sparsely the
+//!   surface was sampled, from the k nearest neighbours;
+//! - [`RobustModel`]: the robustness radius `r_i` of the chance constraint;
+//! - [`validate_covariance`] and [`covariance_factor`]: checks and square roots.
+
+mod covariance;
+mod discretization;
+mod noise;
+mod robust;
+
+pub use covariance::{covariance_factor, max_std, validate_covariance};
+pub(crate) use covariance::directional_std_of;
+pub use discretization::{discretization_covariances, DiscretizationSettings};
+pub use noise::NoiseModel;
+pub use robust::RobustModel;
