@@ -1,1 +1,44 @@
-//! tmp
+//! Python bindings of the cloudprox core crate, imported as `cloudprox._native`.
+//!
+//! One file per concern:
+//!
+//! | file | what |
+//! |---|---|
+//! | `error.rs` | exception hierarchy, core error and panic mapping |
+//! | `convert.rs` | numpy <-> nalgebra conversion and shape checks |
+//! | `cloud.rs` | `PointCloud` |
+//! | `request.rs` | query options -> `CollisionRequest` |
+//! | `collide.rs` | `collide`, `collide_many` |
+//! | `result.rs` | `CollisionResult`, `ContactRegion` |
+//! | `sample.rs` | seeded synthetic shapes |
+//!
+//! The Python package `cloudprox` re-exports everything; `_native.pyi` is the stub.
+#![deny(unused_qualifications)]
+
+use pyo3::prelude::*;
+
+mod cloud;
+mod collide;
+mod convert;
+mod error;
+mod request;
+mod result;
+mod sample;
+
+/// The compiled part of cloudprox.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    error::register(m)?;
+    m.add_class::<cloud::PyPointCloud>()?;
+    m.add_class::<result::PyCollisionResult>()?;
+    m.add_class::<result::PyContactRegion>()?;
+    m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
+    m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
+    m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
+    m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::sample_sphere, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::sample_box_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::add_noise, m)?)?;
+    Ok(())
+}

@@ -8,10 +8,18 @@ use cloudprox::sample::{add_noise, box_surface, sphere};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(2000);
-    let surface = args.get(2).and_then(|s| Surface::from_name(s)).unwrap_or_default();
+    let surface = args
+        .get(2)
+        .and_then(|s| Surface::from_name(s))
+        .unwrap_or_default();
     let sigma = 0.002;
     let r = 0.1;
-    let env = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let env = |k: &str, d: f64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
     let request = CollisionRequest::builder()
         .classify(
             ClassifySettings::builder()
@@ -24,32 +32,65 @@ fn main() {
         .region_max_points(env("RMAX", 160.0) as usize)
         .build()
         .unwrap();
-    let a = PointCloud::from_sigma(add_noise(&sphere(&Point3::origin(), r, n), sigma, 1), sigma).unwrap();
-    let b = PointCloud::from_sigma(add_noise(&sphere(&Point3::origin(), r, n), sigma, 2), sigma).unwrap();
-    println!("spheres: n = {n}, radius {r}, sigma {sigma}, surface {}", surface.name());
-    println!("{:>6} {:>10} {:>10} {:>8} {:>8} {:>9}", "d/sig", "P", "state", "patches", "points", "ms");
-    for k in [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0] {
+    let disc = env("DISC", 0.0) > 0.0;
+    let make = |p: Vec<Point3>| {
+        let c = PointCloud::from_sigma(p, sigma).unwrap();
+        if disc {
+            c.with_discretization(&DiscretizationSettings::default())
+                .unwrap()
+        } else {
+            c
+        }
+    };
+    let a = make(add_noise(&sphere(&Point3::origin(), r, n), sigma, 1));
+    let b = make(add_noise(&sphere(&Point3::origin(), r, n), sigma, 2));
+    println!(
+        "spheres: n = {n}, radius {r}, sigma {sigma}, surface {}",
+        surface.name()
+    );
+    println!(
+        "{:>6} {:>10} {:>10} {:>8} {:>8} {:>9}",
+        "d/sig", "P", "state", "patches", "points", "ms"
+    );
+    for k in [
+        -3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0,
+    ] {
         let d = k * sigma;
         let pb = Pose::translation(2.0 * r + d, 0.0, 0.0);
         let res = collide(&Pose::identity(), &a, &pb, &b, &request).unwrap();
         println!(
-            "{k:>6.1} {:>10.4} {:>10} {:>8} {:>8} {:>9.2}   sep {:+.4}",
+            "{k:>6.1} {:>10.4} {:>10} {:>8} {:>8} {:>9.2}   sep {:+.4} it {}",
             res.probability,
             res.state.name(),
             res.stats.patches,
             res.stats.points_classified,
             res.stats.time_seconds * 1e3,
-            res.regions.iter().map(|r| r.separation).fold(f64::INFINITY, f64::min) / sigma
+            res.regions
+                .iter()
+                .map(|r| r.separation)
+                .fold(f64::INFINITY, f64::min)
+                / sigma,
+            res.stats.solver_iterations
         );
     }
     // Plates: a 20 cm x 20 cm x 2 cm slab under a 10 cm x 10 cm x 2 cm slab.
     let spacing = 0.01;
-    let pa = add_noise(&box_surface(&Point3::origin(), &Vector3::new(0.1, 0.1, 0.01), spacing), sigma, 3);
-    let pb = add_noise(&box_surface(&Point3::origin(), &Vector3::new(0.05, 0.05, 0.01), spacing), sigma, 4);
-    let a = PointCloud::from_sigma(pa, sigma).unwrap();
-    let b = PointCloud::from_sigma(pb, sigma).unwrap();
+    let pa = add_noise(
+        &box_surface(&Point3::origin(), &Vector3::new(0.1, 0.1, 0.01), spacing),
+        sigma,
+        3,
+    );
+    let pb = add_noise(
+        &box_surface(&Point3::origin(), &Vector3::new(0.05, 0.05, 0.01), spacing),
+        sigma,
+        4,
+    );
+    let a = make(pa);
+    let b = make(pb);
     println!("plates: {} and {} points", a.len(), b.len());
-    for k in [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0] {
+    for k in [
+        -3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0,
+    ] {
         let d = k * sigma;
         let pose_b = Pose::translation(0.0, 0.0, 0.02 + d);
         let res = collide(&Pose::identity(), &a, &pose_b, &b, &request).unwrap();

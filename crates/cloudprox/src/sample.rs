@@ -54,7 +54,10 @@ pub struct NormalRng {
 impl NormalRng {
     /// A generator from `seed`.
     pub fn new(seed: u64) -> Self {
-        Self { state: seed, spare: None }
+        Self {
+            state: seed,
+            spare: None,
+        }
     }
 
     /// A uniform number in `(0, 1)`.
@@ -111,6 +114,9 @@ mod tests {
         let xs: Vec<Real> = (0..20000).map(|_| rng.normal()).collect();
         let mean = xs.iter().sum::<Real>() / xs.len() as Real;
         let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<Real>() / xs.len() as Real;
-        assert!(mean.abs() < 0.03 && (var - 1.0).abs() < 0.05, "{mean} {var}");
+        assert!(
+            mean.abs() < 0.03 && (var - 1.0).abs() < 0.05,
+            "{mean} {var}"
+        );
     }
 }

@@ -16,7 +16,9 @@ impl Bvh {
     pub fn build(points: &[Point3], sigmas: &[Real], settings: &BvhSettings) -> Result<Bvh> {
         settings.validate()?;
         if points.is_empty() {
-            return Err(Error::invalid("cannot build a hierarchy over an empty cloud"));
+            return Err(Error::invalid(
+                "cannot build a hierarchy over an empty cloud",
+            ));
         }
         if sigmas.len() != points.len() {
             return Err(Error::Shape {
@@ -67,7 +69,13 @@ impl Bvh {
         let key = |i: &u32| points[*i as usize].coords.dot(&axis);
         slice.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
         let left = self.build_node(points, sigmas, first, mid as u32, leaf_max);
-        let right = self.build_node(points, sigmas, first + mid as u32, count - mid as u32, leaf_max);
+        let right = self.build_node(
+            points,
+            sigmas,
+            first + mid as u32,
+            count - mid as u32,
+            leaf_max,
+        );
         self.nodes[id as usize].children = Some([left, right]);
         id
     }
@@ -76,7 +84,11 @@ impl Bvh {
 /// Unit eigenvector of the largest eigenvalue of the points' scatter matrix.
 fn principal_axis(points: &[Point3], idx: &[u32]) -> Vector3 {
     let n = idx.len() as Real;
-    let mean = idx.iter().map(|&i| points[i as usize].coords).sum::<Vector3>() / n;
+    let mean = idx
+        .iter()
+        .map(|&i| points[i as usize].coords)
+        .sum::<Vector3>()
+        / n;
     let mut scatter = Matrix3::zeros();
     for &i in idx {
         let d = points[i as usize].coords - mean;

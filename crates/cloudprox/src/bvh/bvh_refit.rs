@@ -20,20 +20,17 @@ impl Bvh {
             });
         }
         for id in (0..self.nodes.len()).rev() {
-            let (aabb, sigma_max) = match self.nodes[id].children {
-                Some([l, r]) => {
-                    let (l, r) = (&self.nodes[l as usize], &self.nodes[r as usize]);
-                    (l.aabb.merged(&r.aabb), l.sigma_max.max(r.sigma_max))
+            let (aabb, sigma_max) = if let Some([l, r]) = self.nodes[id].children {
+                let (l, r) = (&self.nodes[l as usize], &self.nodes[r as usize]);
+                (l.aabb.merged(&r.aabb), l.sigma_max.max(r.sigma_max))
+            } else {
+                let mut aabb = Aabb::empty();
+                let mut s: Real = 0.0;
+                for &i in self.node_points(id as u32) {
+                    aabb.take_point(&points[i as usize]);
+                    s = s.max(sigmas[i as usize]);
                 }
-                None => {
-                    let mut aabb = Aabb::empty();
-                    let mut s: Real = 0.0;
-                    for &i in self.node_points(id as u32) {
-                        aabb.take_point(&points[i as usize]);
-                        s = s.max(sigmas[i as usize]);
-                    }
-                    (aabb, s)
-                }
+                (aabb, s)
             };
             self.nodes[id].aabb = aabb;
             self.nodes[id].sigma_max = sigma_max;

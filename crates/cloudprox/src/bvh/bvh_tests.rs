@@ -5,10 +5,14 @@ use crate::probability::normal_cdf;
 fn lcg_points(n: usize, seed: u64) -> Vec<Point3> {
     let mut s = seed;
     let mut next = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((s >> 11) as f64) / ((1u64 << 53) as f64)
     };
-    (0..n).map(|_| Point3::new(next(), next(), next())).collect()
+    (0..n)
+        .map(|_| Point3::new(next(), next(), next()))
+        .collect()
 }
 
 #[test]
@@ -17,8 +21,15 @@ fn build_is_well_formed_and_refit_follows_points() {
     let sig: Vec<f64> = (0..pts.len()).map(|i| 0.001 * (i % 7) as f64).collect();
     let mut bvh = Bvh::build(&pts, &sig, &BvhSettings { leaf_max_points: 8 }).unwrap();
     bvh.assert_well_formed(&pts, &sig);
-    assert!(bvh.nodes().iter().filter(|n| n.is_leaf()).all(|n| n.count <= 8));
-    let moved: Vec<Point3> = pts.iter().map(|p| p + Vector3::new(0.5, -2.0, p.x)).collect();
+    assert!(bvh
+        .nodes()
+        .iter()
+        .filter(|n| n.is_leaf())
+        .all(|n| n.count <= 8));
+    let moved: Vec<Point3> = pts
+        .iter()
+        .map(|p| p + Vector3::new(0.5, -2.0, p.x))
+        .collect();
     bvh.refit(&moved, &sig).unwrap();
     bvh.assert_well_formed(&moved, &sig);
 }
@@ -40,8 +51,11 @@ fn nearest_k_matches_brute_force() {
     let mut out = Vec::new();
     for q in lcg_points(20, 99) {
         bvh.nearest_k(&pts, &q, 7, &mut ws, &mut out);
-        let mut brute: Vec<(f64, u32)> =
-            pts.iter().enumerate().map(|(i, p)| ((p - q).norm_squared(), i as u32)).collect();
+        let mut brute: Vec<(f64, u32)> = pts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| ((p - q).norm_squared(), i as u32))
+            .collect();
         brute.sort_by(|a, b| a.0.total_cmp(&b.0));
         let got: Vec<f64> = out.iter().map(|x| x.0).collect();
         let want: Vec<f64> = brute[..7].iter().map(|x| x.0).collect();
@@ -63,8 +77,22 @@ fn traversal_without_pruning_visits_every_leaf_pair() {
     let b = lcg_points(150, 4);
     let sa = vec![0.01; a.len()];
     let sb = vec![0.01; b.len()];
-    let ta = Bvh::build(&a, &sa, &BvhSettings { leaf_max_points: 10 }).unwrap();
-    let tb = Bvh::build(&b, &sb, &BvhSettings { leaf_max_points: 10 }).unwrap();
+    let ta = Bvh::build(
+        &a,
+        &sa,
+        &BvhSettings {
+            leaf_max_points: 10,
+        },
+    )
+    .unwrap();
+    let tb = Bvh::build(
+        &b,
+        &sb,
+        &BvhSettings {
+            leaf_max_points: 10,
+        },
+    )
+    .unwrap();
     let mut ws = BvhWorkspace::default();
     let far = Pose::translation(100.0, 0.0, 0.0);
     let all = ta.traverse_pairs(&tb, &far, 0.0, &mut ws);
@@ -103,7 +131,10 @@ fn traversal_keeps_every_close_point_pair() {
             // A pruned node pair has bound n * Phi(-gap / 2 sigma) < eps with n >= 2 and
             // gap <= d, so any point pair whose two-point bound reaches eps must be kept.
             if prune_bound(d, sigma, sigma, 2) >= eps {
-                assert!(kept.contains(&(i as u32, j as u32)), "pair {i},{j} at {d} pruned");
+                assert!(
+                    kept.contains(&(i as u32, j as u32)),
+                    "pair {i},{j} at {d} pruned"
+                );
             }
         }
     }

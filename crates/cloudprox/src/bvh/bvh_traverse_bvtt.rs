@@ -62,7 +62,12 @@ impl Bvh {
             out.node_pairs_visited += 1;
             let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
             let gap = na.aabb.transformed(pose).distance(&nb.aabb);
-            let bound = prune_bound(gap, na.sigma_max, nb.sigma_max, (na.count + nb.count) as usize);
+            let bound = prune_bound(
+                gap,
+                na.sigma_max,
+                nb.sigma_max,
+                (na.count + nb.count) as usize,
+            );
             if bound < epsilon {
                 out.pruned_bound += bound;
                 continue;

@@ -35,7 +35,9 @@ pub struct BvhSettings {
 
 impl Default for BvhSettings {
     fn default() -> Self {
-        Self { leaf_max_points: 16 }
+        Self {
+            leaf_max_points: 16,
+        }
     }
 }
 

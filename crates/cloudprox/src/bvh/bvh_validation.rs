@@ -23,14 +23,27 @@ impl Bvh {
                     node.aabb.distance_squared_to_point(p) == 0.0,
                     "node {id} does not contain point {i}"
                 );
-                assert!(sigmas[i as usize] <= node.sigma_max, "node {id}: sigma_max too small");
+                assert!(
+                    sigmas[i as usize] <= node.sigma_max,
+                    "node {id}: sigma_max too small"
+                );
             }
             if let Some([l, r]) = node.children {
                 let (ln, rn) = (&self.nodes[l as usize], &self.nodes[r as usize]);
-                assert!(l as usize > id && r as usize > id, "children must follow parents");
-                assert_eq!(ln.first, node.first, "left child must start where its parent does");
+                assert!(
+                    l as usize > id && r as usize > id,
+                    "children must follow parents"
+                );
+                assert_eq!(
+                    ln.first, node.first,
+                    "left child must start where its parent does"
+                );
                 assert_eq!(rn.first, ln.first + ln.count, "children must be contiguous");
-                assert_eq!(ln.count + rn.count, node.count, "children must partition the parent");
+                assert_eq!(
+                    ln.count + rn.count,
+                    node.count,
+                    "children must partition the parent"
+                );
             }
         }
     }

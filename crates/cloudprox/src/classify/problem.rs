@@ -23,8 +23,17 @@ impl Normalized {
     pub fn new(points: &[Point3], covs: &[Matrix3]) -> Self {
         let n = points.len() as Real;
         let center = Point3::from(points.iter().map(|p| p.coords).sum::<Vector3>() / n);
-        let rms = (points.iter().map(|p| (p - center).norm_squared()).sum::<Real>() / n).sqrt();
-        let scale = if rms > 0.0 && rms.is_finite() { rms } else { 1.0 };
+        let rms = (points
+            .iter()
+            .map(|p| (p - center).norm_squared())
+            .sum::<Real>()
+            / n)
+            .sqrt();
+        let scale = if rms > 0.0 && rms.is_finite() {
+            rms
+        } else {
+            1.0
+        };
         let u = points.iter().map(|p| (p - center) / scale).collect();
         let isotropic = covs
             .iter()
@@ -143,7 +152,13 @@ pub(crate) fn assemble(
     }
     let m = b.len();
     let a = CscMatrix::new_from_triplets(m, n_vars, rows, cols, vals);
-    let p = CscMatrix::new_from_triplets(n_vars, n_vars, (0..d).collect(), (0..d).collect(), vec![1.0; d]);
+    let p = CscMatrix::new_from_triplets(
+        n_vars,
+        n_vars,
+        (0..d).collect(),
+        (0..d).collect(),
+        vec![1.0; d],
+    );
     let mut q = vec![0.0; n_vars];
     for v in &mut q[col_xi..col_xi + n] {
         *v = lambda;

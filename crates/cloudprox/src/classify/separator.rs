@@ -1,11 +1,12 @@
 //! A trained separating surface, evaluated in world coordinates.
 
 use crate::classify::Surface;
-use crate::math::{Point3, Vector3};
+use crate::math::{Point3, Pose, Vector3};
 use crate::Real;
 
-/// The surface `f(x) = w . phi((x - center) / scale) + b`, positive on cloud A's
-/// side and negative on cloud B's.
+/// The surface `f(x) = w . phi((frame^-1 x - center) / scale) + b`, positive on
+/// cloud A's side and negative on cloud B's. `center` and the coefficients live in
+/// the frame the surface was trained in; `frame` maps that frame to the world.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Separator {
     /// Feature family.
@@ -18,11 +19,19 @@ pub struct Separator {
     pub center: Point3,
     /// Normalization scale (metres).
     pub scale: Real,
+    /// Pose of the training frame in the world (identity when trained in the world).
+    pub frame: Pose,
 }
 
 impl Separator {
-    /// `f(x)` and its gradient `grad f(x)` (complete, in world units).
+    /// `f(x)` and its gradient `grad f(x)` at a world point (complete, world units).
     pub fn value_and_gradient(&self, x: &Point3) -> (Real, Vector3) {
+        let (f, g) = self.value_and_gradient_local(&self.frame.inverse_transform_point(x));
+        (f, self.frame.rotation * g)
+    }
+
+    /// `f` and its gradient at a point given in the training frame.
+    pub fn value_and_gradient_local(&self, x: &Point3) -> (Real, Vector3) {
         let u = (x - self.center) / self.scale;
         let d = self.surface.dim();
         let mut phi = [0.0; 9];

@@ -5,7 +5,7 @@ use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverSt
 use crate::classify::problem::{assemble, Normalized};
 use crate::classify::{ClassifySettings, Separator};
 use crate::error::{Error, Result};
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::Real;
 
 /// How a classification ended.
@@ -119,6 +119,7 @@ pub fn train(
                         b: sol.x[d],
                         center: norm.center,
                         scale: norm.scale,
+                        frame: Pose::identity(),
                     },
                     status,
                     iterations: sol.iterations,
@@ -131,7 +132,12 @@ pub fn train(
     Ok(fallback(&norm, labels, settings, 0))
 }
 
-fn fallback(norm: &Normalized, labels: &[Real], settings: &ClassifySettings, iterations: u32) -> Classification {
+fn fallback(
+    norm: &Normalized,
+    labels: &[Real],
+    settings: &ClassifySettings,
+    iterations: u32,
+) -> Classification {
     let mean_of = |label: Real| {
         let (sum, cnt) = norm
             .u
@@ -153,6 +159,7 @@ fn fallback(norm: &Normalized, labels: &[Real], settings: &ClassifySettings, ite
             b: -normal.dot(&mid),
             center: norm.center,
             scale: norm.scale,
+            frame: Pose::identity(),
         },
         status: SolveStatus::Fallback,
         iterations,

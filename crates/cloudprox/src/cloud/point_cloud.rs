@@ -5,9 +5,7 @@ use std::sync::OnceLock;
 use crate::bvh::{Bvh, BvhSettings};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
-use crate::uncertainty::{
-    discretization_covariances, max_std, DiscretizationSettings, NoiseModel,
-};
+use crate::uncertainty::{discretization_covariances, max_std, DiscretizationSettings, NoiseModel};
 use crate::Real;
 
 /// Points with a 3x3 covariance each, in the cloud's own frame.
@@ -45,7 +43,10 @@ fn validate_points(points: &[Point3]) -> Result<()> {
     if points.is_empty() {
         return Err(Error::invalid("point cloud is empty"));
     }
-    if let Some(i) = points.iter().position(|p| !p.coords.iter().all(|c| c.is_finite())) {
+    if let Some(i) = points
+        .iter()
+        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+    {
         return Err(Error::invalid(format!(
             "point {i} has a NaN or infinite coordinate: {:?}",
             points[i].coords.as_slice()

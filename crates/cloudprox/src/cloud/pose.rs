@@ -54,13 +54,19 @@ mod tests {
         assert!((back.to_homogeneous() - p.to_homogeneous()).amax() < 1e-12);
         let mut scaled = pose_to_matrix(&p);
         scaled[(0, 0)] *= 2.0;
-        assert!(pose_from_matrix(&scaled).unwrap_err().to_string().contains("rotation"));
+        assert!(pose_from_matrix(&scaled)
+            .unwrap_err()
+            .to_string()
+            .contains("rotation"));
         let mut reflect = Matrix4::identity();
         reflect[(2, 2)] = -1.0;
         assert!(pose_from_matrix(&reflect).is_err());
         let mut bad_row = Matrix4::identity();
         bad_row[(3, 0)] = 1.0;
-        assert!(pose_from_matrix(&bad_row).unwrap_err().to_string().contains("last row"));
+        assert!(pose_from_matrix(&bad_row)
+            .unwrap_err()
+            .to_string()
+            .contains("last row"));
         let mut nan = Matrix4::identity();
         nan[(0, 3)] = f64::NAN;
         assert!(pose_from_matrix(&nan).is_err());

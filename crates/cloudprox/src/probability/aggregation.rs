@@ -69,7 +69,11 @@ mod tests {
         assert!((Aggregation::Independent.aggregate(p) - ind).abs() < 1e-15);
         assert_eq!(Aggregation::Union.aggregate([0.7, 0.8]), 1.0);
         assert_eq!(Aggregation::Independent.aggregate([1.0, 0.3]), 1.0);
-        for a in [Aggregation::Max, Aggregation::Union, Aggregation::Independent] {
+        for a in [
+            Aggregation::Max,
+            Aggregation::Union,
+            Aggregation::Independent,
+        ] {
             assert_eq!(a.aggregate(std::iter::empty()), 0.0);
             assert_eq!(Aggregation::from_name(a.name()), Some(a));
             // max <= independent <= union

@@ -91,7 +91,9 @@ mod tests {
 
     #[test]
     fn quantile_inverts_cdf() {
-        for &p in &[1e-12, 1e-6, 0.001, 0.02, 0.1, 0.3, 0.5, 0.7, 0.975, 0.999_999] {
+        for &p in &[
+            1e-12, 1e-6, 0.001, 0.02, 0.1, 0.3, 0.5, 0.7, 0.975, 0.999_999,
+        ] {
             let x = normal_quantile(p);
             assert!((normal_cdf(x) / p - 1.0).abs() < 1e-12, "p = {p}, x = {x}");
         }

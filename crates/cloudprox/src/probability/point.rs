@@ -51,7 +51,13 @@ mod tests {
         let cov = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1e-4));
         let p = point_probability(0.02, &Vector3::z(), &cov, 1.0);
         assert!((p - normal_cdf(-2.0)).abs() < 1e-15);
-        assert_eq!(point_probability(0.02, &Vector3::z(), &Matrix3::zeros(), 1.0), 0.0);
-        assert_eq!(point_probability(-0.02, &Vector3::z(), &Matrix3::zeros(), 1.0), 1.0);
+        assert_eq!(
+            point_probability(0.02, &Vector3::z(), &Matrix3::zeros(), 1.0),
+            0.0
+        );
+        assert_eq!(
+            point_probability(-0.02, &Vector3::z(), &Matrix3::zeros(), 1.0),
+            1.0
+        );
     }
 }

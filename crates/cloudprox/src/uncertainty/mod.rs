@@ -11,8 +11,8 @@ mod discretization;
 mod noise;
 mod robust;
 
-pub use covariance::{covariance_factor, max_std, validate_covariance};
 pub(crate) use covariance::directional_std_of;
+pub use covariance::{covariance_factor, max_std, validate_covariance};
 pub use discretization::{discretization_covariances, DiscretizationSettings};
 pub use noise::NoiseModel;
 pub use robust::RobustModel;

@@ -38,7 +38,9 @@ mod tests {
     #[test]
     fn radii_follow_their_formulas() {
         assert!(RobustModel::Gaussian.radius(0.5).unwrap().abs() < 1e-12);
-        assert!((RobustModel::Gaussian.radius(0.975).unwrap() - 1.959_963_984_540_054).abs() < 1e-9);
+        assert!(
+            (RobustModel::Gaussian.radius(0.975).unwrap() - 1.959_963_984_540_054).abs() < 1e-9
+        );
         assert!((RobustModel::Chebyshev.radius(0.9).unwrap() - 3.0).abs() < 1e-12);
         assert!(RobustModel::Gaussian.radius(1.0).is_err());
         assert!(RobustModel::Chebyshev.radius(0.2).is_err());

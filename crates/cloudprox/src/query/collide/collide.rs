@@ -3,10 +3,10 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{train, SolveStatus};
+use crate::classify::{train, Classification, SolveStatus};
 use crate::cloud::PointCloud;
 use crate::error::Result;
-use crate::math::{Matrix3, Point3, Pose};
+use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::point_probability;
 use crate::query::collide::region::{near_regions, split_patches, Patch};
 use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
@@ -25,6 +25,10 @@ use crate::Real;
 /// patches of the near regions (world frame) and statistics. Errors only on an
 /// invalid request; a solver that does not converge falls back (see
 /// [`crate::classify::SolveStatus::Fallback`]) and is counted in the stats.
+///
+/// All the work happens in `b`'s own frame (only `a`'s near points are moved), so
+/// moving both clouds by the same rigid motion changes nothing but the world
+/// coordinates of the reported points, normals and surfaces.
 ///
 /// # Example
 /// ```
@@ -62,8 +66,9 @@ pub(crate) fn collide_with_workspace(
     request.validate()?;
     let start = Instant::now();
     let mut stats = QueryStats::default();
+    // Pose of A in B's frame.
+    let rel = pose_b.inverse() * pose_a;
     let components: Vec<Patch> = if request.use_hierarchy {
-        let rel = pose_b.inverse() * pose_a;
         let t = a
             .bvh()
             .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, workspace);
@@ -80,44 +85,56 @@ pub(crate) fn collide_with_workspace(
     };
     stats.near_regions = components.len();
 
-    let world = |pose: &Pose, cloud: &PointCloud, idx: &[u32]| -> (Vec<Point3>, Vec<Matrix3>) {
-        let r = pose.rotation.to_rotation_matrix();
-        let r = r.matrix();
-        idx.iter()
-            .map(|&i| {
-                let i = i as usize;
-                (pose * cloud.points()[i], r * cloud.covariances()[i] * r.transpose())
-            })
-            .unzip()
-    };
-
     let mut probabilities_a = vec![0.0; a.len()];
     let mut probabilities_b = vec![0.0; b.len()];
     let mut regions = Vec::new();
     for component in components {
-        // Patches are cut in the world frame, so the cut does not depend on which
-        // cloud's frame the traversal ran in.
-        let comp_a = world(pose_a, a, &component.a).0;
-        let comp_b = world(pose_b, b, &component.b).0;
+        let (pa, ca) = in_frame(&rel, a, &component.a);
+        let (pb, cb) = in_frame(&Pose::identity(), b, &component.b);
         let local = Patch {
             component: component.component,
             a: (0..component.a.len() as u32).collect(),
             b: (0..component.b.len() as u32).collect(),
         };
-        for patch in split_patches(local, &comp_a, &comp_b, request.region_max_points) {
+        for patch in split_patches(local, &pa, &pb, request.region_max_points) {
+            let na = patch.a.len();
+            let pick = |idx: &[u32], p: &[Point3], c: &[Matrix3]| -> (Vec<Point3>, Vec<Matrix3>) {
+                idx.iter().map(|&k| (p[k as usize], c[k as usize])).unzip()
+            };
+            let (mut pts, mut covs) = pick(&patch.a, &pa, &ca);
+            let (ptsb, covsb) = pick(&patch.b, &pb, &cb);
+            pts.extend(ptsb);
+            covs.extend(covsb);
+            let fit = fit_patch(&pts, &covs, na, request)?;
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
-            let region = classify_patch(patch.component, pose_a, a, &ia, pose_b, b, &ib, request, &world)?;
-            for (&i, &p) in ia.iter().zip(&region.1) {
+            for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
                 probabilities_a[i as usize] = p;
             }
-            for (&i, &p) in ib.iter().zip(&region.2) {
+            for (&i, &p) in ib.iter().zip(&fit.probabilities[na..]) {
                 probabilities_b[i as usize] = p;
             }
-            stats.points_classified += ia.len() + ib.len();
-            stats.solver_iterations += u64::from(region.0.iterations);
-            stats.solver_fallbacks += usize::from(region.0.status == SolveStatus::Fallback);
-            regions.push(region.0);
+            stats.points_classified += pts.len();
+            stats.solver_iterations += u64::from(fit.classification.iterations);
+            stats.solver_fallbacks +=
+                usize::from(fit.classification.status == SolveStatus::Fallback);
+            let mut separator = fit.classification.separator;
+            separator.frame = *pose_b;
+            regions.push(ContactRegion {
+                component: patch.component,
+                indices_a: ia,
+                indices_b: ib,
+                point: pose_b * fit.point,
+                normal: pose_b.rotation * fit.normal,
+                separation: fit.separation,
+                probability: request
+                    .aggregation
+                    .aggregate(fit.probabilities.iter().copied()),
+                surface: separator.surface,
+                separator,
+                status: fit.classification.status,
+                iterations: fit.classification.iterations,
+            });
         }
     }
     stats.patches = regions.len();
@@ -135,84 +152,101 @@ pub(crate) fn collide_with_workspace(
     })
 }
 
-type WorldFn<'w> = dyn Fn(&Pose, &PointCloud, &[u32]) -> (Vec<Point3>, Vec<Matrix3>) + 'w;
+/// Points `idx` of `cloud` and their covariances, moved by `pose`.
+fn in_frame(pose: &Pose, cloud: &PointCloud, idx: &[u32]) -> (Vec<Point3>, Vec<Matrix3>) {
+    let r = pose.rotation.to_rotation_matrix();
+    let r = r.matrix();
+    idx.iter()
+        .map(|&i| {
+            let i = i as usize;
+            (
+                pose * cloud.points()[i],
+                r * cloud.covariances()[i] * r.transpose(),
+            )
+        })
+        .unzip()
+}
 
-#[allow(clippy::type_complexity)]
-fn classify_patch(
-    component: u32,
-    pose_a: &Pose,
-    a: &PointCloud,
-    ia: &[u32],
-    pose_b: &Pose,
-    b: &PointCloud,
-    ib: &[u32],
+/// A classified patch, in the frame its points were given in.
+struct PatchFit {
+    classification: Classification,
+    /// Per-point probabilities, A's points first.
+    probabilities: Vec<Real>,
+    point: Point3,
+    normal: Vector3,
+    separation: Real,
+}
+
+/// Trains the surface for `pts` (the first `na` from A) and derives the per-point
+/// probabilities (Eq. 3), the contact point, normal and separation estimate.
+fn fit_patch(
+    pts: &[Point3],
+    covs: &[Matrix3],
+    na: usize,
     request: &CollisionRequest,
-    world: &WorldFn<'_>,
-) -> Result<(ContactRegion, Vec<Real>, Vec<Real>)> {
-    let (mut pts, mut covs) = world(pose_a, a, ia);
-    let (pts_b, covs_b) = world(pose_b, b, ib);
-    pts.extend_from_slice(&pts_b);
-    covs.extend_from_slice(&covs_b);
-    let labels: Vec<Real> = std::iter::repeat_n(1.0, ia.len())
-        .chain(std::iter::repeat_n(-1.0, ib.len()))
+) -> Result<PatchFit> {
+    let labels: Vec<Real> = (0..pts.len())
+        .map(|i| if i < na { 1.0 } else { -1.0 })
         .collect();
-    let fit = train(&pts, &covs, &labels, &request.classify)?;
-    let sep = &fit.separator;
-    let mut probs = Vec::with_capacity(pts.len());
-    let mut dists = Vec::with_capacity(pts.len());
-    for ((x, cov), &c) in pts.iter().zip(&covs).zip(&labels) {
-        let (f, g) = sep.value_and_gradient(x);
-        probs.push(point_probability(f, &g, cov, c));
+    let classification = train(pts, covs, &labels, &request.classify)?;
+    let sep = &classification.separator;
+    let mut probabilities = Vec::with_capacity(pts.len());
+    let mut margins = Vec::with_capacity(pts.len());
+    for ((x, cov), &c) in pts.iter().zip(covs).zip(&labels) {
+        let (f, g) = sep.value_and_gradient_local(x);
+        probabilities.push(point_probability(f, &g, cov, c));
         let gn = g.norm();
-        dists.push(if gn > 0.0 { c * f / gn } else if c * f > 0.0 { Real::INFINITY } else { Real::NEG_INFINITY });
+        margins.push(if gn > 0.0 { c * f / gn } else { c * f });
     }
-    let na = ia.len();
-    let (da, db) = dists.split_at(na);
-    let separation = quantile(da, 0.25) + quantile(db, 0.25);
-    let closest = |d: &[Real], off: usize| -> Point3 {
-        let k = d
-            .iter()
-            .enumerate()
-            .min_by(|x, y| x.1.total_cmp(y.1))
-            .map_or(0, |(k, _)| k);
-        pts[off + k]
+    // The contact point: between the point of each side closest to (or deepest
+    // across) the surface, projected onto it.
+    let deepest = |range: std::ops::Range<usize>| -> Point3 {
+        let k = range
+            .clone()
+            .min_by(|&i, &j| margins[i].total_cmp(&margins[j]))
+            .unwrap_or(range.start);
+        pts[k]
     };
-    let mid = nalgebra::center(&closest(da, 0), &closest(db, na));
+    let mid = nalgebra::center(&deepest(0..na), &deepest(na..pts.len()));
     let point = sep.project(&mid);
-    let (_, g) = sep.value_and_gradient(&point);
-    let normal = if g.norm() > 0.0 { -g.normalize() } else { (pts_b_mean(&pts[na..]) - pts_b_mean(&pts[..na])).normalize() };
-    let probability = request.aggregation.aggregate(probs.iter().copied());
-    let probs_b = probs.split_off(na);
-    Ok((
-        ContactRegion {
-            component,
-            indices_a: ia.to_vec(),
-            indices_b: ib.to_vec(),
-            point,
-            normal,
-            separation,
-            probability,
-            separator: fit.separator.clone(),
-            surface: fit.separator.surface,
-            status: fit.status,
-            iterations: fit.iterations,
-        },
-        probs,
-        probs_b,
-    ))
+    let (_, g) = sep.value_and_gradient_local(&point);
+    let normal = if g.norm() > 0.0 {
+        -g.normalize()
+    } else {
+        (mean(&pts[na..]) - mean(&pts[..na])).normalize()
+    };
+    let separation =
+        axial_offset(&pts[na..], &point, &normal) - axial_offset(&pts[..na], &point, &normal);
+    Ok(PatchFit {
+        classification,
+        probabilities,
+        point,
+        normal,
+        separation,
+    })
 }
 
-fn pts_b_mean(p: &[Point3]) -> Point3 {
-    Point3::from(p.iter().map(|x| x.coords).sum::<crate::math::Vector3>() / p.len() as Real)
+fn mean(p: &[Point3]) -> Vector3 {
+    p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }
 
-/// The `q`-quantile of `v` (nearest rank), `NaN` for an empty slice.
-fn quantile(v: &[Real], q: Real) -> Real {
-    if v.is_empty() {
-        return Real::NAN;
-    }
-    let mut s = v.to_vec();
-    let k = ((q * (s.len() - 1) as Real).round() as usize).min(s.len() - 1);
-    let (_, x, _) = s.select_nth_unstable_by(k, Real::total_cmp);
-    *x
+/// Where one side's surface crosses the line through `point` along `normal`: the
+/// median offset along `normal` of the side's points nearest that line (a tenth of
+/// them, between 3 and 30). Medians keep the estimate unbiased by the noise on a
+/// flat contact, where a minimum or maximum would be pulled by the extreme points.
+fn axial_offset(pts: &[Point3], point: &Point3, normal: &Vector3) -> Real {
+    let mut by_lateral: Vec<(Real, Real)> = pts
+        .iter()
+        .map(|x| {
+            let d = x - point;
+            let along = d.dot(normal);
+            ((d - normal * along).norm_squared(), along)
+        })
+        .collect();
+    let k = (pts.len() / 10).clamp(3, 30).min(pts.len());
+    by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| x.1).collect();
+    let m = along.len() / 2;
+    let (_, med, _) = along.select_nth_unstable_by(m, Real::total_cmp);
+    *med
 }

@@ -24,13 +24,6 @@ pub fn near_regions(leaf_pairs: &[(u32, u32)], bvh_a: &Bvh, bvh_b: &Bvh) -> Vec<
     // Union-find over the leaves that occur: A leaves as 2k, B leaves as 2k + 1.
     let mut id_of: HashMap<(u32, bool), usize> = HashMap::new();
     let mut parent: Vec<usize> = Vec::new();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
     let mut node = |key: (u32, bool), parent: &mut Vec<usize>| -> usize {
         *id_of.entry(key).or_insert_with(|| {
             parent.push(parent.len());
@@ -72,6 +65,15 @@ pub fn near_regions(leaf_pairs: &[(u32, u32)], bvh_a: &Bvh, bvh_b: &Bvh) -> Vec<
         }
     }
     out
+}
+
+/// Root of `x` in a union-find forest, halving paths on the way.
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
 }
 
 /// Splits `region` (points given in one common frame) into patches of at most
@@ -128,7 +130,8 @@ fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
     let (_, median, _) = keys.select_nth_unstable_by(mid, Real::total_cmp);
     let median = *median;
     let side = |pts: &[Point3], idx: &[u32]| -> (Vec<u32>, Vec<u32>) {
-        idx.iter().partition(|&&i| pts[i as usize].coords.dot(&axis) < median)
+        idx.iter()
+            .partition(|&&i| pts[i as usize].coords.dot(&axis) < median)
     };
     let (al, ar) = side(pa, &p.a);
     let (bl, br) = side(pb, &p.b);

@@ -1,0 +1,140 @@
+//! `PointCloud`: points with a covariance each.
+
+use std::sync::Arc;
+
+use cloudprox::cloud::PointCloud;
+use cloudprox::uncertainty::DiscretizationSettings;
+use numpy::prelude::*;
+use numpy::{PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+
+use crate::convert::{
+    matrices3_from, matrices3_to_py, points_from, points_to_py, pose_from, shape_str, to_f64_array,
+    vec_to_py,
+};
+use crate::error::{invalid_input, run_detached};
+
+/// The noise given to the constructor.
+enum Noise {
+    Sigma(f64),
+    Sigmas(Vec<f64>),
+    Covariances(Vec<cloudprox::math::Matrix3>),
+}
+
+fn noise_from(
+    py: Python<'_>,
+    sigma: Option<&Bound<'_, PyAny>>,
+    cov: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Noise> {
+    match (sigma, cov) {
+        (Some(_), Some(_)) => Err(invalid_input(
+            py,
+            "give either sigma or cov, not both (cov already holds the full sensor noise)",
+        )),
+        (None, None) => Ok(Noise::Sigma(0.0)),
+        (None, Some(cov)) => Ok(Noise::Covariances(matrices3_from(cov, "cov")?)),
+        (Some(sigma), None) => {
+            let arr = to_f64_array(sigma, "sigma")?;
+            let values: Vec<f64> = arr.readonly().as_array().iter().copied().collect();
+            match (arr.ndim(), values.as_slice()) {
+                (0, &[s]) => Ok(Noise::Sigma(s)),
+                (1, _) => Ok(Noise::Sigmas(values)),
+                _ => Err(invalid_input(
+                    py,
+                    format!(
+                        "sigma must be a scalar or an array of shape (n,), got shape {}",
+                        shape_str(arr.shape())
+                    ),
+                )),
+            }
+        }
+    }
+}
+
+/// A point cloud with a 3x3 covariance per point (the sensor noise, plus the
+/// discretization error if requested), in its own frame.
+///
+/// The Rust cloud sits behind an `Arc`: queries share it (and its hierarchy,
+/// built on first use) without copying.
+#[pyclass(name = "PointCloud", frozen, module = "cloudprox._native")]
+pub struct PyPointCloud {
+    pub(crate) inner: Arc<PointCloud>,
+}
+
+#[pymethods]
+impl PyPointCloud {
+    #[new]
+    #[pyo3(signature = (points, sigma=None, cov=None, discretization=false, k=None))]
+    fn new(
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        sigma: Option<&Bound<'_, PyAny>>,
+        cov: Option<&Bound<'_, PyAny>>,
+        discretization: bool,
+        k: Option<i64>,
+    ) -> PyResult<Self> {
+        let points = points_from(points, "points")?;
+        let noise = noise_from(py, sigma, cov)?;
+        let disc = if discretization {
+            let mut settings = DiscretizationSettings::default();
+            if let Some(k) = k {
+                settings.k = usize::try_from(k).map_err(|_| {
+                    invalid_input(py, format!("discretization k must be >= 2, got {k}"))
+                })?;
+            }
+            Some(settings)
+        } else {
+            None
+        };
+        let cloud = run_detached(py, move || {
+            let cloud = match noise {
+                Noise::Sigma(s) => PointCloud::from_sigma(points, s),
+                Noise::Sigmas(s) => PointCloud::from_sigmas(points, s),
+                Noise::Covariances(c) => PointCloud::from_covariances(points, c),
+            }?;
+            match disc {
+                Some(settings) => cloud.with_discretization(&settings),
+                None => Ok(cloud),
+            }
+        })?;
+        Ok(Self {
+            inner: Arc::new(cloud),
+        })
+    }
+
+    /// Point positions, shape `(n, 3)`, float64 (metres).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points_to_py(py, self.inner.points())
+    }
+
+    /// Per-point total covariances, shape `(n, 3, 3)`, float64 (metres squared).
+    #[getter]
+    fn covariances<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        matrices3_to_py(py, self.inner.covariances())
+    }
+
+    /// Per-point largest standard deviation over all directions, shape `(n,)`.
+    #[getter]
+    fn sigma_max<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec_to_py(py, self.inner.sigma_max())
+    }
+
+    /// A new cloud moved by the `(4, 4)` rigid transform `transform`.
+    fn transformed(&self, py: Python<'_>, transform: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let pose = pose_from(py, Some(transform), "transform")?;
+        let inner = Arc::clone(&self.inner);
+        let moved = run_detached(py, move || Ok(inner.transformed(&pose)))?;
+        Ok(Self {
+            inner: Arc::new(moved),
+        })
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("PointCloud with {} points.", self.inner.len())
+    }
+}

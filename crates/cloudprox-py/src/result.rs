@@ -1,0 +1,229 @@
+//! `CollisionResult` and `ContactRegion`: the answer of a query, as plain data.
+
+use cloudprox::query::{CollisionResult, ContactRegion, QueryStats};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::convert::{indices_to_py, points_from, rows3_to_py, vec_to_py, vector3_to_py};
+use crate::error::guard;
+
+/// The values `(m,)` and gradients `(m, 3)` of a separating surface.
+type Evaluation<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// `x` with about 6 significant digits, like Python's `%.6g`.
+fn fmt_g(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if !(1e-4..1e6).contains(&a) {
+        format!("{x:.5e}")
+    } else {
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    }
+}
+
+/// One patch of a near region with its own separating surface (world frame).
+#[pyclass(name = "ContactRegion", frozen, module = "cloudprox._native")]
+pub struct PyContactRegion {
+    inner: ContactRegion,
+}
+
+#[pymethods]
+impl PyContactRegion {
+    /// Index of the connected near region this patch belongs to.
+    #[getter]
+    fn component(&self) -> u32 {
+        self.inner.component
+    }
+
+    /// Indices of cloud A's points in the patch, shape `(k,)`, int64.
+    #[getter]
+    fn indices_a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        indices_to_py(py, &self.inner.indices_a)
+    }
+
+    /// Indices of cloud B's points in the patch, shape `(l,)`, int64.
+    #[getter]
+    fn indices_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        indices_to_py(py, &self.inner.indices_b)
+    }
+
+    /// A point on the separating surface where the clouds come closest, shape `(3,)`.
+    #[getter]
+    fn point<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector3_to_py(py, &self.inner.point.coords)
+    }
+
+    /// Unit normal of the surface at `point`, from A towards B, shape `(3,)`.
+    #[getter]
+    fn normal<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector3_to_py(py, &self.inner.normal)
+    }
+
+    /// Estimated signed separation along the normal (metres), negative when the
+    /// clouds interpenetrate.
+    #[getter]
+    fn separation(&self) -> f64 {
+        self.inner.separation
+    }
+
+    /// The patch's aggregated collision probability.
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.inner.probability
+    }
+
+    /// The surface family: `"linear"` or `"quadric"`.
+    #[getter]
+    fn surface(&self) -> &'static str {
+        self.inner.surface.name()
+    }
+
+    /// How the solve ended: `"solved"`, `"almost_solved"` or `"fallback"`.
+    #[getter]
+    fn status(&self) -> &'static str {
+        self.inner.status.name()
+    }
+
+    /// Interior-point iterations of the solve.
+    #[getter]
+    fn iterations(&self) -> u32 {
+        self.inner.iterations
+    }
+
+    /// The separating surface `f` (positive on A's side) and its gradient at the
+    /// `(m, 3)` points `x`: a tuple of shapes `(m,)` and `(m, 3)`.
+    fn evaluate<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Evaluation<'py>> {
+        let points = points_from(x, "x")?;
+        let sep = &self.inner.separator;
+        let (f, g): (Vec<f64>, Vec<_>) =
+            guard(|| points.iter().map(|p| sep.value_and_gradient(p)).unzip())
+                .map_err(crate::error::Panicked::into_py_err)?;
+        Ok((vec_to_py(py, &f), rows3_to_py(py, g.into_iter())?))
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.inner;
+        format!(
+            "ContactRegion(component={}, points=({}, {}), probability={}, separation={}, \
+             surface='{}', status='{}')",
+            r.component,
+            r.indices_a.len(),
+            r.indices_b.len(),
+            fmt_g(r.probability),
+            fmt_g(r.separation),
+            r.surface.name(),
+            r.status.name()
+        )
+    }
+}
+
+/// The answer of `collide`: `P`, the state, per-point probabilities, the contact
+/// regions and statistics.
+#[pyclass(name = "CollisionResult", frozen, module = "cloudprox._native")]
+pub struct PyCollisionResult {
+    probability: f64,
+    state: &'static str,
+    probabilities_a: Vec<f64>,
+    probabilities_b: Vec<f64>,
+    regions: Vec<Py<PyContactRegion>>,
+    stats: QueryStats,
+}
+
+impl PyCollisionResult {
+    /// Wraps a core result (creates the region objects once).
+    pub fn new(py: Python<'_>, r: CollisionResult) -> PyResult<Self> {
+        let regions = r
+            .regions
+            .into_iter()
+            .map(|inner| Py::new(py, PyContactRegion { inner }))
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok(Self {
+            probability: r.probability,
+            state: r.state.name(),
+            probabilities_a: r.probabilities_a,
+            probabilities_b: r.probabilities_b,
+            regions,
+            stats: r.stats,
+        })
+    }
+}
+
+#[pymethods]
+impl PyCollisionResult {
+    /// The pair's collision probability `P` in `[0, 1]`.
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.probability
+    }
+
+    /// `"free"`, `"contact"` or `"collision"`.
+    #[getter]
+    fn state(&self) -> &'static str {
+        self.state
+    }
+
+    /// Per-point probability of A's points being on the wrong side, shape `(n_a,)`.
+    #[getter]
+    fn probabilities_a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec_to_py(py, &self.probabilities_a)
+    }
+
+    /// Per-point probability of B's points being on the wrong side, shape `(n_b,)`.
+    #[getter]
+    fn probabilities_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec_to_py(py, &self.probabilities_b)
+    }
+
+    /// The classified patches (a new list of the same region objects each time).
+    #[getter]
+    fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.regions.iter().map(|r| r.clone_ref(py)))
+    }
+
+    /// Counters and timings of the query, as a dict.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        // Destructured without `..`: a new core field must be added here.
+        let QueryStats {
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            points_classified,
+            solver_iterations,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds,
+        } = &self.stats;
+        let d = PyDict::new(py);
+        d.set_item("node_pairs_visited", node_pairs_visited)?;
+        d.set_item("leaf_pairs", leaf_pairs)?;
+        d.set_item("near_regions", near_regions)?;
+        d.set_item("patches", patches)?;
+        d.set_item("points_classified", points_classified)?;
+        d.set_item("solver_iterations", solver_iterations)?;
+        d.set_item("solver_fallbacks", solver_fallbacks)?;
+        d.set_item("pruned_bound", pruned_bound)?;
+        d.set_item("time_seconds", time_seconds)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "CollisionResult(probability={}, state='{}', regions={}, points=({}, {}))",
+            fmt_g(self.probability),
+            self.state,
+            self.regions.len(),
+            self.probabilities_a.len(),
+            self.probabilities_b.len()
+        )
+    }
+}

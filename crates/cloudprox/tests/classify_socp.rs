@@ -1,0 +1,155 @@
+//! The robust SOCP as Clarabel solves it, checked independently of the assembly:
+//! feasibility of Eq. 2 at the returned point and optimality against perturbations.
+
+use cloudprox::classify::{train, Classification, ClassifySettings, SolveStatus, Surface};
+use cloudprox::math::{Matrix3, Point3, Vector3};
+use cloudprox::sample::NormalRng;
+use cloudprox::uncertainty::RobustModel;
+
+/// Two noisy, partly overlapping curved patches with random full covariances.
+fn scene(n: usize, gap: f64, seed: u64, isotropic: bool) -> (Vec<Point3>, Vec<Matrix3>, Vec<f64>) {
+    let mut rng = NormalRng::new(seed);
+    let (mut pts, mut covs, mut labels) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..n {
+        let label = if i % 2 == 0 { 1.0 } else { -1.0 };
+        let (x, y) = (rng.uniform() - 0.5, rng.uniform() - 0.5);
+        let z = 0.3 * (x * x + y * y) + if label > 0.0 { -gap / 2.0 } else { gap / 2.0 };
+        let s = 0.01 + 0.02 * rng.uniform();
+        let cov = if isotropic {
+            Matrix3::identity() * s * s
+        } else {
+            let m = Matrix3::from_fn(|_, _| rng.normal() * s);
+            m * m.transpose()
+        };
+        pts.push(Point3::new(x, y, z) + Vector3::new(rng.normal(), rng.normal(), rng.normal()) * s);
+        covs.push(cov);
+        labels.push(label);
+    }
+    (pts, covs, labels)
+}
+
+/// Objective of Eq. 2 with the smallest feasible slacks for (w, b), evaluated from
+/// the definition (normalized coordinates, covariance pushed through the features).
+fn objective(
+    fit: &Classification,
+    w: &[f64],
+    b: f64,
+    pts: &[Point3],
+    covs: &[Matrix3],
+    labels: &[f64],
+    s: &ClassifySettings,
+) -> f64 {
+    let sep = &fit.separator;
+    let r = s.robust_radius().unwrap();
+    let d = sep.surface.dim();
+    let mut phi = vec![0.0; d];
+    let mut jac = vec![Vector3::zeros(); d];
+    let mut total = 0.5 * w.iter().map(|v| v * v).sum::<f64>();
+    for ((x, cov), &c) in pts.iter().zip(covs).zip(labels) {
+        let u = (x - sep.center) / sep.scale;
+        sep.surface.features(&u, &mut phi, &mut jac);
+        let f = b + w.iter().zip(&phi).map(|(a, p)| a * p).sum::<f64>();
+        let g: Vector3 = w.iter().zip(&jac).map(|(a, j)| j * *a).sum();
+        let spread = g.dot(&(cov / (sep.scale * sep.scale) * g)).max(0.0).sqrt();
+        total += s.lambda * (1.0 - c * f + r * spread).max(0.0);
+    }
+    total
+}
+
+fn check(surface: Surface, isotropic: bool, gap: f64, seed: u64) {
+    let (pts, covs, labels) = scene(120, gap, seed, isotropic);
+    let settings = ClassifySettings::builder()
+        .surface(surface)
+        .robust_model(RobustModel::Gaussian)
+        .robust_eta(0.9)
+        .build()
+        .unwrap();
+    let fit = train(&pts, &covs, &labels, &settings).unwrap();
+    assert!(
+        matches!(fit.status, SolveStatus::Solved | SolveStatus::AlmostSolved),
+        "{:?}",
+        fit.status
+    );
+    let sep = &fit.separator;
+    let r = settings.robust_radius().unwrap();
+    // Feasibility of every constraint of Eq. 2 at the solution, in world units:
+    // c f(x) >= 1 - xi + r sqrt(grad^T Sigma grad) (the scale cancels), xi >= 0.
+    for (i, ((x, cov), &c)) in pts.iter().zip(&covs).zip(&labels).enumerate() {
+        let (f, g) = sep.value_and_gradient(x);
+        let xi = fit.slacks[i];
+        assert!(xi >= -1e-6, "slack {i} negative: {xi}");
+        let rhs = 1.0 - xi + r * g.dot(&(cov * g)).max(0.0).sqrt();
+        assert!(
+            c * f >= rhs - 1e-5 * (1.0 + rhs.abs()),
+            "constraint {i}: {} < {rhs}",
+            c * f
+        );
+    }
+    // Optimality: no perturbation of (w, b) lowers the objective (convexity makes a
+    // local check a global one).
+    let base = objective(&fit, &sep.w, sep.b, &pts, &covs, &labels, &settings);
+    let mut rng = NormalRng::new(seed + 1000);
+    for _ in 0..200 {
+        let step = 1e-3 * (1.0 + sep.w.iter().map(|v| v.abs()).fold(0.0, f64::max));
+        let w2: Vec<f64> = sep.w.iter().map(|v| v + step * rng.normal()).collect();
+        let b2 = sep.b + step * rng.normal();
+        let other = objective(&fit, &w2, b2, &pts, &covs, &labels, &settings);
+        assert!(
+            other >= base * (1.0 - 1e-6) - 1e-6,
+            "perturbation improved {base} to {other}"
+        );
+    }
+}
+
+#[test]
+fn linear_isotropic_shared_cone_is_feasible_and_optimal() {
+    check(Surface::Linear, true, 0.1, 1);
+    check(Surface::Linear, true, -0.05, 2);
+}
+
+#[test]
+fn linear_full_covariance_cones_are_feasible_and_optimal() {
+    check(Surface::Linear, false, 0.1, 3);
+    check(Surface::Linear, false, -0.05, 4);
+}
+
+#[test]
+fn quadric_cones_are_feasible_and_optimal() {
+    check(Surface::Quadric, false, 0.1, 5);
+    check(Surface::Quadric, true, 0.02, 6);
+    check(Surface::Quadric, false, -0.05, 7);
+}
+
+#[test]
+fn a_separable_set_is_separated_with_zero_slack() {
+    // Far apart: every constraint holds with xi = 0 and every point is on its side.
+    let (pts, covs, labels) = scene(60, 1.0, 9, true);
+    for surface in [Surface::Linear, Surface::Quadric] {
+        let s = ClassifySettings::builder()
+            .surface(surface)
+            .build()
+            .unwrap();
+        let fit = train(&pts, &covs, &labels, &s).unwrap();
+        assert!(fit.slacks.iter().all(|&x| x < 1e-6), "{surface:?}");
+        for (x, &c) in pts.iter().zip(&labels) {
+            assert!(c * fit.separator.value_and_gradient(x).0 > 0.0);
+        }
+    }
+}
+
+#[test]
+fn train_rejects_bad_labels_and_lengths() {
+    let (pts, covs, mut labels) = scene(10, 0.1, 1, true);
+    let s = ClassifySettings::default();
+    assert!(train(&pts, &covs[..9], &labels, &s).is_err());
+    let one_class = vec![1.0; 10];
+    assert!(train(&pts, &covs, &one_class, &s)
+        .unwrap_err()
+        .to_string()
+        .contains("both clouds"));
+    labels[3] = 0.5;
+    assert!(train(&pts, &covs, &labels, &s)
+        .unwrap_err()
+        .to_string()
+        .contains("label 3"));
+}

@@ -1,0 +1,249 @@
+//! The collide query between two noisy clouds: analytic cases, invariances, the
+//! hierarchy against brute force.
+
+mod common;
+
+use cloudprox::prelude::*;
+use cloudprox::probability::normal_cdf;
+use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
+
+fn request(surface: Surface) -> CollisionRequest {
+    CollisionRequest::builder()
+        .classify(
+            ClassifySettings::builder()
+                .surface(surface)
+                .build()
+                .unwrap(),
+        )
+        .build()
+        .unwrap()
+}
+
+fn sweep(
+    a: &PointCloud,
+    b: &PointCloud,
+    pose: impl Fn(f64) -> Pose,
+    req: &CollisionRequest,
+) -> Vec<(f64, f64)> {
+    [
+        -3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 12.0,
+    ]
+    .iter()
+    .map(|&k| {
+        let r = collide(&Pose::identity(), a, &pose(k * SIGMA), b, req).unwrap();
+        (k, r.probability)
+    })
+    .collect()
+}
+
+fn assert_sweep(name: &str, ps: &[(f64, f64)]) {
+    for w in ps.windows(2) {
+        assert!(
+            w[1].1 <= w[0].1 + 1e-6,
+            "{name}: P must not increase with the gap: {ps:?}"
+        );
+    }
+    let at = |k: f64| ps.iter().find(|x| x.0 == k).unwrap().1;
+    assert!(at(-3.0) > 0.95, "{name}: P at -3 sigma = {}", at(-3.0));
+    assert!(at(10.0) < 0.01, "{name}: P at 10 sigma = {}", at(10.0));
+}
+
+#[test]
+fn spheres_probability_falls_with_separation() {
+    let (a, b) = spheres(2000);
+    assert_sweep(
+        "spheres/quadric",
+        &sweep(&a, &b, sphere_pose, &request(Surface::Quadric)),
+    );
+}
+
+#[test]
+fn spheres_linear_surface_also_orders_separations() {
+    let (a, b) = spheres(1000);
+    assert_sweep(
+        "spheres/linear",
+        &sweep(&a, &b, sphere_pose, &request(Surface::Linear)),
+    );
+}
+
+#[test]
+fn plates_probability_falls_with_separation() {
+    let (a, b) = plates();
+    assert_sweep(
+        "plates/quadric",
+        &sweep(&a, &b, plate_pose, &request(Surface::Quadric)),
+    );
+}
+
+#[test]
+fn states_follow_thresholds() {
+    let (a, b) = spheres(1000);
+    let req = request(Surface::Quadric);
+    let deep = collide(&Pose::identity(), &a, &sphere_pose(-5.0 * SIGMA), &b, &req).unwrap();
+    assert_eq!(deep.state, CollisionState::Collision);
+    let far = collide(&Pose::identity(), &a, &sphere_pose(20.0 * SIGMA), &b, &req).unwrap();
+    assert_eq!(far.state, CollisionState::Free);
+    assert_eq!(far.probability, 0.0);
+    assert!(far.regions.is_empty() && far.stats.pruned_bound < 1e-3);
+}
+
+#[test]
+fn per_point_probabilities_are_the_gaussian_cdf_of_the_plane_distance() {
+    let (a, b) = spheres(800);
+    let pose_b = sphere_pose(2.0 * SIGMA);
+    let r = collide(
+        &Pose::identity(),
+        &a,
+        &pose_b,
+        &b,
+        &request(Surface::Linear),
+    )
+    .unwrap();
+    assert!(!r.regions.is_empty());
+    for reg in &r.regions {
+        // The plane in its training frame: n . x + d = 0 with n = w / scale.
+        let sep = &reg.separator;
+        let n = Vector3::new(sep.w[0], sep.w[1], sep.w[2]) / sep.scale;
+        let d = sep.b - n.dot(&sep.center.coords);
+        for &i in &reg.indices_a {
+            let x = sep.frame.inverse_transform_point(&a.points()[i as usize]);
+            let dist = (n.dot(&x.coords) + d) / n.norm();
+            let want = normal_cdf(-dist / SIGMA);
+            assert!((r.probabilities_a[i as usize] - want).abs() < 1e-12);
+        }
+        for &i in &reg.indices_b {
+            let x = sep
+                .frame
+                .inverse_transform_point(&(pose_b * b.points()[i as usize]));
+            let dist = (n.dot(&x.coords) + d) / n.norm();
+            let want = normal_cdf(dist / SIGMA);
+            assert!((r.probabilities_b[i as usize] - want).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn moving_both_clouds_rigidly_changes_nothing() {
+    let (a, b) = spheres(1000);
+    let req = request(Surface::Quadric);
+    let t = Pose::new(Vector3::new(0.3, -1.2, 0.7), Vector3::new(0.4, -0.9, 2.1));
+    for gap in [-2.0, 1.0, 3.0] {
+        let pb = sphere_pose(gap * SIGMA);
+        let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
+        let r1 = collide(&t, &a, &(t * pb), &b, &req).unwrap();
+        assert!((r0.probability - r1.probability).abs() < 1e-6, "gap {gap}");
+        let dp = r0
+            .probabilities_a
+            .iter()
+            .zip(&r1.probabilities_a)
+            .map(|(x, y)| (x - y).abs());
+        let dmax = dp.fold(0.0, f64::max);
+        assert!(dmax < 1e-4, "gap {gap}: per-point difference {dmax}");
+        assert_eq!(r0.regions.len(), r1.regions.len());
+        for (g0, g1) in r0.regions.iter().zip(&r1.regions) {
+            assert!(((t * g0.point) - g1.point).norm() < 1e-6);
+            assert!(((t * g0.normal) - g1.normal).norm() < 1e-5);
+            assert!((g0.separation - g1.separation).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn the_classifier_is_equivariant_under_rotations_of_the_data() {
+    // Moving the data itself (not the poses) changes the hierarchies' leaves and
+    // hence the near regions; with one region of all points the remaining
+    // difference is the classifier's, whose regularizer is rotation invariant.
+    let (a, b) = spheres(300);
+    let t = Pose::new(Vector3::new(0.3, -1.2, 0.7), Vector3::new(0.4, -0.9, 2.1));
+    for surface in [Surface::Quadric, Surface::Linear] {
+        let req = CollisionRequest::builder()
+            .classify(
+                ClassifySettings::builder()
+                    .surface(surface)
+                    .build()
+                    .unwrap(),
+            )
+            .use_hierarchy(false)
+            .region_max_points(10_000)
+            .build()
+            .unwrap();
+        for gap in [-2.0, 1.0, 3.0] {
+            let pb = sphere_pose(gap * SIGMA);
+            let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
+            let r2 = collide(
+                &Pose::identity(),
+                &a.transformed(&t),
+                &Pose::identity(),
+                &b.transformed(&(t * pb)),
+                &req,
+            )
+            .unwrap();
+            assert!(
+                (r0.probability - r2.probability).abs() < 1e-5,
+                "{surface:?} gap {gap}: {} vs {}",
+                r0.probability,
+                r2.probability
+            );
+        }
+    }
+}
+
+#[test]
+fn swapping_the_clouds_gives_the_same_probability() {
+    let (a, b) = spheres(1000);
+    let req = request(Surface::Quadric);
+    for gap in [-1.0, 2.0, 4.0] {
+        let pb = sphere_pose(gap * SIGMA);
+        let ab = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
+        let ba = collide(&pb, &b, &Pose::identity(), &a, &req).unwrap();
+        assert!((ab.probability - ba.probability).abs() < 1e-6, "gap {gap}");
+        let d = ab
+            .probabilities_a
+            .iter()
+            .zip(&ba.probabilities_b)
+            .map(|(x, y)| (x - y).abs());
+        assert!(d.fold(0.0, f64::max) < 1e-5);
+        for (ra, rb) in ab.regions.iter().zip(&ba.regions) {
+            assert!(
+                (ra.normal + rb.normal).norm() < 1e-5,
+                "normals point from A to B"
+            );
+        }
+    }
+}
+
+#[test]
+fn collide_many_equals_a_loop_of_collide() {
+    let (a, b) = spheres(600);
+    let req = request(Surface::Quadric);
+    let poses: Vec<Pose> = (0..8)
+        .map(|k| {
+            Pose::new(
+                Vector3::new(-0.2 - 0.002 * k as f64, 0.01 * k as f64, 0.0),
+                Vector3::new(0.0, 0.1 * k as f64, 0.0),
+            )
+        })
+        .collect();
+    let many = collide_many(&poses, &a, &Pose::identity(), &b, &req).unwrap();
+    for (p, m) in poses.iter().zip(&many) {
+        let one = collide(p, &a, &Pose::identity(), &b, &req).unwrap();
+        assert_eq!(one.probability, m.probability);
+        assert_eq!(one.probabilities_b, m.probabilities_b);
+    }
+}
+
+#[test]
+fn refitted_cloud_answers_like_a_fresh_one() {
+    let (mut a, b) = spheres(600);
+    let _ = a.bvh();
+    let shift = Vector3::new(0.05, 0.0, 0.0);
+    let moved: Vec<Point3> = a.points().iter().map(|p| p + shift).collect();
+    a.set_points(moved.clone()).unwrap();
+    a.bvh().assert_well_formed(a.points(), a.sigma_max());
+    let fresh = PointCloud::from_sigma(moved, SIGMA).unwrap();
+    let req = request(Surface::Quadric);
+    let pb = sphere_pose(0.05 + 2.0 * SIGMA);
+    let r1 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
+    let r2 = collide(&Pose::identity(), &fresh, &pb, &b, &req).unwrap();
+    assert!((r1.probability - r2.probability).abs() < 1e-9);
+}

@@ -1,0 +1,114 @@
+//! The hierarchy path against the brute-force path (all points in one region, no
+//! pruning) on random small scenes.
+//!
+//! The two train their surfaces on different point sets (the near region against
+//! whole clouds), so inside the contact band, where the noisiest point decides
+//! `P`, they may differ; they must agree wherever either is decisive, and closely
+//! on the bulk of scenes.
+
+use cloudprox::prelude::*;
+use cloudprox::sample::{add_noise, sphere, NormalRng};
+use proptest::prelude::*;
+
+const SIGMA: f64 = 0.003;
+
+fn req(hierarchy: bool, surface: Surface) -> CollisionRequest {
+    CollisionRequest::builder()
+        .classify(
+            ClassifySettings::builder()
+                .surface(surface)
+                .build()
+                .unwrap(),
+        )
+        .use_hierarchy(hierarchy)
+        .region_max_points(100_000)
+        .build()
+        .unwrap()
+}
+
+/// Two noisy spheres of radii `ra`, `rb` whose exact surfaces are `gap_sigmas`
+/// sigma apart along `dir`, B rotated by `rot`.
+fn scene(
+    na: usize,
+    nb: usize,
+    ra: f64,
+    rb: f64,
+    gap_sigmas: f64,
+    dir: Vector3,
+    rot: Vector3,
+    seed: u64,
+) -> (PointCloud, PointCloud, Pose) {
+    let a = PointCloud::from_sigma(
+        add_noise(&sphere(&Point3::origin(), ra, na), SIGMA, seed),
+        SIGMA,
+    )
+    .unwrap();
+    let b = PointCloud::from_sigma(
+        add_noise(&sphere(&Point3::origin(), rb, nb), SIGMA, seed + 1),
+        SIGMA,
+    )
+    .unwrap();
+    (
+        a,
+        b,
+        Pose::new(dir.normalize() * (ra + rb + gap_sigmas * SIGMA), rot),
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, failure_persistence: None, .. ProptestConfig::default() })]
+
+    #[test]
+    fn hierarchy_agrees_with_brute_force_where_either_is_decisive(
+        na in 40usize..160,
+        nb in 40usize..160,
+        ra in 0.03f64..0.08,
+        rb in 0.03f64..0.08,
+        gap_sigmas in -4.0f64..16.0,
+        dir in prop::array::uniform3(-1.0f64..1.0).prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01),
+        rot in prop::array::uniform3(-3.0f64..3.0),
+        seed in 0u64..1000,
+        linear in any::<bool>(),
+    ) {
+        let (a, b, pose_b) = scene(na, nb, ra, rb, gap_sigmas, Vector3::from(dir), Vector3::from(rot), seed);
+        let surface = if linear { Surface::Linear } else { Surface::Quadric };
+        let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface)).unwrap();
+        let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface)).unwrap();
+        let (ph, pb) = (h.probability, bf.probability);
+        for (x, y, what) in [(ph, pb, "hierarchy decisive"), (pb, ph, "brute force decisive")] {
+            prop_assert!(!(x <= 0.01 && y > 0.1), "{what}: {x} vs {y} at gap {gap_sigmas} sigma");
+            prop_assert!(!(x >= 0.99 && y < 0.9), "{what}: {x} vs {y} at gap {gap_sigmas} sigma");
+        }
+        if h.regions.is_empty() {
+            // Everything pruned: the brute force must find the pair free too.
+            prop_assert!(pb <= 0.01, "pruned everything (bound {}), brute force P = {pb}", h.stats.pruned_bound);
+        }
+    }
+}
+
+#[test]
+fn hierarchy_and_brute_force_agree_closely_on_most_scenes() {
+    let mut rng = NormalRng::new(5);
+    for surface in [Surface::Linear, Surface::Quadric] {
+        let mut diffs = Vec::new();
+        for k in 0..120u64 {
+            let na = 40 + (rng.uniform() * 120.0) as usize;
+            let nb = 40 + (rng.uniform() * 120.0) as usize;
+            let (ra, rb) = (0.03 + 0.05 * rng.uniform(), 0.03 + 0.05 * rng.uniform());
+            let gap = -3.0 + 17.0 * rng.uniform();
+            let dir = Vector3::new(rng.normal(), rng.normal(), rng.normal());
+            let rot = Vector3::new(rng.normal(), rng.normal(), rng.normal());
+            let (a, b, pose_b) = scene(na, nb, ra, rb, gap, dir, rot, k);
+            let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface)).unwrap();
+            let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface)).unwrap();
+            diffs.push((h.probability - bf.probability).abs());
+        }
+        diffs.sort_by(f64::total_cmp);
+        let median = diffs[diffs.len() / 2];
+        let p90 = diffs[diffs.len() * 9 / 10];
+        assert!(
+            median < 0.01 && p90 < 0.1,
+            "{surface:?}: median {median}, p90 {p90}"
+        );
+    }
+}
