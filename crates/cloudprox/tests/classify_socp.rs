@@ -1,7 +1,9 @@
 //! The robust SOCP as Clarabel solves it, checked independently of the assembly:
 //! feasibility of Eq. 2 at the returned point and optimality against perturbations.
 
-use cloudprox::classify::{train, Classification, ClassifySettings, SolveStatus, Surface};
+use cloudprox::classify::{
+    train, Classification, ClassifySettings, SocpSolver, SolveStatus, Surface,
+};
 use cloudprox::math::{Matrix3, Point3, Vector3};
 use cloudprox::sample::NormalRng;
 use cloudprox::uncertainty::RobustModel;
@@ -57,8 +59,15 @@ fn objective(
 }
 
 fn check(surface: Surface, isotropic: bool, gap: f64, seed: u64) {
+    for solver in [SocpSolver::Barrier, SocpSolver::Clarabel] {
+        check_with(surface, isotropic, gap, seed, solver);
+    }
+}
+
+fn check_with(surface: Surface, isotropic: bool, gap: f64, seed: u64, solver: SocpSolver) {
     let (pts, covs, labels) = scene(120, gap, seed, isotropic);
     let settings = ClassifySettings::builder()
+        .solver(solver)
         .surface(surface)
         .robust_model(RobustModel::Gaussian)
         .robust_eta(0.9)
@@ -152,4 +161,67 @@ fn train_rejects_bad_labels_and_lengths() {
         .unwrap_err()
         .to_string()
         .contains("label 3"));
+}
+
+#[test]
+fn barrier_method_agrees_with_clarabel() {
+    for (k, surface) in [Surface::Linear, Surface::Quadric].into_iter().enumerate() {
+        for (j, &gap) in [0.2, 0.05, 0.0, -0.05, -0.2].iter().enumerate() {
+            for isotropic in [true, false] {
+                let seed = 100 + 10 * k as u64 + j as u64;
+                let (pts, covs, labels) = scene(150, gap, seed, isotropic);
+                let s = |solver| {
+                    ClassifySettings::builder()
+                        .surface(surface)
+                        .solver(solver)
+                        .build()
+                        .unwrap()
+                };
+                let fb = train(&pts, &covs, &labels, &s(SocpSolver::Barrier)).unwrap();
+                let fc = train(&pts, &covs, &labels, &s(SocpSolver::Clarabel)).unwrap();
+                assert_eq!(
+                    fb.solver,
+                    SocpSolver::Barrier,
+                    "{surface:?} gap {gap} iso {isotropic}"
+                );
+                let ob = objective(
+                    &fb,
+                    &fb.separator.w,
+                    fb.separator.b,
+                    &pts,
+                    &covs,
+                    &labels,
+                    &s(SocpSolver::Barrier),
+                );
+                let oc = objective(
+                    &fc,
+                    &fc.separator.w,
+                    fc.separator.b,
+                    &pts,
+                    &covs,
+                    &labels,
+                    &s(SocpSolver::Clarabel),
+                );
+                assert!(
+                    (ob - oc).abs() <= 1e-5 * oc.abs().max(1.0),
+                    "{surface:?} gap {gap}: barrier {ob} vs clarabel {oc}"
+                );
+                // w is unique (the objective is strictly convex in w); b need not be
+                // (the hinge terms can be flat in b), so only w is compared.
+                let dw: f64 = fb
+                    .separator
+                    .w
+                    .iter()
+                    .zip(&fc.separator.w)
+                    .map(|(x, y)| (x - y).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let nw: f64 = fc.separator.w.iter().map(|x| x * x).sum::<f64>().sqrt();
+                assert!(
+                    dw <= 1e-3 * nw.max(1.0),
+                    "{surface:?} gap {gap}: |dw| = {dw}, |w| = {nw}"
+                );
+            }
+        }
+    }
 }

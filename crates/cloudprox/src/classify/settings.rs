@@ -5,6 +5,37 @@ use crate::error::{Error, Result};
 use crate::uncertainty::RobustModel;
 use crate::Real;
 
+/// Which solver trains the surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SocpSolver {
+    /// The specialized log-barrier interior-point method: Newton systems of
+    /// `dim + 1` unknowns, `O(n)` per step. Falls back to Clarabel if it does not
+    /// converge. The default.
+    #[default]
+    Barrier,
+    /// Clarabel, a general conic interior-point solver: the exact reference.
+    Clarabel,
+}
+
+impl SocpSolver {
+    /// Parses `"barrier"` or `"clarabel"`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "barrier" => Some(SocpSolver::Barrier),
+            "clarabel" => Some(SocpSolver::Clarabel),
+            _ => None,
+        }
+    }
+
+    /// The lowercase name, as [`SocpSolver::from_name`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SocpSolver::Barrier => "barrier",
+            SocpSolver::Clarabel => "clarabel",
+        }
+    }
+}
+
 /// How separating surfaces are trained. Build with [`ClassifySettingsBuilder`] or
 /// take [`ClassifySettings::default`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,7 +49,9 @@ pub struct ClassifySettings {
     pub robust_eta: Real,
     /// Distribution assumption behind `r = r(eta)` (default Gaussian).
     pub robust_model: RobustModel,
-    /// Interior-point iteration limit (default 100).
+    /// Which solver (default [`SocpSolver::Barrier`]).
+    pub solver: SocpSolver,
+    /// Clarabel's interior-point iteration limit (default 100).
     pub solver_max_iter: u32,
     /// Relative and absolute gap / feasibility tolerance (default 1e-7).
     pub solver_tol: Real,
@@ -31,6 +64,7 @@ impl Default for ClassifySettings {
             lambda: 100.0,
             robust_eta: 0.9,
             robust_model: RobustModel::Gaussian,
+            solver: SocpSolver::Barrier,
             solver_max_iter: 100,
             solver_tol: 1e-7,
         }
@@ -97,7 +131,12 @@ impl ClassifySettingsBuilder {
         self.inner.robust_model = model;
         self
     }
-    /// Interior-point iteration limit.
+    /// Which solver.
+    pub fn solver(mut self, solver: SocpSolver) -> Self {
+        self.inner.solver = solver;
+        self
+    }
+    /// Clarabel's iteration limit.
     pub fn solver_max_iter(mut self, n: u32) -> Self {
         self.inner.solver_max_iter = n;
         self

@@ -2,8 +2,9 @@
 
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
 
+use crate::classify::barrier::solve_barrier;
 use crate::classify::problem::{assemble, Normalized};
-use crate::classify::{ClassifySettings, Separator};
+use crate::classify::{ClassifySettings, Separator, SocpSolver};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::Real;
@@ -39,7 +40,9 @@ pub struct Classification {
     pub separator: Separator,
     /// Outcome of the solve.
     pub status: SolveStatus,
-    /// Interior-point iterations.
+    /// The solver that produced the separator (Clarabel for the fallback too).
+    pub solver: SocpSolver,
+    /// Interior-point iterations (Newton steps for the barrier method).
     pub iterations: u32,
     /// Optimal slacks `xi_i` in the input order (empty on fallback).
     pub slacks: Vec<Real>,
@@ -81,6 +84,31 @@ pub fn train(
     }
     let r = settings.robust_radius()?;
     let norm = Normalized::new(points, covs);
+    if settings.solver == SocpSolver::Barrier {
+        if let Some(sol) = solve_barrier(
+            &norm,
+            labels,
+            settings.surface,
+            settings.lambda,
+            r,
+            settings.solver_tol,
+        ) {
+            return Ok(Classification {
+                separator: Separator {
+                    surface: settings.surface,
+                    w: sol.w,
+                    b: sol.b,
+                    center: norm.center,
+                    scale: norm.scale,
+                    frame: Pose::identity(),
+                },
+                status: SolveStatus::Solved,
+                solver: SocpSolver::Barrier,
+                iterations: sol.newton_steps,
+                slacks: sol.xi,
+            });
+        }
+    }
     let problem = assemble(&norm, labels, settings.surface, settings.lambda, r);
     let solver_settings = DefaultSettingsBuilder::default()
         .verbose(false)
@@ -122,6 +150,7 @@ pub fn train(
                         frame: Pose::identity(),
                     },
                     status,
+                    solver: SocpSolver::Clarabel,
                     iterations: sol.iterations,
                     slacks: sol.x[d + 1..d + 1 + n].to_vec(),
                 });
@@ -162,6 +191,7 @@ fn fallback(
             frame: Pose::identity(),
         },
         status: SolveStatus::Fallback,
+        solver: SocpSolver::Clarabel,
         iterations,
         slacks: Vec::new(),
     }

@@ -50,7 +50,10 @@ pub struct QueryStats {
     pub points_classified: usize,
     /// Interior-point iterations over all patches.
     pub solver_iterations: u64,
-    /// Patches whose solve fell back (see [`SolveStatus::Fallback`]).
+    /// Patches where the barrier method did not converge and Clarabel was used.
+    pub barrier_fallbacks: usize,
+    /// Patches whose solve fell back to the mean-difference plane (see
+    /// [`SolveStatus::Fallback`]).
     pub solver_fallbacks: usize,
     /// Upper bound on the probability that any pruned point is on the wrong side
     /// of a plane separating its node from the other cloud's (see
