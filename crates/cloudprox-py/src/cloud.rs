@@ -83,6 +83,11 @@ impl PyPointCloud {
                 })?;
             }
             Some(settings)
+        } else if let Some(k) = k {
+            return Err(invalid_input(
+                py,
+                format!("k = {k} is only used with discretization=True"),
+            ));
         } else {
             None
         };

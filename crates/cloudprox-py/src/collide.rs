@@ -19,7 +19,7 @@ use crate::result::PyCollisionResult;
     a, b, pose_a=None, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, lambda_=None, robust_eta=None, robust_model=None,
-    use_hierarchy=None
+    solver=None, use_hierarchy=None
 ))]
 pub fn collide(
     py: Python<'_>,
@@ -36,6 +36,7 @@ pub fn collide(
     lambda_: Option<f64>,
     robust_eta: Option<f64>,
     robust_model: Option<String>,
+    solver: Option<String>,
     use_hierarchy: Option<bool>,
 ) -> PyResult<PyCollisionResult> {
     let request = RequestOptions {
@@ -48,6 +49,7 @@ pub fn collide(
         lambda: lambda_,
         robust_eta,
         robust_model,
+        solver,
         use_hierarchy,
     }
     .build(py)?;
@@ -68,7 +70,7 @@ pub fn collide(
     a, b, poses_a, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, lambda_=None, robust_eta=None, robust_model=None,
-    use_hierarchy=None
+    solver=None, use_hierarchy=None
 ))]
 pub fn collide_many(
     py: Python<'_>,
@@ -85,6 +87,7 @@ pub fn collide_many(
     lambda_: Option<f64>,
     robust_eta: Option<f64>,
     robust_model: Option<String>,
+    solver: Option<String>,
     use_hierarchy: Option<bool>,
 ) -> PyResult<Vec<PyCollisionResult>> {
     let request = RequestOptions {
@@ -97,6 +100,7 @@ pub fn collide_many(
         lambda: lambda_,
         robust_eta,
         robust_model,
+        solver,
         use_hierarchy,
     }
     .build(py)?;

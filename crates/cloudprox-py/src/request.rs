@@ -4,7 +4,7 @@
 //! (`CollisionRequest::default()` and `ClassifySettings::default()`), so the
 //! defaults live in one place. [`default_options`] shows them to Python.
 
-use cloudprox::classify::Surface;
+use cloudprox::classify::{SocpSolver, Surface};
 use cloudprox::probability::Aggregation;
 use cloudprox::query::CollisionRequest;
 use cloudprox::uncertainty::RobustModel;
@@ -20,6 +20,7 @@ const AGGREGATIONS: [Aggregation; 3] = [
     Aggregation::Independent,
 ];
 const ROBUST_MODELS: [RobustModel; 2] = [RobustModel::Gaussian, RobustModel::Chebyshev];
+const SOLVERS: [SocpSolver; 2] = [SocpSolver::Barrier, SocpSolver::Clarabel];
 
 /// The lowercase name of a robust model (the core has none).
 pub fn robust_model_name(model: RobustModel) -> &'static str {
@@ -72,6 +73,7 @@ pub struct RequestOptions {
     pub lambda: Option<f64>,
     pub robust_eta: Option<f64>,
     pub robust_model: Option<String>,
+    pub solver: Option<String>,
     pub use_hierarchy: Option<bool>,
 }
 
@@ -88,6 +90,9 @@ impl RequestOptions {
         if let Some(s) = &self.robust_model {
             r.classify.robust_model =
                 parse_name(py, "robust_model", s, &ROBUST_MODELS, robust_model_name)?;
+        }
+        if let Some(s) = &self.solver {
+            r.classify.solver = parse_name(py, "solver", s, &SOLVERS, SocpSolver::name)?;
         }
         if let Some(v) = self.threshold_collision {
             r.thresholds.collision = v;
@@ -131,6 +136,7 @@ pub fn default_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("lambda_", r.classify.lambda)?;
     d.set_item("robust_eta", r.classify.robust_eta)?;
     d.set_item("robust_model", robust_model_name(r.classify.robust_model))?;
+    d.set_item("solver", r.classify.solver.name())?;
     d.set_item("use_hierarchy", r.use_hierarchy)?;
     Ok(d)
 }
@@ -148,5 +154,6 @@ pub fn option_names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         "robust_model",
         PyTuple::new(py, ROBUST_MODELS.map(robust_model_name))?,
     )?;
+    d.set_item("solver", PyTuple::new(py, SOLVERS.map(SocpSolver::name))?)?;
     Ok(d)
 }

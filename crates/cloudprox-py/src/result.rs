@@ -199,6 +199,7 @@ impl PyCollisionResult {
             patches,
             points_classified,
             solver_iterations,
+            barrier_fallbacks,
             solver_fallbacks,
             pruned_bound,
             time_seconds,
@@ -210,6 +211,7 @@ impl PyCollisionResult {
         d.set_item("patches", patches)?;
         d.set_item("points_classified", points_classified)?;
         d.set_item("solver_iterations", solver_iterations)?;
+        d.set_item("barrier_fallbacks", barrier_fallbacks)?;
         d.set_item("solver_fallbacks", solver_fallbacks)?;
         d.set_item("pruned_bound", pruned_bound)?;
         d.set_item("time_seconds", time_seconds)?;

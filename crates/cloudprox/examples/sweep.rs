@@ -1,6 +1,9 @@
 //! Collision probability against separation for two noisy spheres and two plates.
 //!
-//! `cargo run --release --example sweep -- [n_points] [surface]`
+//! `cargo run --release --example sweep -- [n_points] [linear|quadric]`
+//!
+//! Environment overrides for experiments: `LAMBDA` (slack weight), `ETA` (robust
+//! confidence), `RMAX` (largest patch), `DISC=1` (add the discretization error).
 
 use cloudprox::prelude::*;
 use cloudprox::sample::{add_noise, box_surface, sphere};
@@ -24,7 +27,7 @@ fn main() {
         .classify(
             ClassifySettings::builder()
                 .surface(surface)
-                .lambda(env("LAMBDA", 10.0))
+                .lambda(env("LAMBDA", 100.0))
                 .robust_eta(env("ETA", 0.9))
                 .build()
                 .unwrap(),

@@ -247,3 +247,28 @@ fn refitted_cloud_answers_like_a_fresh_one() {
     let r2 = collide(&Pose::identity(), &fresh, &pb, &b, &req).unwrap();
     assert!((r1.probability - r2.probability).abs() < 1e-9);
 }
+
+#[test]
+fn separation_estimate_tracks_the_exact_gap() {
+    // A noisy ball above a noisy plate: the deepest patch's separation follows the
+    // exact gap, with the right sign when they interpenetrate.
+    let plate =
+        cloudprox::sample::box_surface(&Point3::origin(), &Vector3::new(0.2, 0.2, 0.01), 0.008);
+    let ball = cloudprox::sample::sphere(&Point3::origin(), 0.05, 1500);
+    let a = PointCloud::from_sigma(cloudprox::sample::add_noise(&plate, SIGMA, 1), SIGMA).unwrap();
+    let b = PointCloud::from_sigma(cloudprox::sample::add_noise(&ball, SIGMA, 2), SIGMA).unwrap();
+    let req = request(Surface::Quadric);
+    for gap in [-0.005, 0.0, 0.005, 0.01, 0.02] {
+        let pose_b = Pose::translation(0.0, 0.0, 0.06 + gap);
+        let r = collide(&Pose::identity(), &a, &pose_b, &b, &req).unwrap();
+        let sep = r
+            .regions
+            .iter()
+            .map(|g| g.separation)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (sep - gap).abs() < 2.0 * SIGMA,
+            "exact gap {gap}: estimated {sep}"
+        );
+    }
+}

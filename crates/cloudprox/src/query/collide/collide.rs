@@ -96,6 +96,9 @@ pub(crate) fn collide_with_workspace(
             a: (0..component.a.len() as u32).collect(),
             b: (0..component.b.len() as u32).collect(),
         };
+        // The direction of least spread of the whole near region, oriented from A
+        // to B: the axis along which every patch measures its separation.
+        let axis = least_spread_axis(&[&pa[..], &pb[..]].concat(), &(mean(&pb) - mean(&pa)));
         for patch in split_patches(local, &pa, &pb, request.region_max_points) {
             let na = patch.a.len();
             let pick = |idx: &[u32], p: &[Point3], c: &[Matrix3]| -> (Vec<Point3>, Vec<Matrix3>) {
@@ -105,7 +108,7 @@ pub(crate) fn collide_with_workspace(
             let (ptsb, covsb) = pick(&patch.b, &pb, &cb);
             pts.extend(ptsb);
             covs.extend(covsb);
-            let fit = fit_patch(&pts, &covs, na, request)?;
+            let fit = fit_patch(&pts, &covs, na, &axis, request)?;
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
             for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
@@ -187,6 +190,7 @@ fn fit_patch(
     pts: &[Point3],
     covs: &[Matrix3],
     na: usize,
+    axis: &Vector3,
     request: &CollisionRequest,
 ) -> Result<PatchFit> {
     let labels: Vec<Real> = (0..pts.len())
@@ -219,8 +223,33 @@ fn fit_patch(
     } else {
         (mean(&pts[na..]) - mean(&pts[..na])).normalize()
     };
-    let separation =
-        axial_offset(&pts[na..], &point, &normal) - axial_offset(&pts[..na], &point, &normal);
+    // The separation is measured along the near region's axis (unlike the trained
+    // surface's normal, it stays meaningful when the clouds interpenetrate and the
+    // surface cannot separate them), on lines through up to 16 of the patch's
+    // points; the smallest is where the surfaces come closest or cross deepest.
+    // Only points within half of the patch's lateral RMS spread of a line
+    // count for it, and a line needs 3 of each side.
+    let c = mean(pts);
+    let lateral = |x: &Point3| {
+        let d = x.coords - c;
+        (d - axis * d.dot(axis)).norm_squared()
+    };
+    let radius = 0.5 * (pts.iter().map(lateral).sum::<Real>() / pts.len() as Real).sqrt();
+    let stride = pts.len().div_ceil(16).max(1);
+    let separation = pts
+        .iter()
+        .step_by(stride)
+        .filter_map(|x| {
+            let sb = axial_offset(&pts[na..], x, axis, radius)?;
+            let sa = axial_offset(&pts[..na], x, axis, radius)?;
+            Some(sb - sa)
+        })
+        .reduce(Real::min)
+        .unwrap_or_else(|| {
+            let inf = Real::INFINITY;
+            axial_offset(&pts[na..], &mid, axis, inf).unwrap_or(0.0)
+                - axial_offset(&pts[..na], &mid, axis, inf).unwrap_or(0.0)
+        });
     Ok(PatchFit {
         classification,
         probabilities,
@@ -230,27 +259,51 @@ fn fit_patch(
     })
 }
 
+/// Unit eigenvector of the smallest eigenvalue of the points' scatter, oriented
+/// along `towards`.
+fn least_spread_axis(pts: &[Point3], towards: &Vector3) -> Vector3 {
+    let c = mean(pts);
+    let mut scatter = Matrix3::zeros();
+    for p in pts {
+        let d = p.coords - c;
+        scatter += d * d.transpose();
+    }
+    let eig = scatter.symmetric_eigen();
+    let axis = eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned();
+    if axis.dot(towards) < 0.0 {
+        -axis
+    } else {
+        axis
+    }
+}
+
 fn mean(p: &[Point3]) -> Vector3 {
     p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }
 
-/// Where one side's surface crosses the line through `point` along `normal`: the
-/// median offset along `normal` of the side's points nearest that line (a tenth of
-/// them, between 3 and 30). Medians keep the estimate unbiased by the noise on a
-/// flat contact, where a minimum or maximum would be pulled by the extreme points.
-fn axial_offset(pts: &[Point3], point: &Point3, normal: &Vector3) -> Real {
+/// Where one side's surface crosses the line through `point` along `axis`: the
+/// median offset along `axis` of the side's points nearest that line (a tenth of
+/// them, between 3 and 30) among those within `radius` of it; `None` with fewer
+/// than 3 there. Medians keep the estimate unbiased by the noise on a flat
+/// contact, where a minimum or maximum would be pulled by the extreme points.
+fn axial_offset(pts: &[Point3], point: &Point3, axis: &Vector3, radius: Real) -> Option<Real> {
+    let r2 = radius * radius;
     let mut by_lateral: Vec<(Real, Real)> = pts
         .iter()
-        .map(|x| {
+        .filter_map(|x| {
             let d = x - point;
-            let along = d.dot(normal);
-            ((d - normal * along).norm_squared(), along)
+            let along = d.dot(axis);
+            let lat = (d - axis * along).norm_squared();
+            (lat <= r2).then_some((lat, along))
         })
         .collect();
-    let k = (pts.len() / 10).clamp(3, 30).min(pts.len());
+    if by_lateral.len() < 3 {
+        return None;
+    }
+    let k = (pts.len() / 10).clamp(3, 30).min(by_lateral.len());
     by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
     let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| x.1).collect();
     let m = along.len() / 2;
     let (_, med, _) = along.select_nth_unstable_by(m, Real::total_cmp);
-    *med
+    Some(*med)
 }

@@ -18,10 +18,13 @@ pub struct ContactRegion {
     pub point: Point3,
     /// Unit normal of the surface at `point`, pointing from A towards B.
     pub normal: Vector3,
-    /// Estimated signed separation of the two surfaces along the normal (metres),
-    /// negative when they interpenetrate: on the line through `point` along
-    /// `normal`, the median offset of B's points nearest the line minus that of
-    /// A's (a tenth of each side's patch points, 3 to 30).
+    /// Estimated signed separation of the two clouds' surfaces (metres), negative
+    /// when they interpenetrate, at this patch. Measured along the near region's
+    /// direction of least spread (oriented from A to B), as the smallest over lines
+    /// through up to 16 of the patch's points of: the median
+    /// offset of B's points nearest that line minus that of A's (a tenth of each
+    /// side's patch points, 3 to 30). Medians keep it unbiased by the noise on a
+    /// flat contact; curvature within the sampled neighbourhood biases it upwards.
     pub separation: Real,
     /// The patch's aggregated collision probability.
     pub probability: Real,
