@@ -49,6 +49,21 @@ struct PointData {
     c: Vec<Real>,
 }
 
+/// Largest working set tried before solving with every point.
+const WORKING_SET_ROUNDS: usize = 8;
+/// Points of each cloud in the first working set, and most added per round.
+const WORKING_SET_STEP: usize = 24;
+
+/// Solves the robust SOCP for all points with a working set of constraints.
+///
+/// Points far on their own side satisfy their constraint with zero slack and do
+/// not shape the optimum. The problem is solved on a working set (first the
+/// points of each cloud nearest the other cloud), every other point's constraint
+/// is checked at that solution (`c_i f(x_i) - 1 >= r |Sigma_i^(1/2) grad f|`), and
+/// the most violated are added until none is. Solving on a subset is a relaxation
+/// of the full problem, and a relaxation's optimum that is feasible for the full
+/// problem (with zero slacks elsewhere) is the full problem's optimum: the answer
+/// is exact. Normalization is the full set's throughout.
 pub(crate) fn solve_barrier(
     norm: &Normalized,
     labels: &[Real],
@@ -61,6 +76,87 @@ pub(crate) fn solve_barrier(
     let d = surface.dim();
     let m = d + 1;
     let data = point_data(norm, labels, surface, r);
+    if n <= 3 * WORKING_SET_STEP {
+        let all: Vec<&PointData> = data.iter().collect();
+        return solve_subset(&all, d, lambda, tol);
+    }
+    let mut in_set = initial_working_set(norm, labels);
+    let mut total_steps = 0;
+    for _ in 0..WORKING_SET_ROUNDS {
+        let idx: Vec<usize> = (0..n).filter(|&i| in_set[i]).collect();
+        let subset: Vec<&PointData> = idx.iter().map(|&i| &data[i]).collect();
+        let sol = solve_subset(&subset, d, lambda, tol)?;
+        total_steps += sol.newton_steps;
+        let mut z = sol.w.clone();
+        z.push(sol.b);
+        let mut violated: Vec<(Real, usize)> = (0..n)
+            .filter(|&i| !in_set[i])
+            .filter_map(|i| {
+                let pd = &data[i];
+                let u: Real = (0..m).map(|k| pd.a[k] * z[k]).sum::<Real>() - 1.0;
+                let mut v2 = 0.0;
+                for row in 0..3 {
+                    let x: Real = (0..m).map(|k| pd.bm[row * m + k] * z[k]).sum();
+                    v2 += x * x;
+                }
+                let viol = v2.sqrt() - u;
+                (viol > 1e-9 * (1.0 + u.abs())).then_some((viol, i))
+            })
+            .collect();
+        if violated.is_empty() {
+            let mut xi = vec![0.0; n];
+            for (k, &i) in idx.iter().enumerate() {
+                xi[i] = sol.xi[k];
+            }
+            return Some(BarrierSolution {
+                xi,
+                newton_steps: total_steps,
+                ..sol
+            });
+        }
+        violated.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for &(_, i) in violated.iter().take(WORKING_SET_STEP) {
+            in_set[i] = true;
+        }
+    }
+    let all: Vec<&PointData> = data.iter().collect();
+    let sol = solve_subset(&all, d, lambda, tol)?;
+    Some(BarrierSolution {
+        newton_steps: sol.newton_steps + total_steps,
+        ..sol
+    })
+}
+
+/// The `WORKING_SET_STEP` points of each cloud nearest any point of the other.
+fn initial_working_set(norm: &Normalized, labels: &[Real]) -> Vec<bool> {
+    let n = labels.len();
+    let mut nearest: Vec<(Real, usize)> = (0..n)
+        .map(|i| {
+            let d2 = (0..n)
+                .filter(|&j| labels[j] != labels[i])
+                .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                .fold(Real::INFINITY, Real::min);
+            (d2, i)
+        })
+        .collect();
+    nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut in_set = vec![false; n];
+    for label in [1.0, -1.0] {
+        for &(_, i) in nearest
+            .iter()
+            .filter(|(_, i)| labels[*i] == label)
+            .take(WORKING_SET_STEP)
+        {
+            in_set[i] = true;
+        }
+    }
+    in_set
+}
+
+/// The barrier method on the points `data`.
+fn solve_subset(data: &[&PointData], d: usize, lambda: Real, tol: Real) -> Option<BarrierSolution> {
+    let n = data.len();
+    let m = d + 1;
 
     let mut z = vec![0.0; m];
     let mut xi = vec![2.0; n];
@@ -91,7 +187,7 @@ pub(crate) fn solve_barrier(
                 return None;
             }
             steps += 1;
-            eval_cones(&data, &z, &xi, &mut u, &mut v, &mut g, m);
+            eval_cones(data, &z, &xi, &mut u, &mut v, &mut g, m);
             // Accumulate the Schur complement S (lower triangle, row-major in a
             // fixed array) and the reduced right-hand side.
             let mut sacc = [0.0; 100];
@@ -104,7 +200,7 @@ pub(crate) fn solve_barrier(
             neg_grad_z[d] = 0.0;
             for i in 0..n {
                 let (ui, vi, gi) = (u[i], v[i], g[i]);
-                let pd = &data[i];
+                let pd = data[i];
                 let a = &pd.a[..m];
                 // q = u a - B^T v
                 let mut q = [0.0; 10];
@@ -173,7 +269,7 @@ pub(crate) fn solve_barrier(
                 break;
             }
             // Backtracking line search: stay strictly feasible, then Armijo.
-            let phi0 = barrier_value(&data, &z, &xi, t, lambda, d, m)?;
+            let phi0 = barrier_value(data, &z, &xi, t, lambda, d, m)?;
             let mut step = 1.0;
             let mut z_new = vec![0.0; m];
             let mut xi_new = vec![0.0; n];
@@ -184,7 +280,7 @@ pub(crate) fn solve_barrier(
                 for i in 0..n {
                     xi_new[i] = xi[i] + step * dxi[i];
                 }
-                if let Some(phi) = barrier_value(&data, &z_new, &xi_new, t, lambda, d, m) {
+                if let Some(phi) = barrier_value(data, &z_new, &xi_new, t, lambda, d, m) {
                     if phi <= phi0 - ALPHA * step * decrement {
                         break;
                     }
@@ -254,7 +350,7 @@ fn point_data(norm: &Normalized, labels: &[Real], surface: Surface, r: Real) -> 
 }
 
 fn eval_cones(
-    data: &[PointData],
+    data: &[&PointData],
     z: &[Real],
     xi: &[Real],
     u: &mut [Real],
@@ -279,7 +375,7 @@ fn eval_cones(
 
 /// `F_t` at `(z, xi)`, or `None` outside the barrier's domain.
 fn barrier_value(
-    data: &[PointData],
+    data: &[&PointData],
     z: &[Real],
     xi: &[Real],
     t: Real,
