@@ -33,6 +33,7 @@ fn main() {
                 .unwrap(),
         )
         .region_max_points(env("RMAX", 160.0) as usize)
+        .near_context(env("CTX", 2.0))
         .build()
         .unwrap();
     let disc = env("DISC", 0.0) > 0.0;

@@ -93,3 +93,15 @@ fn bad_settings_are_rejected() {
         .unwrap_err();
     assert!(e.to_string().contains("weight_scale"));
 }
+
+#[test]
+fn spacing_is_the_distance_to_the_sixth_neighbour() {
+    // On a square grid of spacing h the 6th nearest neighbour of an interior point
+    // is a diagonal one, at h sqrt 2.
+    let h = 0.01;
+    let cloud = PointCloud::from_sigma(grid(h, 12), 0.0).unwrap();
+    let i = 5 * 12 + 6;
+    assert!((cloud.spacing()[i] - h * 2f64.sqrt()).abs() < 1e-12);
+    let node_max = cloud.node_spacing()[0];
+    assert!(cloud.spacing().iter().all(|&s| s <= node_max));
+}

@@ -95,9 +95,9 @@ fn traversal_without_pruning_visits_every_leaf_pair() {
     .unwrap();
     let mut ws = BvhWorkspace::default();
     let far = Pose::translation(100.0, 0.0, 0.0);
-    let all = ta.traverse_pairs(&tb, &far, 0.0, &mut ws);
+    let all = ta.traverse_pairs(&tb, &far, 0.0, &[], &[], &mut ws);
     assert_eq!(all.leaf_pairs.len(), ta.leaf_count() * tb.leaf_count());
-    let pruned = ta.traverse_pairs(&tb, &far, 1e-9, &mut ws);
+    let pruned = ta.traverse_pairs(&tb, &far, 1e-9, &[], &[], &mut ws);
     assert!(pruned.leaf_pairs.is_empty());
     assert_eq!(pruned.node_pairs_visited, 1);
     assert!(pruned.pruned_bound < 1e-9);
@@ -116,7 +116,7 @@ fn traversal_keeps_every_close_point_pair() {
     let pose = Pose::new(Vector3::new(0.9, 0.1, 0.0), Vector3::new(0.2, 0.4, 0.9));
     let mut ws = BvhWorkspace::default();
     let eps = 1e-3;
-    let t = ta.traverse_pairs(&tb, &pose, eps, &mut ws);
+    let t = ta.traverse_pairs(&tb, &pose, eps, &[], &[], &mut ws);
     let mut kept = std::collections::HashSet::new();
     for &(la, lb) in &t.leaf_pairs {
         for &i in ta.node_points(la) {

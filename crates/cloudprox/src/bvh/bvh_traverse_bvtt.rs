@@ -39,21 +39,44 @@ pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
 }
 
 impl Bvh {
+    /// The largest of a per-point quantity below every node (one value per node).
+    pub fn node_max(&self, per_point: &[Real]) -> Vec<Real> {
+        let mut out: Vec<Real> = vec![0.0; self.nodes.len()];
+        for id in (0..self.nodes.len()).rev() {
+            out[id] = match self.nodes[id].children {
+                Some([l, r]) => out[l as usize].max(out[r as usize]),
+                None => self
+                    .node_points(id as u32)
+                    .iter()
+                    .map(|&i| per_point[i as usize])
+                    .fold(0.0, Real::max),
+            };
+        }
+        out
+    }
+
     /// Traverses `self` (posed by `pose`, which maps `self`'s frame into `other`'s)
     /// and `other` together, returning the leaf pairs that could not be pruned.
     ///
     /// A node pair is pruned when [`prune_bound`] of the distance between their
-    /// boxes (the first one's box moved by `pose`, enclosed in an axis-aligned box,
+    /// boxes (less the margin) (the first one's box moved by `pose`, enclosed in an axis-aligned box,
     /// which only makes the distance smaller and the bound safer) is below
     /// `epsilon`. With `epsilon = 0` nothing is pruned. The larger node of a pair
     /// is the one descended.
+    ///
+    /// `margin_self` and `margin_other` are optional per-node distances (one per
+    /// node, or empty for none) subtracted from a pair's gap, the larger of the
+    /// two: a margin of context kept around the noise-based near region.
     pub fn traverse_pairs(
         &self,
         other: &Bvh,
         pose: &Pose,
         epsilon: Real,
+        margin_self: &[Real],
+        margin_other: &[Real],
         workspace: &mut BvhWorkspace,
     ) -> PairTraversal {
+        let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
         let mut out = PairTraversal::default();
         let stack = &mut workspace.pair_stack;
         stack.clear();
@@ -61,7 +84,9 @@ impl Bvh {
         while let Some((ia, ib)) = stack.pop() {
             out.node_pairs_visited += 1;
             let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
-            let gap = na.aabb.transformed(pose).distance(&nb.aabb);
+            let gap = (na.aabb.transformed(pose).distance(&nb.aabb)
+                - margin(margin_self, ia).max(margin(margin_other, ib)))
+            .max(0.0);
             let bound = prune_bound(
                 gap,
                 na.sigma_max,

@@ -21,7 +21,18 @@ pub struct PointCloud {
     sigma_max: Vec<Real>,
     bvh_settings: BvhSettings,
     bvh: OnceLock<Bvh>,
+    spacing: OnceLock<Spacing>,
 }
+
+/// Sampling spacing per point and its maximum per hierarchy node.
+#[derive(Debug, Clone)]
+struct Spacing {
+    per_point: Vec<Real>,
+    per_node: Vec<Real>,
+}
+
+/// Neighbours behind the spacing estimate: the distance to the 6th nearest.
+const SPACING_NEIGHBOURS: usize = 6;
 
 impl Clone for PointCloud {
     fn clone(&self) -> Self {
@@ -29,12 +40,17 @@ impl Clone for PointCloud {
         if let Some(b) = self.bvh.get() {
             let _ = bvh.set(b.clone());
         }
+        let spacing = OnceLock::new();
+        if let Some(sp) = self.spacing.get() {
+            let _ = spacing.set(sp.clone());
+        }
         Self {
             points: self.points.clone(),
             covariances: self.covariances.clone(),
             sigma_max: self.sigma_max.clone(),
             bvh_settings: self.bvh_settings,
             bvh,
+            spacing,
         }
     }
 }
@@ -87,6 +103,7 @@ impl PointCloud {
             sigma_max,
             bvh_settings: BvhSettings::default(),
             bvh: OnceLock::new(),
+            spacing: OnceLock::new(),
         }
     }
 
@@ -138,11 +155,46 @@ impl PointCloud {
         })
     }
 
+    /// Local sampling spacing of every point: the distance to its 6th nearest
+    /// neighbour in the cloud (0 for clouds of fewer than 7 points, which use
+    /// their farthest point). Computed on first call.
+    pub fn spacing(&self) -> &[Real] {
+        &self.spacing_data().per_point
+    }
+
+    /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].
+    pub fn node_spacing(&self) -> &[Real] {
+        &self.spacing_data().per_node
+    }
+
+    fn spacing_data(&self) -> &Spacing {
+        self.spacing.get_or_init(|| {
+            let bvh = self.bvh();
+            let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
+            let mut ws = crate::bvh::BvhWorkspace::default();
+            let mut nn = Vec::with_capacity(k + 1);
+            let per_point: Vec<Real> = self
+                .points
+                .iter()
+                .map(|p| {
+                    bvh.nearest_k(&self.points, p, k + 1, &mut ws, &mut nn);
+                    nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
+                })
+                .collect();
+            let per_node = bvh.node_max(&per_point);
+            Spacing {
+                per_point,
+                per_node,
+            }
+        })
+    }
+
     /// Sets how the hierarchy is built; an existing one is dropped and rebuilt lazily.
     pub fn set_bvh_settings(&mut self, settings: BvhSettings) -> Result<()> {
         settings.validate()?;
         self.bvh_settings = settings;
         self.bvh = OnceLock::new();
+        self.spacing = OnceLock::new();
         Ok(())
     }
 
@@ -161,6 +213,7 @@ impl PointCloud {
         if let Some(bvh) = self.bvh.get_mut() {
             bvh.refit(&self.points, &self.sigma_max)?;
         }
+        self.spacing = OnceLock::new();
         Ok(())
     }
 
@@ -176,6 +229,7 @@ impl PointCloud {
             *c = r * *c * r.transpose();
         }
         self.bvh = OnceLock::new();
+        self.spacing = OnceLock::new();
     }
 
     /// A copy moved by `pose` (see [`PointCloud::transform`]).

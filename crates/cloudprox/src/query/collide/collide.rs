@@ -8,7 +8,9 @@ use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::point_probability;
-use crate::query::collide::region::{near_regions, split_patches, Patch};
+use crate::query::collide::region::{
+    near_points, near_points_brute_force, near_regions, split_patches, Patch,
+};
 use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
 use crate::Real;
 
@@ -69,19 +71,54 @@ pub(crate) fn collide_with_workspace(
     // Pose of A in B's frame.
     let rel = pose_b.inverse() * pose_a;
     let components: Vec<Patch> = if request.use_hierarchy {
-        let t = a
-            .bvh()
-            .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, workspace);
+        // First the noise alone: if no point pair is within its reach the pair is
+        // free and the query ends here. Otherwise again with the context margin,
+        // so the classifier sees the surface around the near points.
+        let mut t =
+            a.bvh()
+                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &[], &[], workspace);
+        let ctx = request.near_context;
+        let mut keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, 0.0);
+        let any_near = keep.0.iter().any(|&k| k);
+        if any_near && ctx > 0.0 {
+            let margins = |c: &PointCloud| -> Vec<Real> {
+                c.node_spacing().iter().map(|s| s * ctx).collect()
+            };
+            let (ma, mb) = (margins(a), margins(b));
+            t = a
+                .bvh()
+                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &ma, &mb, workspace);
+            keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, ctx);
+        }
         stats.node_pairs_visited = t.node_pairs_visited;
         stats.leaf_pairs = t.leaf_pairs.len();
         stats.pruned_bound = t.pruned_bound;
-        near_regions(&t.leaf_pairs, a.bvh(), b.bvh())
+        let (keep_a, keep_b) = keep;
+        if !any_near {
+            t.leaf_pairs.clear();
+        }
+        near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep_a, &keep_b)
     } else {
-        vec![Patch {
+        // The brute-force reference: the same near-point rule on every point pair,
+        // all near points in one region.
+        let (mut keep_a, mut keep_b) =
+            near_points_brute_force(&rel, a, b, request.prune_epsilon, 0.0);
+        if keep_a.iter().any(|&k| k) && request.near_context > 0.0 {
+            (keep_a, keep_b) =
+                near_points_brute_force(&rel, a, b, request.prune_epsilon, request.near_context);
+        }
+        let pick =
+            |k: &[bool]| -> Vec<u32> { (0..k.len() as u32).filter(|&i| k[i as usize]).collect() };
+        let region = Patch {
             component: 0,
-            a: (0..a.len() as u32).collect(),
-            b: (0..b.len() as u32).collect(),
-        }]
+            a: pick(&keep_a),
+            b: pick(&keep_b),
+        };
+        if region.a.is_empty() || region.b.is_empty() {
+            Vec::new()
+        } else {
+            vec![region]
+        }
     };
     stats.near_regions = components.len();
 

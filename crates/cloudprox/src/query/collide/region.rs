@@ -2,8 +2,9 @@
 
 use std::collections::HashMap;
 
-use crate::bvh::Bvh;
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::bvh::{prune_bound, Bvh};
+use crate::cloud::PointCloud;
+use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::Real;
 
 /// A set of points of both clouds classified together.
@@ -17,10 +18,89 @@ pub struct Patch {
     pub b: Vec<u32>,
 }
 
+/// Which points of the kept leaves are near the other cloud.
+///
+/// A point `i` of A is near when some point `j` of B has
+/// `prune_bound(max(0, |x_i - x_j| - m_ij), sigma_i, sigma_j, 2) >= epsilon` with
+/// the context margin `m_ij = context * max(spacing_i, spacing_j)`: within the
+/// noise's reach of the other cloud, plus a few sampling spacings of surface
+/// around it for the classifier to see. The rule involves only distances, so it
+/// does not depend on the frame the clouds are given in (leaf boundaries do). The
+/// traversal keeps every leaf pair holding such a pair of points (its margins
+/// bound `m_ij`), so searching the partner leaves finds every `j`.
+pub fn near_points(
+    leaf_pairs: &[(u32, u32)],
+    rel: &Pose,
+    a: &PointCloud,
+    b: &PointCloud,
+    epsilon: Real,
+    context: Real,
+) -> (Vec<bool>, Vec<bool>) {
+    let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
+    let (sp_a, sp_b) = (a.spacing(), b.spacing());
+    let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
+    let mut near_a = vec![false; a.len()];
+    let mut near_b = vec![false; b.len()];
+    for &(la, lb) in leaf_pairs {
+        for &i in bvh_a.node_points(la) {
+            let i = i as usize;
+            let xi = rel * a.points()[i];
+            for &j in bvh_b.node_points(lb) {
+                let j = j as usize;
+                if near_a[i] && near_b[j] {
+                    continue;
+                }
+                let m = context * sp_a[i].max(sp_b[j]);
+                let d = ((xi - b.points()[j]).norm() - m).max(0.0);
+                if prune_bound(d, sg_a[i], sg_b[j], 2) >= epsilon {
+                    near_a[i] = true;
+                    near_b[j] = true;
+                }
+            }
+        }
+    }
+    (near_a, near_b)
+}
+
+/// The brute-force reference of [`near_points`]: the same rule tested on every
+/// pair of points, `O(n_a n_b)`, without the hierarchy.
+pub fn near_points_brute_force(
+    rel: &Pose,
+    a: &PointCloud,
+    b: &PointCloud,
+    epsilon: Real,
+    context: Real,
+) -> (Vec<bool>, Vec<bool>) {
+    let (sp_a, sp_b) = (a.spacing(), b.spacing());
+    let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
+    let mut near_a = vec![false; a.len()];
+    let mut near_b = vec![false; b.len()];
+    for (i, pa) in a.points().iter().enumerate() {
+        let xi = rel * pa;
+        for (j, xj) in b.points().iter().enumerate() {
+            let m = context * sp_a[i].max(sp_b[j]);
+            let d = ((xi - xj).norm() - m).max(0.0);
+            if prune_bound(d, sg_a[i], sg_b[j], 2) >= epsilon {
+                near_a[i] = true;
+                near_b[j] = true;
+            }
+        }
+    }
+    (near_a, near_b)
+}
+
 /// Merges kept leaf pairs into connected components: two leaf pairs are connected
-/// when they share a leaf. Returns one patch per component, leaves' points
-/// unioned, components ordered by their first leaf pair.
-pub fn near_regions(leaf_pairs: &[(u32, u32)], bvh_a: &Bvh, bvh_b: &Bvh) -> Vec<Patch> {
+/// when they share a leaf. Returns one patch per component with the leaves'
+/// points for which `keep_a` / `keep_b` hold (all points when empty), components
+/// ordered by their first leaf pair; a component left without points of either
+/// cloud is dropped.
+pub fn near_regions(
+    leaf_pairs: &[(u32, u32)],
+    bvh_a: &Bvh,
+    bvh_b: &Bvh,
+    keep_a: &[bool],
+    keep_b: &[bool],
+) -> Vec<Patch> {
     // Union-find over the leaves that occur: A leaves as 2k, B leaves as 2k + 1.
     let mut id_of: HashMap<(u32, bool), usize> = HashMap::new();
     let mut parent: Vec<usize> = Vec::new();
@@ -58,11 +138,18 @@ pub fn near_regions(leaf_pairs: &[(u32, u32)], bvh_a: &Bvh, bvh_b: &Bvh) -> Vec<
             });
             out.len() - 1
         });
+        let keep = |k: &[bool], i: u32| k.is_empty() || k[i as usize];
         if is_b {
-            out[c].b.extend_from_slice(bvh_b.node_points(leaf));
+            let pts = bvh_b.node_points(leaf).iter().filter(|&&i| keep(keep_b, i));
+            out[c].b.extend(pts);
         } else {
-            out[c].a.extend_from_slice(bvh_a.node_points(leaf));
+            let pts = bvh_a.node_points(leaf).iter().filter(|&&i| keep(keep_a, i));
+            out[c].a.extend(pts);
         }
+    }
+    out.retain(|p| !p.a.is_empty() && !p.b.is_empty());
+    for (k, p) in out.iter_mut().enumerate() {
+        p.component = k as u32;
     }
     out
 }

@@ -19,11 +19,17 @@ pub struct CollisionRequest {
     /// The sum of the bounds of what was pruned is reported in
     /// [`crate::query::QueryStats::pruned_bound`].
     pub prune_epsilon: Real,
+    /// Context kept around the noise-based near region, in sampling spacings
+    /// (each point's distance to its 6th nearest neighbour) (default 2): once
+    /// some point pair is within the noise's reach, the classifier sees that much
+    /// surface beyond it, so that sparse clouds still give it a surface to fit.
+    pub near_context: Real,
     /// Near regions with more points than this are split into patches along the
     /// contact, each with its own surface (default 160).
     pub region_max_points: usize,
-    /// `false` skips the hierarchy: every point of both clouds goes into one
-    /// region (still split into patches). The brute-force reference.
+    /// `false` skips the hierarchy: the near points are found by testing every
+    /// point pair (`O(n_a n_b)`) and all go into one region (still split into
+    /// patches). The brute-force reference.
     pub use_hierarchy: bool,
 }
 
@@ -34,6 +40,7 @@ impl Default for CollisionRequest {
             aggregation: Aggregation::Max,
             thresholds: Thresholds::default(),
             prune_epsilon: 1e-3,
+            near_context: 2.0,
             region_max_points: 160,
             use_hierarchy: true,
         }
@@ -54,6 +61,12 @@ impl CollisionRequest {
             return Err(Error::invalid(format!(
                 "prune_epsilon must be in [0, 1), got {}",
                 self.prune_epsilon
+            )));
+        }
+        if !(self.near_context.is_finite() && self.near_context >= 0.0) {
+            return Err(Error::invalid(format!(
+                "near_context must be finite and >= 0, got {}",
+                self.near_context
             )));
         }
         if self.region_max_points < 8 {
@@ -91,6 +104,11 @@ impl CollisionRequestBuilder {
     /// Pruning bound `epsilon`.
     pub fn prune_epsilon(mut self, epsilon: Real) -> Self {
         self.inner.prune_epsilon = epsilon;
+        self
+    }
+    /// Context around the near region, in sampling spacings.
+    pub fn near_context(mut self, spacings: Real) -> Self {
+        self.inner.near_context = spacings;
         self
     }
     /// Largest patch.
