@@ -3,7 +3,8 @@
 //! `cargo run --release --example sweep -- [n_points] [linear|quadric]`
 //!
 //! Environment overrides for experiments: `LAMBDA` (slack weight), `ETA` (robust
-//! confidence), `RMAX` (largest patch), `DISC=1` (add the discretization error).
+//! confidence), `RMAX` (largest patch), `CTX` (near context in spacings), `DISC=1`
+//! (add the discretization error).
 
 use cloudprox::prelude::*;
 use cloudprox::sample::{add_noise, box_surface, sphere};
@@ -32,7 +33,7 @@ fn main() {
                 .build()
                 .unwrap(),
         )
-        .region_max_points(env("RMAX", 160.0) as usize)
+        .region_max_points(env("RMAX", 2000.0) as usize)
         .near_context(env("CTX", 2.0))
         .build()
         .unwrap();

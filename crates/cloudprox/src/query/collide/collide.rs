@@ -71,20 +71,20 @@ pub(crate) fn collide_with_workspace(
     // Pose of A in B's frame.
     let rel = pose_b.inverse() * pose_a;
     let components: Vec<Patch> = if request.use_hierarchy {
-        // First the noise alone: if no point pair is within its reach the pair is
-        // free and the query ends here. Otherwise again with the context margin,
-        // so the classifier sees the surface around the near points.
+        // First the noise and the sampling alone: two surfaces sampled at spacing
+        // h can meet with no two samples closer than about h, so a pair is near
+        // when the noise reaches across its distance less one spacing. If no pair
+        // is, the clouds are free and the query ends here. Otherwise again with
+        // the context margin, so the classifier sees the surface around.
+        let (ma, mb) = (margins(a, 1.0), margins(b, 1.0));
         let mut t =
             a.bvh()
-                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &[], &[], workspace);
-        let ctx = request.near_context;
-        let mut keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, 0.0);
+                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &ma, &mb, workspace);
+        let ctx = request.near_context.max(1.0);
+        let mut keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, 1.0);
         let any_near = keep.0.iter().any(|&k| k);
-        if any_near && ctx > 0.0 {
-            let margins = |c: &PointCloud| -> Vec<Real> {
-                c.node_spacing().iter().map(|s| s * ctx).collect()
-            };
-            let (ma, mb) = (margins(a), margins(b));
+        if any_near && ctx > 1.0 {
+            let (ma, mb) = (margins(a, ctx), margins(b, ctx));
             t = a
                 .bvh()
                 .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &ma, &mb, workspace);
@@ -102,10 +102,10 @@ pub(crate) fn collide_with_workspace(
         // The brute-force reference: the same near-point rule on every point pair,
         // all near points in one region.
         let (mut keep_a, mut keep_b) =
-            near_points_brute_force(&rel, a, b, request.prune_epsilon, 0.0);
-        if keep_a.iter().any(|&k| k) && request.near_context > 0.0 {
-            (keep_a, keep_b) =
-                near_points_brute_force(&rel, a, b, request.prune_epsilon, request.near_context);
+            near_points_brute_force(&rel, a, b, request.prune_epsilon, 1.0);
+        let ctx = request.near_context.max(1.0);
+        if keep_a.iter().any(|&k| k) && ctx > 1.0 {
+            (keep_a, keep_b) = near_points_brute_force(&rel, a, b, request.prune_epsilon, ctx);
         }
         let pick =
             |k: &[bool]| -> Vec<u32> { (0..k.len() as u32).filter(|&i| k[i as usize]).collect() };
@@ -145,9 +145,16 @@ pub(crate) fn collide_with_workspace(
             let (ptsb, covsb) = pick(&patch.b, &pb, &cb);
             pts.extend(ptsb);
             covs.extend(covsb);
-            let fit = fit_patch(&pts, &covs, na, &axis, request)?;
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
+            let mut spacings: Vec<Real> = ia
+                .iter()
+                .map(|&i| a.spacing()[i as usize])
+                .chain(ib.iter().map(|&i| b.spacing()[i as usize]))
+                .collect();
+            let mid_k = spacings.len() / 2;
+            let spacing = *spacings.select_nth_unstable_by(mid_k, Real::total_cmp).1;
+            let fit = fit_patch(&pts, &covs, na, &axis, spacing, request)?;
             for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
                 probabilities_a[i as usize] = p;
             }
@@ -196,6 +203,11 @@ pub(crate) fn collide_with_workspace(
     })
 }
 
+/// Per-node margins of `spacings` sampling spacings.
+fn margins(cloud: &PointCloud, spacings: Real) -> Vec<Real> {
+    cloud.node_spacing().iter().map(|s| s * spacings).collect()
+}
+
 /// Points `idx` of `cloud` and their covariances, moved by `pose`.
 fn in_frame(pose: &Pose, cloud: &PointCloud, idx: &[u32]) -> (Vec<Point3>, Vec<Matrix3>) {
     let r = pose.rotation.to_rotation_matrix();
@@ -228,6 +240,7 @@ fn fit_patch(
     covs: &[Matrix3],
     na: usize,
     axis: &Vector3,
+    spacing: Real,
     request: &CollisionRequest,
 ) -> Result<PatchFit> {
     let labels: Vec<Real> = (0..pts.len())
@@ -262,30 +275,31 @@ fn fit_patch(
     };
     // The separation is measured along the near region's axis (unlike the trained
     // surface's normal, it stays meaningful when the clouds interpenetrate and the
-    // surface cannot separate them), on lines through up to 16 of the patch's
+    // surface cannot separate them), on lines through up to 64 of the patch's
     // points; the smallest is where the surfaces come closest or cross deepest.
-    // Only points within half of the patch's lateral RMS spread of a line
+    // Only points within two sampling spacings (the patch's median) of a line
     // count for it, and a line needs 3 of each side.
-    let c = mean(pts);
-    let lateral = |x: &Point3| {
-        let d = x.coords - c;
-        (d - axis * d.dot(axis)).norm_squared()
-    };
-    let radius = 0.5 * (pts.iter().map(lateral).sum::<Real>() / pts.len() as Real).sqrt();
-    let stride = pts.len().div_ceil(16).max(1);
+    let radius = 2.0 * spacing;
+    // Along a line, one cloud may show several surfaces (both faces of a thin
+    // plate): offsets further apart than this belong to different surfaces.
+    let mut sig: Vec<Real> = covs.iter().map(crate::uncertainty::max_std).collect();
+    let mid_k = sig.len() / 2;
+    let sigma = *sig.select_nth_unstable_by(mid_k, Real::total_cmp).1;
+    let split = (4.0 * sigma).max(0.5 * spacing);
+    let stride = pts.len().div_ceil(64).max(1);
     let separation = pts
         .iter()
         .step_by(stride)
         .filter_map(|x| {
-            let sb = axial_offset(&pts[na..], x, axis, radius)?;
-            let sa = axial_offset(&pts[..na], x, axis, radius)?;
+            let sb = axial_offset(&pts[na..], x, axis, radius, -1.0, split)?;
+            let sa = axial_offset(&pts[..na], x, axis, radius, 1.0, split)?;
             Some(sb - sa)
         })
         .reduce(Real::min)
         .unwrap_or_else(|| {
             let inf = Real::INFINITY;
-            axial_offset(&pts[na..], &mid, axis, inf).unwrap_or(0.0)
-                - axial_offset(&pts[..na], &mid, axis, inf).unwrap_or(0.0)
+            axial_offset(&pts[na..], &mid, axis, inf, -1.0, split).unwrap_or(0.0)
+                - axial_offset(&pts[..na], &mid, axis, inf, 1.0, split).unwrap_or(0.0)
         });
     Ok(PatchFit {
         classification,
@@ -318,12 +332,21 @@ fn mean(p: &[Point3]) -> Vector3 {
     p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }
 
-/// Where one side's surface crosses the line through `point` along `axis`: the
-/// median offset along `axis` of the side's points nearest that line (a tenth of
-/// them, between 3 and 30) among those within `radius` of it; `None` with fewer
-/// than 3 there. Medians keep the estimate unbiased by the noise on a flat
-/// contact, where a minimum or maximum would be pulled by the extreme points.
-fn axial_offset(pts: &[Point3], point: &Point3, axis: &Vector3, radius: Real) -> Option<Real> {
+/// Where one side's surface crosses the line through `point` along `axis`: among
+/// the side's 12 points nearest that line (within `radius` of it), sorted by
+/// their offset along `axis` starting from the end that faces the other cloud
+/// (`facing = +1`: the largest offsets first), the median of the leading run of
+/// offsets less than `split` apart, i.e. of the surface nearest the other cloud;
+/// `None` with fewer than 3 points near the line or 2 in that run. Medians keep
+/// the estimate unbiased by the noise on a flat contact.
+fn axial_offset(
+    pts: &[Point3],
+    point: &Point3,
+    axis: &Vector3,
+    radius: Real,
+    facing: Real,
+    split: Real,
+) -> Option<Real> {
     let r2 = radius * radius;
     let mut by_lateral: Vec<(Real, Real)> = pts
         .iter()
@@ -337,10 +360,13 @@ fn axial_offset(pts: &[Point3], point: &Point3, axis: &Vector3, radius: Real) ->
     if by_lateral.len() < 3 {
         return None;
     }
-    let k = (pts.len() / 10).clamp(3, 30).min(by_lateral.len());
+    let k = 12.min(by_lateral.len());
     by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| x.1).collect();
-    let m = along.len() / 2;
-    let (_, med, _) = along.select_nth_unstable_by(m, Real::total_cmp);
-    Some(*med)
+    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
+    along.sort_by(|a, b| b.total_cmp(a));
+    let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
+    if run < 2 {
+        return None;
+    }
+    Some(facing * along[run / 2])
 }

@@ -19,13 +19,15 @@ pub struct CollisionRequest {
     /// The sum of the bounds of what was pruned is reported in
     /// [`crate::query::QueryStats::pruned_bound`].
     pub prune_epsilon: Real,
-    /// Context kept around the noise-based near region, in sampling spacings
-    /// (each point's distance to its 6th nearest neighbour) (default 2): once
-    /// some point pair is within the noise's reach, the classifier sees that much
-    /// surface beyond it, so that sparse clouds still give it a surface to fit.
+    /// Context kept around the near region, in sampling spacings (each point's
+    /// distance to its 6th nearest neighbour) (default 2, at least 1). A pair of
+    /// points is near when the noise reaches across its distance less one
+    /// spacing (sampled surfaces can meet between samples); once some pair is,
+    /// points within `near_context` spacings more join, so that sparse clouds
+    /// still give the classifier a surface to fit.
     pub near_context: Real,
     /// Near regions with more points than this are split into patches along the
-    /// contact, each with its own surface (default 160).
+    /// contact, each with its own surface (default 2000).
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
@@ -41,7 +43,7 @@ impl Default for CollisionRequest {
             thresholds: Thresholds::default(),
             prune_epsilon: 1e-3,
             near_context: 2.0,
-            region_max_points: 160,
+            region_max_points: 2000,
             use_hierarchy: true,
         }
     }
@@ -63,9 +65,9 @@ impl CollisionRequest {
                 self.prune_epsilon
             )));
         }
-        if !(self.near_context.is_finite() && self.near_context >= 0.0) {
+        if !(self.near_context.is_finite() && self.near_context >= 1.0) {
             return Err(Error::invalid(format!(
-                "near_context must be finite and >= 0, got {}",
+                "near_context must be finite and >= 1, got {}",
                 self.near_context
             )));
         }

@@ -21,9 +21,9 @@ pub struct ContactRegion {
     /// Estimated signed separation of the two clouds' surfaces (metres), negative
     /// when they interpenetrate, at this patch. Measured along the near region's
     /// direction of least spread (oriented from A to B), as the smallest over lines
-    /// through up to 16 of the patch's points of: the median
-    /// offset of B's points nearest that line minus that of A's (a tenth of each
-    /// side's patch points, 3 to 30). Medians keep it unbiased by the noise on a
+    /// through up to 64 of the patch's points of: the median
+    /// offset of B's points nearest that line minus that of A's (those within two
+    /// sampling spacings of it, at most 30, at least 3 of each). Medians keep it unbiased by the noise on a
     /// flat contact; curvature within the sampled neighbourhood biases it upwards.
     pub separation: Real,
     /// The patch's aggregated collision probability.
