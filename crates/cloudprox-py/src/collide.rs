@@ -18,7 +18,7 @@ use crate::result::PyCollisionResult;
 #[pyo3(signature = (
     a, b, pose_a=None, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
-    region_max_points=None, lambda_=None, robust_eta=None, robust_model=None,
+    region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
     solver=None, use_hierarchy=None
 ))]
 pub fn collide(
@@ -33,6 +33,7 @@ pub fn collide(
     threshold_free: Option<f64>,
     prune_epsilon: Option<f64>,
     region_max_points: Option<i64>,
+    near_context: Option<f64>,
     lambda_: Option<f64>,
     robust_eta: Option<f64>,
     robust_model: Option<String>,
@@ -46,6 +47,7 @@ pub fn collide(
         threshold_free,
         prune_epsilon,
         region_max_points,
+        near_context,
         lambda: lambda_,
         robust_eta,
         robust_model,
@@ -69,7 +71,7 @@ pub fn collide(
 #[pyo3(signature = (
     a, b, poses_a, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
-    region_max_points=None, lambda_=None, robust_eta=None, robust_model=None,
+    region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
     solver=None, use_hierarchy=None
 ))]
 pub fn collide_many(
@@ -84,6 +86,7 @@ pub fn collide_many(
     threshold_free: Option<f64>,
     prune_epsilon: Option<f64>,
     region_max_points: Option<i64>,
+    near_context: Option<f64>,
     lambda_: Option<f64>,
     robust_eta: Option<f64>,
     robust_model: Option<String>,
@@ -97,6 +100,7 @@ pub fn collide_many(
         threshold_free,
         prune_epsilon,
         region_max_points,
+        near_context,
         lambda: lambda_,
         robust_eta,
         robust_model,

@@ -70,6 +70,7 @@ pub struct RequestOptions {
     pub threshold_free: Option<f64>,
     pub prune_epsilon: Option<f64>,
     pub region_max_points: Option<i64>,
+    pub near_context: Option<f64>,
     pub lambda: Option<f64>,
     pub robust_eta: Option<f64>,
     pub robust_model: Option<String>,
@@ -106,6 +107,9 @@ impl RequestOptions {
         if let Some(v) = self.region_max_points {
             r.region_max_points = usize_option(py, "region_max_points", v)?;
         }
+        if let Some(v) = self.near_context {
+            r.near_context = v;
+        }
         if let Some(v) = self.lambda {
             r.classify.lambda = v;
         }
@@ -133,6 +137,7 @@ pub fn default_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("threshold_free", r.thresholds.free)?;
     d.set_item("prune_epsilon", r.prune_epsilon)?;
     d.set_item("region_max_points", r.region_max_points)?;
+    d.set_item("near_context", r.near_context)?;
     d.set_item("lambda_", r.classify.lambda)?;
     d.set_item("robust_eta", r.classify.robust_eta)?;
     d.set_item("robust_model", robust_model_name(r.classify.robust_model))?;

@@ -197,6 +197,7 @@ impl PyCollisionResult {
             leaf_pairs,
             near_regions,
             patches,
+            misfit_cuts,
             points_classified,
             solver_iterations,
             barrier_fallbacks,
@@ -209,6 +210,7 @@ impl PyCollisionResult {
         d.set_item("leaf_pairs", leaf_pairs)?;
         d.set_item("near_regions", near_regions)?;
         d.set_item("patches", patches)?;
+        d.set_item("misfit_cuts", misfit_cuts)?;
         d.set_item("points_classified", points_classified)?;
         d.set_item("solver_iterations", solver_iterations)?;
         d.set_item("barrier_fallbacks", barrier_fallbacks)?;

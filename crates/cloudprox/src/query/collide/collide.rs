@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::point_probability;
 use crate::query::collide::region::{
-    near_points, near_points_brute_force, near_regions, split_patches, Patch,
+    cut, near_points, near_points_brute_force, near_regions, split_patches, Patch,
 };
 use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
 use crate::Real;
@@ -70,55 +70,54 @@ pub(crate) fn collide_with_workspace(
     let mut stats = QueryStats::default();
     // Pose of A in B's frame.
     let rel = pose_b.inverse() * pose_a;
-    let components: Vec<Patch> = if request.use_hierarchy {
-        // First the noise and the sampling alone: two surfaces sampled at spacing
-        // h can meet with no two samples closer than about h, so a pair is near
-        // when the noise reaches across its distance less one spacing. If no pair
-        // is, the clouds are free and the query ends here. Otherwise again with
-        // the context margin, so the classifier sees the surface around.
-        let (ma, mb) = (margins(a, 1.0), margins(b, 1.0));
-        let mut t =
-            a.bvh()
-                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &ma, &mb, workspace);
-        let ctx = request.near_context.max(1.0);
-        let mut keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, 1.0);
-        let any_near = keep.0.iter().any(|&k| k);
-        if any_near && ctx > 1.0 {
+    // Near points, in two stages. First the noise and the sampling alone: two
+    // surfaces sampled at spacing h can meet with no two samples closer than
+    // about h/2, so a pair is near when the noise reaches across its distance
+    // less half a spacing (the "core" points). If no pair is, the clouds are free
+    // and the query ends here. Otherwise again with the context margin, so the
+    // classifier sees the surface around the core.
+    let ctx = request.near_context.max(SAMPLING_MARGIN);
+    let eps = request.prune_epsilon;
+    let (components, core): (Vec<Patch>, (Vec<bool>, Vec<bool>)) = if request.use_hierarchy {
+        let (ma, mb) = (margins(a, SAMPLING_MARGIN), margins(b, SAMPLING_MARGIN));
+        let mut t = a.bvh().traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
+        let core = near_points(&t.leaf_pairs, &rel, a, b, eps, SAMPLING_MARGIN);
+        let any_near = core.0.iter().any(|&k| k);
+        let mut keep = core.clone();
+        if any_near && ctx > SAMPLING_MARGIN {
             let (ma, mb) = (margins(a, ctx), margins(b, ctx));
-            t = a
-                .bvh()
-                .traverse_pairs(b.bvh(), &rel, request.prune_epsilon, &ma, &mb, workspace);
-            keep = near_points(&t.leaf_pairs, &rel, a, b, request.prune_epsilon, ctx);
+            t = a.bvh().traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
+            keep = near_points(&t.leaf_pairs, &rel, a, b, eps, ctx);
         }
         stats.node_pairs_visited = t.node_pairs_visited;
         stats.leaf_pairs = t.leaf_pairs.len();
         stats.pruned_bound = t.pruned_bound;
-        let (keep_a, keep_b) = keep;
         if !any_near {
             t.leaf_pairs.clear();
         }
-        near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep_a, &keep_b)
+        let regions = near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep.0, &keep.1);
+        (regions, core)
     } else {
         // The brute-force reference: the same near-point rule on every point pair,
         // all near points in one region.
-        let (mut keep_a, mut keep_b) =
-            near_points_brute_force(&rel, a, b, request.prune_epsilon, 1.0);
-        let ctx = request.near_context.max(1.0);
-        if keep_a.iter().any(|&k| k) && ctx > 1.0 {
-            (keep_a, keep_b) = near_points_brute_force(&rel, a, b, request.prune_epsilon, ctx);
+        let core = near_points_brute_force(&rel, a, b, eps, SAMPLING_MARGIN);
+        let mut keep = core.clone();
+        if keep.0.iter().any(|&k| k) && ctx > SAMPLING_MARGIN {
+            keep = near_points_brute_force(&rel, a, b, eps, ctx);
         }
         let pick =
             |k: &[bool]| -> Vec<u32> { (0..k.len() as u32).filter(|&i| k[i as usize]).collect() };
         let region = Patch {
             component: 0,
-            a: pick(&keep_a),
-            b: pick(&keep_b),
+            a: pick(&keep.0),
+            b: pick(&keep.1),
         };
-        if region.a.is_empty() || region.b.is_empty() {
+        let regions = if region.a.is_empty() || region.b.is_empty() {
             Vec::new()
         } else {
             vec![region]
-        }
+        };
+        (regions, core)
     };
     stats.near_regions = components.len();
 
@@ -136,7 +135,8 @@ pub(crate) fn collide_with_workspace(
         // The direction of least spread of the whole near region, oriented from A
         // to B: the axis along which every patch measures its separation.
         let axis = least_spread_axis(&[&pa[..], &pb[..]].concat(), &(mean(&pb) - mean(&pa)));
-        for patch in split_patches(local, &pa, &pb, request.region_max_points) {
+        let mut todo = split_patches(local, &pa, &pb, request.region_max_points);
+        while let Some(patch) = todo.pop() {
             let na = patch.a.len();
             let pick = |idx: &[u32], p: &[Point3], c: &[Matrix3]| -> (Vec<Point3>, Vec<Matrix3>) {
                 idx.iter().map(|&k| (p[k as usize], c[k as usize])).unzip()
@@ -155,6 +155,24 @@ pub(crate) fn collide_with_workspace(
             let mid_k = spacings.len() / 2;
             let spacing = *spacings.select_nth_unstable_by(mid_k, Real::total_cmp).1;
             let fit = fit_patch(&pts, &covs, na, &axis, spacing, request)?;
+            // A context point (beyond the noise's reach of the other cloud) that
+            // the surface puts on the wrong side shows a surface too rigid for the
+            // patch (a wrapped or saddle-shaped contact): cut it and fit the halves.
+            let misfit = ia
+                .iter()
+                .map(|&i| !core.0[i as usize])
+                .chain(ib.iter().map(|&i| !core.1[i as usize]))
+                .zip(&fit.probabilities)
+                .any(|(context, &p)| context && p >= 0.5);
+            let big_enough = na >= MIN_CUT_POINTS && pts.len() - na >= MIN_CUT_POINTS;
+            if misfit && big_enough {
+                if let Some((l, r)) = cut(&patch, &pa, &pb) {
+                    stats.misfit_cuts += 1;
+                    todo.push(r);
+                    todo.push(l);
+                    continue;
+                }
+            }
             for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
                 probabilities_a[i as usize] = p;
             }
@@ -202,6 +220,14 @@ pub(crate) fn collide_with_workspace(
         stats,
     })
 }
+
+/// The margin, in sampling spacings, by which two samples may be farther apart
+/// than the surfaces they sample.
+const SAMPLING_MARGIN: Real = 0.5;
+
+/// Patches are cut on a misfit only while both halves keep this many points of
+/// each cloud.
+const MIN_CUT_POINTS: usize = 16;
 
 /// Per-node margins of `spacings` sampling spacings.
 fn margins(cloud: &PointCloud, spacings: Real) -> Vec<Real> {

@@ -191,7 +191,9 @@ pub fn split_patches(region: Patch, pa: &[Point3], pb: &[Point3], max_points: us
     out
 }
 
-fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
+/// Cuts a patch in two at the median along the contact (see [`split_patches`]);
+/// `None` when a half would lose all points of a cloud.
+pub fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
     let xa = p.a.iter().map(|&i| pa[i as usize].coords);
     let xb = p.b.iter().map(|&i| pb[i as usize].coords);
     let mean_a = xa.clone().sum::<Vector3>() / p.a.len() as Real;

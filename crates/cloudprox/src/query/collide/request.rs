@@ -20,14 +20,16 @@ pub struct CollisionRequest {
     /// [`crate::query::QueryStats::pruned_bound`].
     pub prune_epsilon: Real,
     /// Context kept around the near region, in sampling spacings (each point's
-    /// distance to its 6th nearest neighbour) (default 2, at least 1). A pair of
-    /// points is near when the noise reaches across its distance less one
+    /// distance to its 6th nearest neighbour) (default 2, at least 0.5). A pair
+    /// of points is near when the noise reaches across its distance less half a
     /// spacing (sampled surfaces can meet between samples); once some pair is,
-    /// points within `near_context` spacings more join, so that sparse clouds
-    /// still give the classifier a surface to fit.
+    /// points within `near_context` spacings join, so that sparse clouds still
+    /// give the classifier a surface to fit.
     pub near_context: Real,
     /// Near regions with more points than this are split into patches along the
-    /// contact, each with its own surface (default 2000).
+    /// contact, each with its own surface (default 2000): a bound on the cost of
+    /// one solve. Smaller patches are also cut where one surface misfits (see
+    /// [`QueryStats::misfit_cuts`](crate::query::QueryStats::misfit_cuts)).
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
@@ -65,9 +67,9 @@ impl CollisionRequest {
                 self.prune_epsilon
             )));
         }
-        if !(self.near_context.is_finite() && self.near_context >= 1.0) {
+        if !(self.near_context.is_finite() && self.near_context >= 0.5) {
             return Err(Error::invalid(format!(
-                "near_context must be finite and >= 1, got {}",
+                "near_context must be finite and >= 0.5, got {}",
                 self.near_context
             )));
         }

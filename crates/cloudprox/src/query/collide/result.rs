@@ -49,6 +49,9 @@ pub struct QueryStats {
     pub near_regions: usize,
     /// Patches (= [`CollisionResult::regions`]) classified.
     pub patches: usize,
+    /// Patches cut in two because their surface put a point beyond the noise's
+    /// reach of the other cloud on the wrong side.
+    pub misfit_cuts: usize,
     /// Points of both clouds that went into a classifier.
     pub points_classified: usize,
     /// Interior-point iterations over all patches.

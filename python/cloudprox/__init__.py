@@ -1,0 +1,52 @@
+"""Probabilistic collision queries between noisy point clouds.
+
+Two clouds are collision-free iff a surface separates them. Every point carries a
+3x3 covariance; a robust classifier finds the separating surface that tolerates
+that noise, every point gets the probability of lying on the wrong side of it, and
+the pair gets an aggregated probability ``P`` and a state (``"free"``,
+``"contact"`` or ``"collision"``).
+
+Examples
+--------
+>>> import numpy as np
+>>> import cloudprox
+>>> pts = cloudprox.sample_sphere(500, radius=0.1)
+>>> a = cloudprox.PointCloud(cloudprox.add_noise(pts, 0.002, seed=1), sigma=0.002)
+>>> b = cloudprox.PointCloud(cloudprox.add_noise(pts, 0.002, seed=2), sigma=0.002)
+>>> pose_b = np.eye(4)
+>>> pose_b[0, 3] = 0.25  # 5 cm (25 sigma) between the two spheres
+>>> cloudprox.collide(a, b, pose_b=pose_b).state
+'free'
+"""
+
+from cloudprox._native import (
+    CollisionResult,
+    ContactRegion,
+    PointCloud,
+    __version__,
+    add_noise,
+    collide,
+    collide_many,
+    default_options,
+    option_names,
+    sample_box_surface,
+    sample_sphere,
+)
+from cloudprox.exceptions import CloudproxError, InvalidInputError, SolverError
+
+__all__ = [
+    "CloudproxError",
+    "CollisionResult",
+    "ContactRegion",
+    "InvalidInputError",
+    "PointCloud",
+    "SolverError",
+    "__version__",
+    "add_noise",
+    "collide",
+    "collide_many",
+    "default_options",
+    "option_names",
+    "sample_box_surface",
+    "sample_sphere",
+]

@@ -1,0 +1,7 @@
+"""``python -m cloudprox``: the command-line interface."""
+
+import sys
+
+from cloudprox.cli import main
+
+sys.exit(main())

@@ -1,0 +1,413 @@
+"""Type stubs of the compiled module ``cloudprox._native`` (PyO3, ``crates/cloudprox-py``).
+
+Conventions
+-----------
+Inputs are any numeric array-like, converted to C-contiguous float64: points
+``(n, 3)``, covariances ``(n, 3, 3)``, transforms ``(4, 4)``. Outputs are fresh numpy
+arrays. Units are SI: metres, and metres squared for covariances. Poses map an
+object's own frame to the world; ``None`` means identity.
+"""
+
+from typing import Final, Literal, final
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: Final[str]
+__all__ = [
+    "CloudproxError",
+    "CollisionResult",
+    "ContactRegion",
+    "InvalidInputError",
+    "PointCloud",
+    "SolverError",
+    "__version__",
+    "add_noise",
+    "collide",
+    "collide_many",
+    "default_options",
+    "option_names",
+    "sample_box_surface",
+    "sample_sphere",
+]
+
+_FloatArray = npt.NDArray[np.float64]
+_IntArray = npt.NDArray[np.int64]
+_SurfaceName = Literal["linear", "quadric"]
+_AggregationName = Literal["max", "union", "independent"]
+_RobustModelName = Literal["gaussian", "chebyshev"]
+_SolverName = Literal["barrier", "clarabel"]
+_StateName = Literal["free", "contact", "collision"]
+
+class CloudproxError(Exception):
+    """Base class of every exception raised by cloudprox."""
+
+class InvalidInputError(CloudproxError, ValueError):
+    """An input is out of its domain or has the wrong shape or dtype.
+
+    Raised for NaN or infinite coordinates, empty clouds, arrays of the wrong
+    shape, negative sigmas, covariances that are not symmetric positive
+    semi-definite, poses that are not rigid, thresholds out of order and unknown
+    option names.
+    """
+
+class SolverError(CloudproxError, RuntimeError):
+    """A solver failed in a way that cannot be reported as data (reserved).
+
+    A solve that does not converge is not an error: it falls back to a plane and
+    is reported in ``ContactRegion.status`` and ``CollisionResult.stats``.
+    """
+
+@final
+class PointCloud:
+    """Points with a 3x3 covariance each, in the cloud's own frame.
+
+    The covariance of a point is its sensor covariance (from ``sigma`` or
+    ``cov``) plus, with ``discretization=True``, the k-nearest-neighbour
+    discretization covariance. The bounding volume hierarchy over the points is
+    built on first use and shared by every query on this cloud.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Point positions (metres); ``n >= 1``, all finite.
+    sigma : float or array_like of shape (n,), optional
+        Isotropic standard deviation of the sensor noise, one for all points or
+        one per point (metres, ``>= 0``).
+    cov : array_like, shape (n, 3, 3), optional
+        Full sensor covariance per point (metres squared), symmetric positive
+        semi-definite. Exclusive with ``sigma``; with neither the sensor noise
+        is zero.
+    discretization : bool, default False
+        Add the discretization covariance estimated from each point's ``k``
+        nearest neighbours (Gaussian weights of scale ``2 d_k``).
+    k : int, optional
+        Number of neighbours for ``discretization`` (Rust default: 10; ``>= 2``);
+        only allowed with ``discretization=True``.
+
+    Raises
+    ------
+    InvalidInputError
+        On a wrong shape or dtype, an empty cloud, a NaN or infinite coordinate,
+        a negative or non-finite sigma, a sigma array of the wrong length, a
+        covariance that is not symmetric PSD, both ``sigma`` and ``cov``, or ``k``
+        without ``discretization``.
+    """
+
+    def __new__(
+        cls,
+        points: npt.ArrayLike,
+        sigma: npt.ArrayLike | None = None,
+        cov: npt.ArrayLike | None = None,
+        discretization: bool = False,
+        k: int | None = None,
+    ) -> PointCloud: ...
+    @property
+    def points(self) -> _FloatArray:
+        """Point positions, shape ``(n, 3)``, float64 (metres)."""
+    @property
+    def covariances(self) -> _FloatArray:
+        """Per-point total covariances, shape ``(n, 3, 3)``, float64 (metres squared)."""
+    @property
+    def sigma_max(self) -> _FloatArray:
+        """Per-point largest standard deviation over all directions, shape ``(n,)``."""
+    def transformed(self, transform: npt.ArrayLike) -> PointCloud:
+        """Return a copy moved by a rigid transform.
+
+        Parameters
+        ----------
+        transform : array_like, shape (4, 4)
+            Homogeneous rigid transform ``[R t; 0 0 0 1]``.
+
+        Returns
+        -------
+        PointCloud
+            The moved cloud: points ``R x + t``, covariances ``R S R^T``.
+
+        Raises
+        ------
+        InvalidInputError
+            If ``transform`` is not a ``(4, 4)`` rigid transform.
+        """
+    def __len__(self) -> int: ...
+
+@final
+class ContactRegion:
+    """One patch of a near region with its own separating surface (world frame).
+
+    The surface ``f`` is positive on cloud A's side and negative on cloud B's.
+    """
+
+    @property
+    def component(self) -> int:
+        """Index of the connected near region the patch belongs to."""
+    @property
+    def indices_a(self) -> _IntArray:
+        """Indices of cloud A's points in the patch, shape ``(k,)``, int64."""
+    @property
+    def indices_b(self) -> _IntArray:
+        """Indices of cloud B's points in the patch, shape ``(l,)``, int64."""
+    @property
+    def point(self) -> _FloatArray:
+        """A point on the surface where the clouds come closest, shape ``(3,)``."""
+    @property
+    def normal(self) -> _FloatArray:
+        """Unit normal of the surface at ``point``, from A towards B, shape ``(3,)``."""
+    @property
+    def separation(self) -> float:
+        """Estimated signed separation along the normal (metres); negative = overlap."""
+    @property
+    def probability(self) -> float:
+        """The patch's aggregated collision probability."""
+    @property
+    def surface(self) -> _SurfaceName:
+        """The surface family."""
+    @property
+    def status(self) -> Literal["solved", "almost_solved", "fallback"]:
+        """How the solve ended (``"fallback"``: did not converge, a plane was used)."""
+    @property
+    def iterations(self) -> int:
+        """Interior-point iterations of the solve."""
+    def evaluate(self, x: npt.ArrayLike) -> tuple[_FloatArray, _FloatArray]:
+        """Evaluate the separating surface and its gradient.
+
+        Parameters
+        ----------
+        x : array_like, shape (m, 3)
+            Points in the world frame.
+
+        Returns
+        -------
+        f : ndarray, shape (m,)
+            ``f(x)``, positive on A's side.
+        grad : ndarray, shape (m, 3)
+            ``grad f(x)``.
+
+        Notes
+        -----
+        The per-point probability of a point ``x`` with covariance ``S`` and label
+        ``c`` (+1 for A, -1 for B) is ``Phi(-c f(x) / sqrt(g^T S g))`` with
+        ``g = grad f(x)``.
+        """
+
+@final
+class CollisionResult:
+    """The answer of :func:`collide`."""
+
+    @property
+    def probability(self) -> float:
+        """The pair's collision probability ``P`` in ``[0, 1]``."""
+    @property
+    def state(self) -> _StateName:
+        """``"free"`` (``P <= threshold_free``), ``"collision"`` (``P >= threshold_collision``) or ``"contact"``."""
+    @property
+    def probabilities_a(self) -> _FloatArray:
+        """Per-point probability of A's points being on the wrong side, shape ``(n_a,)``.
+
+        Points outside every near region get 0.
+        """
+    @property
+    def probabilities_b(self) -> _FloatArray:
+        """Per-point probability of B's points being on the wrong side, shape ``(n_b,)``."""
+    @property
+    def regions(self) -> list[ContactRegion]:
+        """The classified patches of the near regions."""
+    @property
+    def stats(self) -> dict[str, int | float]:
+        """Counters and timings of the query.
+
+        Keys: ``node_pairs_visited``, ``leaf_pairs``, ``near_regions``, ``patches``,
+        ``misfit_cuts`` (patches cut because one surface misfit them),
+        ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
+        where the barrier method gave way to Clarabel), ``solver_fallbacks`` (patches
+        that fell back to a plane) (int),
+        ``pruned_bound`` and ``time_seconds`` (float).
+        """
+
+def collide(
+    a: PointCloud,
+    b: PointCloud,
+    pose_a: npt.ArrayLike | None = None,
+    pose_b: npt.ArrayLike | None = None,
+    *,
+    surface: _SurfaceName | None = None,
+    aggregation: _AggregationName | None = None,
+    threshold_collision: float | None = None,
+    threshold_free: float | None = None,
+    prune_epsilon: float | None = None,
+    region_max_points: int | None = None,
+    near_context: float | None = None,
+    lambda_: float | None = None,
+    robust_eta: float | None = None,
+    robust_model: _RobustModelName | None = None,
+    solver: _SolverName | None = None,
+    use_hierarchy: bool | None = None,
+) -> CollisionResult:
+    """Probabilistic collision query between two noisy point clouds.
+
+    Every option left at ``None`` takes the Rust default (``CollisionRequest::default()``,
+    listed by :func:`default_options`). The GIL is released during the query.
+
+    Parameters
+    ----------
+    a, b : PointCloud
+        The two clouds.
+    pose_a, pose_b : array_like, shape (4, 4), optional
+        Rigid poses of the clouds (own frame to world); ``None`` is the identity.
+    surface : {"quadric", "linear"}, optional
+        Family of the separating surface (default ``"quadric"``).
+    aggregation : {"max", "union", "independent"}, optional
+        How per-point probabilities become ``P`` (default ``"max"``).
+    threshold_collision : float, optional
+        ``P >= threshold_collision`` is ``"collision"`` (default 0.9).
+    threshold_free : float, optional
+        ``P <= threshold_free`` is ``"free"`` (default 0.1). Must satisfy
+        ``0 <= threshold_free <= 0.5 <= threshold_collision <= 1``.
+    prune_epsilon : float, optional
+        Node pairs whose crossing bound is below this are pruned (default 1e-3).
+    region_max_points : int, optional
+        Near regions larger than this are split into patches (default 2000, ``>= 8``):
+        a bound on the cost of one solve. Regions are also cut where one surface
+        misfits (``stats["misfit_cuts"]``).
+    near_context : float, optional
+        Context kept around the near points, in sampling spacings (each point's
+        distance to its 6th nearest neighbour; default 2, ``>= 0.5``).
+    lambda_ : float, optional
+        Weight of the slacks in the classifier (default 100).
+    robust_eta : float, optional
+        Confidence of each point's chance constraint, in ``[0.5, 1)`` (default 0.9).
+    robust_model : {"gaussian", "chebyshev"}, optional
+        Distribution assumption of the robustness radius (default ``"gaussian"``).
+    solver : {"barrier", "clarabel"}, optional
+        SOCP solver: the specialized log-barrier method (falls back to Clarabel if
+        it does not converge) or Clarabel alone (default ``"barrier"``).
+    use_hierarchy : bool, optional
+        ``False`` finds the near points by testing every point pair and classifies
+        them in one region (the brute-force reference; default ``True``).
+
+    Returns
+    -------
+    CollisionResult
+        ``P``, the state, per-point probabilities, regions and statistics.
+
+    Raises
+    ------
+    InvalidInputError
+        On a bad pose, an unknown option name or an option out of its domain.
+    """
+
+def collide_many(
+    a: PointCloud,
+    b: PointCloud,
+    poses_a: npt.ArrayLike,
+    pose_b: npt.ArrayLike | None = None,
+    *,
+    surface: _SurfaceName | None = None,
+    aggregation: _AggregationName | None = None,
+    threshold_collision: float | None = None,
+    threshold_free: float | None = None,
+    prune_epsilon: float | None = None,
+    region_max_points: int | None = None,
+    near_context: float | None = None,
+    lambda_: float | None = None,
+    robust_eta: float | None = None,
+    robust_model: _RobustModelName | None = None,
+    solver: _SolverName | None = None,
+    use_hierarchy: bool | None = None,
+) -> list[CollisionResult]:
+    """Run :func:`collide` for many poses of ``a``, in parallel.
+
+    Parameters
+    ----------
+    a, b : PointCloud
+        The two clouds.
+    poses_a : array_like, shape (m, 4, 4)
+        Poses of ``a``.
+    pose_b : array_like, shape (4, 4), optional
+        Pose of ``b``; ``None`` is the identity.
+    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy
+        As in :func:`collide`.
+
+    Returns
+    -------
+    list of CollisionResult
+        One result per pose, in the order of ``poses_a``; identical to calling
+        :func:`collide` in a loop.
+    """
+
+def default_options() -> dict[str, str | float | int | bool]:
+    """Return the default of every option of :func:`collide`, read from the Rust defaults.
+
+    Returns
+    -------
+    dict
+        ``surface``, ``aggregation``, ``threshold_collision``, ``threshold_free``,
+        ``prune_epsilon``, ``region_max_points``, ``near_context``, ``lambda_``, ``robust_eta``,
+        ``robust_model``, ``solver`` and ``use_hierarchy``.
+    """
+
+def option_names() -> dict[str, tuple[str, ...]]:
+    """Return the valid names of the string options.
+
+    Returns
+    -------
+    dict
+        ``surface``, ``aggregation``, ``robust_model`` and ``solver``, each a tuple of
+        names.
+    """
+
+def sample_sphere(n: int, radius: float = 1.0, center: npt.ArrayLike | None = None) -> _FloatArray:
+    """Spread points evenly over a sphere (Fibonacci lattice).
+
+    Parameters
+    ----------
+    n : int
+        Number of points.
+    radius : float, default 1.0
+        Sphere radius (metres).
+    center : array_like, shape (3,), optional
+        Sphere centre; the origin by default.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        The points.
+    """
+
+def sample_box_surface(
+    half_extents: npt.ArrayLike, spacing: float, center: npt.ArrayLike | None = None
+) -> _FloatArray:
+    """Sample the surface of an axis-aligned box on a grid.
+
+    Parameters
+    ----------
+    half_extents : array_like, shape (3,)
+        Half the box's size along x, y and z (metres, each > 0).
+    spacing : float
+        Approximate grid spacing on each face (metres).
+    center : array_like, shape (3,), optional
+        Box centre; the origin by default.
+
+    Returns
+    -------
+    ndarray, shape (m, 3)
+        The points.
+    """
+
+def add_noise(points: npt.ArrayLike, sigma: float, seed: int = 0) -> _FloatArray:
+    """Add seeded isotropic Gaussian noise.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        The points.
+    sigma : float
+        Standard deviation of the noise (metres, ``>= 0``).
+    seed : int, default 0
+        Seed of the core's generator: the same seed gives the same noise.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        The noisy points.
+    """

@@ -1,0 +1,413 @@
+"""The ``cloudprox`` command.
+
+``cloudprox demo``
+    A piano lowered over a table in a room, at several exact gaps: a table of
+    ``P`` and states, and a figure.
+``cloudprox collide A.npy B.npy --sigma S``
+    One query between two ``(n, 3)`` arrays saved with ``numpy.save``.
+``cloudprox bench``
+    cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
+
+Every user error (missing or unreadable file, wrong shape, bad option) prints one
+line to stderr and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cloudprox import __version__
+from cloudprox._native import (
+    CollisionResult,
+    PointCloud,
+    collide,
+    default_options,
+    option_names,
+)
+from cloudprox.exceptions import CloudproxError
+
+__all__ = ["main", "result_to_dict"]
+
+#: Gaps of the demo, in units of sigma.
+DEMO_GAPS_SIGMA = (-3.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 15.0)
+#: The demo's "far" gap (metres).
+DEMO_FAR_GAP = 0.25
+
+
+class CliError(Exception):
+    """A user error: reported on one line, exit status 2."""
+
+
+def _finite(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
+def result_to_dict(result: CollisionResult) -> dict[str, Any]:
+    """Plain-JSON form of a result (non-finite numbers become ``None``).
+
+    Parameters
+    ----------
+    result : CollisionResult
+        A query's result.
+
+    Returns
+    -------
+    dict
+        ``probability``, ``state``, ``regions`` (each with ``component``,
+        ``points_a``, ``points_b``, ``point``, ``normal``, ``separation``,
+        ``probability``, ``surface``, ``status``, ``iterations``) and ``stats``.
+    """
+    return {
+        "probability": result.probability,
+        "state": result.state,
+        "regions": [
+            {
+                "component": r.component,
+                "points_a": len(r.indices_a),
+                "points_b": len(r.indices_b),
+                "point": [_finite(float(x)) for x in r.point],
+                "normal": [_finite(float(x)) for x in r.normal],
+                "separation": _finite(r.separation),
+                "probability": r.probability,
+                "surface": r.surface,
+                "status": r.status,
+                "iterations": r.iterations,
+            }
+            for r in result.regions
+        ],
+        "stats": {k: (_finite(v) if isinstance(v, float) else v) for k, v in result.stats.items()},
+    }
+
+
+def _console(stderr: bool = False) -> Any:
+    from rich.console import Console
+
+    console = Console(stderr=stderr, highlight=False)
+    if not console.is_terminal:  # files and pipes: do not squeeze tables into 80 columns
+        console.width = max(console.width, 120)
+    return console
+
+
+# --------------------------------------------------------------------------- demo
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from rich.table import Table
+
+    from cloudprox.plots import Panel, plot_collisions, world_points
+    from cloudprox.scenes import build_scene
+
+    if not (math.isfinite(args.sigma) and args.sigma > 0.0):
+        raise CliError(f"--sigma must be finite and > 0, got {args.sigma}")
+    if args.points < 50:
+        raise CliError(f"--points must be >= 50, got {args.points}")
+    out = Path(args.out)
+    console = _console()
+    t_start = time.perf_counter()
+    s = args.sigma
+    scene = build_scene(sigma=s, points=args.points, seed=args.seed)
+    piano = PointCloud(scene.piano_points, sigma=s)
+    room = PointCloud(scene.room_points, sigma=s)
+    console.print(
+        f"Piano ({len(piano)} points) lowered over {scene.table} in a room ({len(room)} points), "
+        f"noise sigma = {1e3 * s:g} mm, seed {args.seed}."
+    )
+
+    table = Table(title="Piano against the room at exact gaps")
+    for col in ("gap mm", "gap/sigma", "nearest", "P", "state", "regions", "ms"):
+        table.add_column(col, justify="left" if col in ("nearest", "state") else "right")
+    gaps = [g * s for g in DEMO_GAPS_SIGMA] + [DEMO_FAR_GAP]
+    runs = []
+    for gap in gaps:
+        pose = scene.piano_pose(gap)
+        per_group = scene.gaps(pose)
+        nearest = min(per_group, key=per_group.__getitem__)
+        exact = per_group[nearest]
+        result = collide(piano, room, pose_a=pose)
+        runs.append((gap, pose, result))
+        style = {"free": "green", "contact": "yellow", "collision": "red"}[result.state]
+        table.add_row(
+            f"{1e3 * exact:+.1f}",
+            f"{exact / s:+.1f}",
+            nearest,
+            f"{result.probability:.3g}",
+            f"[{style}]{result.state}[/{style}]",
+            str(len(result.regions)),
+            f"{1e3 * result.stats['time_seconds']:.1f}",
+        )
+    console.print(table)
+
+    # The figure: touching, and the first undecided case (else the 4 sigma one).
+    touching = next(r for r in runs if r[0] == 0.0)
+    undecided = next((r for r in runs if r[2].state == "contact"), runs[DEMO_GAPS_SIGMA.index(4.0)])
+    top = next(b for b in scene.room_boxes if b.name == f"{scene.table} top")
+    lo = np.array([top.center[0] - 1.0, top.center[1] - 1.1, top.hi[2] - 0.3])
+    hi = np.array([top.center[0] + 1.0, top.center[1] + 1.1, top.hi[2] + 0.5])
+    out.mkdir(parents=True, exist_ok=True)
+    png = out / "demo.png"
+    panels = [
+        Panel(
+            world_points(scene.piano_points, pose),
+            scene.room_points,
+            result,
+            f"piano {gap / s:+g} sigma ({1e3 * gap:+.1f} mm) above {scene.table}",
+        )
+        for gap, pose, result in (touching, undecided)
+    ]
+    plot_collisions(panels, png, bounds=(lo, hi), labels=("piano", "room"))
+    console.print(f"Figure written to {png.resolve()}")
+    console.print(f"Total time {time.perf_counter() - t_start:.2f} s.")
+    return 0
+
+
+# ------------------------------------------------------------------------ collide
+
+
+def _load_array(path: str, what: str) -> np.ndarray:
+    p = Path(path)
+    if not p.exists():
+        raise CliError(f"{what}: no such file: {path}")
+    if p.is_dir():
+        raise CliError(f"{what}: {path} is a directory, expected a .npy file")
+    try:
+        with p.open("rb") as f:
+            magic = f.read(6)
+        if magic[:4] == b"PK\x03\x04":
+            raise CliError(f"{what}: {path} is an .npz archive, expected a single .npy array")
+        if magic != b"\x93NUMPY":
+            raise CliError(f"{what}: {path} is not a .npy file (no NumPy header)")
+        data = np.load(p, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as e:
+        raise CliError(f"{what}: {path} is not a readable .npy file ({e})") from None
+    if not isinstance(data, np.ndarray):
+        raise CliError(f"{what}: {path} does not hold an array")
+    return data
+
+
+def _cmd_collide(args: argparse.Namespace) -> int:
+    clouds = []
+    for path, sigma, what in ((args.a, args.sigma, "A"), (args.b, args.sigma_b, "B")):
+        points = _load_array(path, what)
+        try:
+            clouds.append(PointCloud(points, sigma=args.sigma if sigma is None else sigma))
+        except CloudproxError as e:
+            raise CliError(f"{what} ({path}): {e}") from None
+    poses = []
+    for path, what in ((args.pose_a, "pose A"), (args.pose_b, "pose B")):
+        poses.append(None if path is None else _load_array(path, what))
+    options = {
+        k: getattr(args, k)
+        for k in ("surface", "aggregation", "solver")
+        if getattr(args, k) is not None
+    }
+    try:
+        result = collide(clouds[0], clouds[1], poses[0], poses[1], **options)
+    except CloudproxError as e:
+        raise CliError(str(e)) from None
+    if args.json:
+        print(json.dumps(result_to_dict(result), indent=2))
+        return 0
+    console = _console()
+    style = {"free": "green", "contact": "yellow", "collision": "red"}[result.state]
+    console.print(f"A: {args.a} ({len(clouds[0])} points)   B: {args.b} ({len(clouds[1])} points)")
+    console.print(
+        f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
+        f"regions: {len(result.regions)}   time: {1e3 * result.stats['time_seconds']:.2f} ms"
+    )
+    for k, r in enumerate(result.regions):
+        point = ", ".join(f"{x:+.4f}" for x in r.point)
+        normal = ", ".join(f"{x:+.3f}" for x in r.normal)
+        console.print(
+            f"  region {k}: P = {r.probability:.3g}, separation {1e3 * r.separation:+.2f} mm, "
+            f"point ({point}), normal ({normal}), points {len(r.indices_a)}+{len(r.indices_b)}, "
+            f"{r.surface} surface, {r.status}"
+        )
+    stats = ", ".join(
+        f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
+    )
+    console.print(f"stats: {stats}")
+    return 0
+
+
+# -------------------------------------------------------------------------- bench
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.table import Table
+
+    from cloudprox.bench import CONFIGS, engine_names, run_bench
+
+    if args.points < 10 or args.repeat < 1:
+        raise CliError("--points must be >= 10 and --repeat >= 1")
+    total = len(engine_names()) * len(CONFIGS) * args.repeat
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        console=_console(stderr=True),
+        transient=True,
+    ) as progress:
+        task = progress.add_task("benchmark", total=total)
+
+        def step(desc: str) -> None:
+            progress.update(task, advance=1, description=desc)
+
+        rows, notes = run_bench(args.points, args.repeat, on_step=step)
+    ref = {r.config: r.median_ms for r in rows if r.engine == "cloudprox"}
+    if args.json:
+        doc = {
+            "points": args.points,
+            "repeat": args.repeat,
+            "rows": [
+                {
+                    "config": r.config,
+                    "engine": r.engine,
+                    "median_ms": r.median_ms,
+                    "prep_ms": r.prep_ms,
+                    "ratio_to_cloudprox": r.median_ms / ref[r.config] if ref[r.config] else None,
+                    "answer": r.answer,
+                }
+                for r in rows
+            ],
+            "notes": notes,
+        }
+        print(json.dumps(doc, indent=2))
+        return 0
+    console = _console()
+    table = Table(title=f"Two noisy spheres, {args.points} points each, median of {args.repeat}")
+    for col in ("config", "engine", "median ms", "ratio", "prep ms", "answer"):
+        right = col in ("median ms", "ratio", "prep ms")
+        table.add_column(col, justify="right" if right else "left", no_wrap=True)
+    for r in rows:
+        ratio = f"{r.median_ms / ref[r.config]:.3g}" if ref[r.config] else "-"
+        table.add_row(r.config, r.engine, f"{r.median_ms:.3f}", ratio, f"{r.prep_ms:.1f}", r.answer)
+    console.print(table)
+    console.print("ratio = engine median / cloudprox median on the same configuration.")
+    for note in notes:
+        console.print(f"note: {note}")
+    return 0
+
+
+# --------------------------------------------------------------------------- main
+
+
+def _parser() -> argparse.ArgumentParser:
+    defaults = default_options()
+    names = option_names()
+    parser = argparse.ArgumentParser(
+        prog="cloudprox",
+        description="Probabilistic collision queries between noisy point clouds.",
+    )
+    parser.add_argument("--version", action="version", version=f"cloudprox {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    demo = sub.add_parser("demo", help="piano over a table in a room, at several exact gaps")
+    demo.add_argument(
+        "--out", default="cloudprox-demo", help="directory for demo.png (default: %(default)s)"
+    )
+    demo.add_argument(
+        "--sigma",
+        type=float,
+        default=0.005,
+        help="noise standard deviation in metres (default: %(default)s)",
+    )
+    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    demo.add_argument(
+        "--points",
+        type=int,
+        default=10_000,
+        help="approximate number of piano points (default: %(default)s)",
+    )
+    demo.set_defaults(func=_cmd_demo)
+
+    col = sub.add_parser("collide", help="one query between two .npy point arrays")
+    col.add_argument("a", metavar="A.npy", help="(n, 3) array of cloud A's points (metres)")
+    col.add_argument("b", metavar="B.npy", help="(m, 3) array of cloud B's points (metres)")
+    col.add_argument(
+        "--sigma",
+        type=float,
+        required=True,
+        help="noise standard deviation of A (and of B unless --sigma-b) in metres",
+    )
+    col.add_argument("--sigma-b", type=float, default=None, help="noise standard deviation of B")
+    col.add_argument("--pose-a", default=None, metavar="FILE.npy", help="(4, 4) pose of A")
+    col.add_argument("--pose-b", default=None, metavar="FILE.npy", help="(4, 4) pose of B")
+    col.add_argument(
+        "--surface",
+        choices=names["surface"],
+        default=None,
+        help=f"separating surface (default: {defaults['surface']})",
+    )
+    col.add_argument(
+        "--aggregation",
+        choices=names["aggregation"],
+        default=None,
+        help=f"aggregation of per-point probabilities (default: {defaults['aggregation']})",
+    )
+    col.add_argument(
+        "--solver",
+        choices=names["solver"],
+        default=None,
+        help=f"SOCP solver (default: {defaults['solver']})",
+    )
+    col.add_argument("--json", action="store_true", help="print the result as JSON")
+    col.set_defaults(func=_cmd_collide)
+
+    bench = sub.add_parser("bench", help="cloudprox against comparison engines")
+    bench.add_argument(
+        "--points", type=int, default=10_000, help="points per sphere (default: %(default)s)"
+    )
+    bench.add_argument(
+        "--repeat",
+        type=int,
+        default=5,
+        help="timed queries per engine and configuration (default: %(default)s)",
+    )
+    bench.add_argument("--json", action="store_true", help="print the results as JSON")
+    bench.set_defaults(func=_cmd_bench)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``cloudprox`` command.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name; ``sys.argv[1:]`` by default.
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 on a user error.
+    """
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:  # --help, --version, or a usage error already printed
+        return e.code if isinstance(e.code, int) else 2
+    if args.command is None:
+        parser.print_usage(sys.stderr)
+        print("cloudprox: error: a command is required (demo, collide or bench)", file=sys.stderr)
+        return 2
+    try:
+        return int(args.func(args))
+    except (CliError, CloudproxError) as e:
+        print(f"cloudprox {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"cloudprox {args.command}: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("cloudprox: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,19 @@
+"""Exceptions raised by cloudprox.
+
+The classes are created by the compiled module (``cloudprox._native``) and
+re-exported here::
+
+    Exception
+    └── CloudproxError            base of everything cloudprox raises
+        ├── InvalidInputError     also a ValueError: bad shapes, dtypes, values, options
+        └── SolverError           also a RuntimeError: reserved for solver failures
+
+A solve that does not converge is *not* an error: it falls back to a plane and is
+reported as data (``ContactRegion.status == "fallback"`` and
+``CollisionResult.stats["solver_fallbacks"]``). Missing files raise the builtin
+``FileNotFoundError``.
+"""
+
+from cloudprox._native import CloudproxError, InvalidInputError, SolverError
+
+__all__ = ["CloudproxError", "InvalidInputError", "SolverError"]
