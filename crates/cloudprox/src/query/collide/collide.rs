@@ -80,13 +80,17 @@ pub(crate) fn collide_with_workspace(
     let eps = request.prune_epsilon;
     let (components, core): (Vec<Patch>, (Vec<bool>, Vec<bool>)) = if request.use_hierarchy {
         let (ma, mb) = (margins(a, SAMPLING_MARGIN), margins(b, SAMPLING_MARGIN));
-        let mut t = a.bvh().traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
+        let mut t = a
+            .bvh()
+            .traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
         let core = near_points(&t.leaf_pairs, &rel, a, b, eps, SAMPLING_MARGIN);
         let any_near = core.0.iter().any(|&k| k);
         let mut keep = core.clone();
         if any_near && ctx > SAMPLING_MARGIN {
             let (ma, mb) = (margins(a, ctx), margins(b, ctx));
-            t = a.bvh().traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
+            t = a
+                .bvh()
+                .traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
             keep = near_points(&t.leaf_pairs, &rel, a, b, eps, ctx);
         }
         stats.node_pairs_visited = t.node_pairs_visited;
