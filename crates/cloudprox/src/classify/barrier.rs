@@ -51,7 +51,8 @@ struct PointData {
 
 /// Largest working set tried before solving with every point.
 const WORKING_SET_ROUNDS: usize = 8;
-/// Points of each cloud in the first working set, and most added per round.
+/// Points of each cloud in the first working set, and fewest added per round
+/// (a round adds as many as the set holds, so it grows geometrically).
 const WORKING_SET_STEP: usize = 24;
 
 /// Solves the robust SOCP for all points with a working set of constraints.
@@ -115,7 +116,9 @@ pub(crate) fn solve_barrier(
             });
         }
         violated.sort_by(|a, b| b.0.total_cmp(&a.0));
-        for &(_, i) in violated.iter().take(WORKING_SET_STEP) {
+        // Grow geometrically: at least as many as are in the set already.
+        let grow = WORKING_SET_STEP.max(idx.len());
+        for &(_, i) in violated.iter().take(grow) {
             in_set[i] = true;
         }
     }
