@@ -8,19 +8,25 @@ use crate::Real;
 /// Which solver trains the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SocpSolver {
+    /// The faster of the two for the problem, by measurement (BENCHMARKS.md):
+    /// Clarabel when the surface is linear and every covariance isotropic (one
+    /// shared cone then replaces the per-point cones), the barrier method
+    /// otherwise. The default.
+    #[default]
+    Auto,
     /// The specialized log-barrier interior-point method: Newton systems of
     /// `dim + 1` unknowns, `O(n)` per step. Falls back to Clarabel if it does not
-    /// converge. The default.
-    #[default]
+    /// converge.
     Barrier,
     /// Clarabel, a general conic interior-point solver: the exact reference.
     Clarabel,
 }
 
 impl SocpSolver {
-    /// Parses `"barrier"` or `"clarabel"`.
+    /// Parses `"auto"`, `"barrier"` or `"clarabel"`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
+            "auto" => Some(SocpSolver::Auto),
             "barrier" => Some(SocpSolver::Barrier),
             "clarabel" => Some(SocpSolver::Clarabel),
             _ => None,
@@ -30,6 +36,7 @@ impl SocpSolver {
     /// The lowercase name, as [`SocpSolver::from_name`] reads it.
     pub fn name(self) -> &'static str {
         match self {
+            SocpSolver::Auto => "auto",
             SocpSolver::Barrier => "barrier",
             SocpSolver::Clarabel => "clarabel",
         }
@@ -49,7 +56,7 @@ pub struct ClassifySettings {
     pub robust_eta: Real,
     /// Distribution assumption behind `r = r(eta)` (default Gaussian).
     pub robust_model: RobustModel,
-    /// Which solver (default [`SocpSolver::Barrier`]).
+    /// Which solver (default [`SocpSolver::Auto`]).
     pub solver: SocpSolver,
     /// Clarabel's interior-point iteration limit (default 100).
     pub solver_max_iter: u32,
@@ -64,7 +71,7 @@ impl Default for ClassifySettings {
             lambda: 100.0,
             robust_eta: 0.9,
             robust_model: RobustModel::Gaussian,
-            solver: SocpSolver::Barrier,
+            solver: SocpSolver::Auto,
             solver_max_iter: 100,
             solver_tol: 1e-7,
         }
