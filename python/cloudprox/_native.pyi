@@ -36,7 +36,7 @@ _IntArray = npt.NDArray[np.int64]
 _SurfaceName = Literal["linear", "quadric"]
 _AggregationName = Literal["max", "union", "independent"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
-_SolverName = Literal["auto", "barrier", "clarabel"]
+_SolverName = Literal["barrier", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
 
 class CloudproxError(Exception):
@@ -278,10 +278,9 @@ def collide(
         Confidence of each point's chance constraint, in ``[0.5, 1)`` (default 0.9).
     robust_model : {"gaussian", "chebyshev"}, optional
         Distribution assumption of the robustness radius (default ``"gaussian"``).
-    solver : {"auto", "barrier", "clarabel"}, optional
+    solver : {"barrier", "clarabel"}, optional
         SOCP solver: the specialized log-barrier method (falls back to Clarabel if
-        it does not converge), Clarabel alone, or ``"auto"`` (default): Clarabel
-        for a linear surface with isotropic noise, the barrier method otherwise.
+        it does not converge) or Clarabel alone (default ``"barrier"``).
     use_hierarchy : bool, optional
         ``False`` finds the near points by testing every point pair and classifies
         them in one region (the brute-force reference; default ``True``).

@@ -20,7 +20,7 @@ const AGGREGATIONS: [Aggregation; 3] = [
     Aggregation::Independent,
 ];
 const ROBUST_MODELS: [RobustModel; 2] = [RobustModel::Gaussian, RobustModel::Chebyshev];
-const SOLVERS: [SocpSolver; 3] = [SocpSolver::Auto, SocpSolver::Barrier, SocpSolver::Clarabel];
+const SOLVERS: [SocpSolver; 2] = [SocpSolver::Barrier, SocpSolver::Clarabel];
 
 /// The lowercase name of a robust model (the core has none).
 pub fn robust_model_name(model: RobustModel) -> &'static str {

@@ -8,25 +8,19 @@ use crate::Real;
 /// Which solver trains the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SocpSolver {
-    /// The faster of the two for the problem, by measurement (BENCHMARKS.md):
-    /// Clarabel when the surface is linear and every covariance isotropic (one
-    /// shared cone then replaces the per-point cones), the barrier method
-    /// otherwise. The default.
-    #[default]
-    Auto,
     /// The specialized log-barrier interior-point method: Newton systems of
     /// `dim + 1` unknowns, `O(n)` per step. Falls back to Clarabel if it does not
-    /// converge.
+    /// converge. The default.
+    #[default]
     Barrier,
     /// Clarabel, a general conic interior-point solver: the exact reference.
     Clarabel,
 }
 
 impl SocpSolver {
-    /// Parses `"auto"`, `"barrier"` or `"clarabel"`.
+    /// Parses `"barrier"` or `"clarabel"`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
-            "auto" => Some(SocpSolver::Auto),
             "barrier" => Some(SocpSolver::Barrier),
             "clarabel" => Some(SocpSolver::Clarabel),
             _ => None,
@@ -36,7 +30,6 @@ impl SocpSolver {
     /// The lowercase name, as [`SocpSolver::from_name`] reads it.
     pub fn name(self) -> &'static str {
         match self {
-            SocpSolver::Auto => "auto",
             SocpSolver::Barrier => "barrier",
             SocpSolver::Clarabel => "clarabel",
         }
@@ -56,7 +49,7 @@ pub struct ClassifySettings {
     pub robust_eta: Real,
     /// Distribution assumption behind `r = r(eta)` (default Gaussian).
     pub robust_model: RobustModel,
-    /// Which solver (default [`SocpSolver::Auto`]).
+    /// Which solver (default [`SocpSolver::Barrier`]).
     pub solver: SocpSolver,
     /// Clarabel's interior-point iteration limit (default 100).
     pub solver_max_iter: u32,
@@ -71,7 +64,7 @@ impl Default for ClassifySettings {
             lambda: 100.0,
             robust_eta: 0.9,
             robust_model: RobustModel::Gaussian,
-            solver: SocpSolver::Auto,
+            solver: SocpSolver::Barrier,
             solver_max_iter: 100,
             solver_tol: 1e-7,
         }

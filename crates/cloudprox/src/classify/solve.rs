@@ -4,7 +4,7 @@ use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverSt
 
 use crate::classify::barrier::solve_barrier;
 use crate::classify::problem::{assemble, Normalized};
-use crate::classify::{ClassifySettings, Separator, SocpSolver, Surface};
+use crate::classify::{ClassifySettings, Separator, SocpSolver};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::Real;
@@ -42,8 +42,6 @@ pub struct Classification {
     pub status: SolveStatus,
     /// The solver that produced the separator (Clarabel for the fallback too).
     pub solver: SocpSolver,
-    /// Whether the barrier method was tried and did not converge.
-    pub barrier_failed: bool,
     /// Interior-point iterations (Newton steps for the barrier method).
     pub iterations: u32,
     /// Optimal slacks `xi_i` in the input order (empty on fallback).
@@ -86,12 +84,7 @@ pub fn train(
     }
     let r = settings.robust_radius()?;
     let norm = Normalized::new(points, covs);
-    let use_barrier = match settings.solver {
-        SocpSolver::Barrier => true,
-        SocpSolver::Clarabel => false,
-        SocpSolver::Auto => settings.surface != Surface::Linear || norm.isotropic.is_none(),
-    };
-    if use_barrier {
+    if settings.solver == SocpSolver::Barrier {
         if let Some(sol) = solve_barrier(
             &norm,
             labels,
@@ -111,7 +104,6 @@ pub fn train(
                 },
                 status: SolveStatus::Solved,
                 solver: SocpSolver::Barrier,
-                barrier_failed: false,
                 iterations: sol.newton_steps,
                 slacks: sol.xi,
             });
@@ -159,21 +151,14 @@ pub fn train(
                     },
                     status,
                     solver: SocpSolver::Clarabel,
-                    barrier_failed: use_barrier,
                     iterations: sol.iterations,
                     slacks: sol.x[d + 1..d + 1 + n].to_vec(),
                 });
             }
         }
-        return Ok(fallback(
-            &norm,
-            labels,
-            settings,
-            sol.iterations,
-            use_barrier,
-        ));
+        return Ok(fallback(&norm, labels, settings, sol.iterations));
     }
-    Ok(fallback(&norm, labels, settings, 0, use_barrier))
+    Ok(fallback(&norm, labels, settings, 0))
 }
 
 fn fallback(
@@ -181,7 +166,6 @@ fn fallback(
     labels: &[Real],
     settings: &ClassifySettings,
     iterations: u32,
-    barrier_failed: bool,
 ) -> Classification {
     let mean_of = |label: Real| {
         let (sum, cnt) = norm
@@ -208,7 +192,6 @@ fn fallback(
         },
         status: SolveStatus::Fallback,
         solver: SocpSolver::Clarabel,
-        barrier_failed,
         iterations,
         slacks: Vec::new(),
     }

@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{train, Classification, SolveStatus};
+use crate::classify::{train, Classification, SocpSolver, SolveStatus};
 use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
@@ -185,7 +185,10 @@ pub(crate) fn collide_with_workspace(
             }
             stats.points_classified += pts.len();
             stats.solver_iterations += u64::from(fit.classification.iterations);
-            stats.barrier_fallbacks += usize::from(fit.classification.barrier_failed);
+            stats.barrier_fallbacks += usize::from(
+                request.classify.solver == SocpSolver::Barrier
+                    && fit.classification.solver != SocpSolver::Barrier,
+            );
             stats.solver_fallbacks +=
                 usize::from(fit.classification.status == SolveStatus::Fallback);
             let mut separator = fit.classification.separator;
