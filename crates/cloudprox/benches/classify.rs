@@ -6,7 +6,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::hint::black_box;
 
-use cloudprox::classify::{train, ClassifySettings, Surface};
+use cloudprox::classify::{train, ClassifySettings, SocpSolver, Surface};
 use cloudprox::math::{Matrix3, Point3};
 use cloudprox::sample::NormalRng;
 
@@ -29,15 +29,19 @@ fn bench_classify(c: &mut Criterion) {
     let mut group = c.benchmark_group("train");
     group.sample_size(20);
     for surface in [Surface::Linear, Surface::Quadric] {
-        let s = ClassifySettings::builder()
-            .surface(surface)
-            .build()
-            .unwrap();
-        for n in [100, 200, 400, 800] {
-            let (p, cv, l) = patches(n);
-            group.bench_with_input(BenchmarkId::new(surface.name(), n), &n, |b, _| {
-                b.iter(|| black_box(train(&p, &cv, &l, &s).unwrap()));
-            });
+        for solver in [SocpSolver::Barrier, SocpSolver::Clarabel] {
+            let s = ClassifySettings::builder()
+                .surface(surface)
+                .solver(solver)
+                .build()
+                .unwrap();
+            for n in [100, 200, 400, 800, 1600] {
+                let (p, cv, l) = patches(n);
+                let id = format!("{}_{}", surface.name(), solver.name());
+                group.bench_with_input(BenchmarkId::new(id, n), &n, |b, _| {
+                    b.iter(|| black_box(train(&p, &cv, &l, &s).unwrap()));
+                });
+            }
         }
     }
     group.finish();
