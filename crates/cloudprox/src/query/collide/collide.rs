@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::point_probability;
 use crate::query::collide::region::{
-    cut, near_points, near_points_brute_force, near_regions, split_patches, Patch,
+    cut, near_points, near_points_brute_force, near_regions, split_patches, Patch, SAMPLING_MARGIN,
 };
 use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
 use crate::Real;
@@ -224,10 +224,6 @@ pub(crate) fn collide_with_workspace(
         stats,
     })
 }
-
-/// The margin, in sampling spacings, by which two samples may be farther apart
-/// than the surfaces they sample.
-const SAMPLING_MARGIN: Real = 0.5;
 
 /// Patches are cut on a misfit only while both halves keep this many points of
 /// each cloud.

@@ -2,9 +2,10 @@
 
 use std::collections::HashMap;
 
-use crate::bvh::{prune_bound, Bvh};
+use crate::bvh::Bvh;
 use crate::cloud::PointCloud;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::probability::normal_quantile;
 use crate::Real;
 
 /// A set of points of both clouds classified together.
@@ -18,16 +19,47 @@ pub struct Patch {
     pub b: Vec<u32>,
 }
 
-/// Which points of the kept leaves are near the other cloud.
+/// The margin, in sampling spacings, by which two samples may be farther apart
+/// than the surfaces they sample.
+pub const SAMPLING_MARGIN: Real = 0.5;
+
+/// The near rule for points `x_i`, `x_j` at distance `d`, with `h` the larger
+/// of their sampling spacings: near when the noise reaches across the distance
+/// less half a spacing, `prune_bound(max(0, d - h/2), sigma_i, sigma_j, 2) >=
+/// epsilon` (sampled surfaces can meet between samples), or, as context, when
+/// `d <= context * h`: the classifier sees at least `context` spacings of
+/// surface around the contact, which matters where the sampling is sparse
+/// against the noise, and adds nothing where the noise's reach is wider.
 ///
-/// A point `i` of A is near when some point `j` of B has
-/// `prune_bound(max(0, |x_i - x_j| - m_ij), sigma_i, sigma_j, 2) >= epsilon` with
-/// the context margin `m_ij = context * max(spacing_i, spacing_j)`: within the
-/// noise's reach of the other cloud, plus a few sampling spacings of surface
-/// around it for the classifier to see. The rule involves only distances, so it
-/// does not depend on the frame the clouds are given in (leaf boundaries do). The
-/// traversal keeps every leaf pair holding such a pair of points (its margins
-/// bound `m_ij`), so searching the partner leaves finds every `j`.
+/// The bound is evaluated through its inverse, `max(0, d - h/2) <= (sigma_i +
+/// sigma_j) k` with `k = Phi^-1(1 - epsilon / 2)` ([`NearRule::new`]), so no
+/// transcendental function runs per pair.
+#[derive(Debug, Clone, Copy)]
+struct NearRule {
+    k: Real,
+    context: Real,
+}
+
+impl NearRule {
+    fn new(epsilon: Real, context: Real) -> Self {
+        Self {
+            k: -normal_quantile(0.5 * epsilon),
+            context,
+        }
+    }
+
+    fn is_near(&self, xi: &Point3, xj: &Point3, h: Real, si: Real, sj: Real) -> bool {
+        let d = (xi - xj).norm();
+        d <= self.context * h || (d - SAMPLING_MARGIN * h).max(0.0) <= (si + sj) * self.k
+    }
+}
+
+/// Which points of the kept leaves are near the other cloud, by the near rule
+/// with some point of it. The rule involves only distances, so it does not
+/// depend on the frame the clouds are given in (leaf boundaries do). The
+/// traversal, run with margins of `context` times each node's largest spacing,
+/// keeps every leaf pair holding such a pair of points, so searching the
+/// partner leaves finds every one.
 pub fn near_points(
     leaf_pairs: &[(u32, u32)],
     rel: &Pose,
@@ -39,6 +71,7 @@ pub fn near_points(
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
     let (sp_a, sp_b) = (a.spacing(), b.spacing());
     let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
+    let rule = NearRule::new(epsilon, context);
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     for &(la, lb) in leaf_pairs {
@@ -50,9 +83,7 @@ pub fn near_points(
                 if near_a[i] && near_b[j] {
                     continue;
                 }
-                let m = context * sp_a[i].max(sp_b[j]);
-                let d = ((xi - b.points()[j]).norm() - m).max(0.0);
-                if prune_bound(d, sg_a[i], sg_b[j], 2) >= epsilon {
+                if rule.is_near(&xi, &b.points()[j], sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
                     near_a[i] = true;
                     near_b[j] = true;
                 }
@@ -73,14 +104,13 @@ pub fn near_points_brute_force(
 ) -> (Vec<bool>, Vec<bool>) {
     let (sp_a, sp_b) = (a.spacing(), b.spacing());
     let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
+    let rule = NearRule::new(epsilon, context);
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     for (i, pa) in a.points().iter().enumerate() {
         let xi = rel * pa;
         for (j, xj) in b.points().iter().enumerate() {
-            let m = context * sp_a[i].max(sp_b[j]);
-            let d = ((xi - xj).norm() - m).max(0.0);
-            if prune_bound(d, sg_a[i], sg_b[j], 2) >= epsilon {
+            if rule.is_near(&xi, xj, sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
                 near_a[i] = true;
                 near_b[j] = true;
             }

@@ -23,8 +23,8 @@ pub struct CollisionRequest {
     /// distance to its 6th nearest neighbour) (default 2, at least 0.5). A pair
     /// of points is near when the noise reaches across its distance less half a
     /// spacing (sampled surfaces can meet between samples); once some pair is,
-    /// points within `near_context` spacings join, so that sparse clouds still
-    /// give the classifier a surface to fit.
+    /// pairs closer than `near_context` spacings join too, so that sparse clouds
+    /// still give the classifier a surface to fit.
     pub near_context: Real,
     /// Near regions with more points than this are split into patches along the
     /// contact, each with its own surface (default 2000): a bound on the cost of
