@@ -69,28 +69,10 @@ pub fn near_points(
     context: Real,
 ) -> (Vec<bool>, Vec<bool>) {
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
-    let (sp_a, sp_b) = (a.spacing(), b.spacing());
-    let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
-    let rule = NearRule::new(epsilon, context);
-    let mut near_a = vec![false; a.len()];
-    let mut near_b = vec![false; b.len()];
-    for &(la, lb) in leaf_pairs {
-        for &i in bvh_a.node_points(la) {
-            let i = i as usize;
-            let xi = rel * a.points()[i];
-            for &j in bvh_b.node_points(lb) {
-                let j = j as usize;
-                if near_a[i] && near_b[j] {
-                    continue;
-                }
-                if rule.is_near(&xi, &b.points()[j], sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
-                    near_a[i] = true;
-                    near_b[j] = true;
-                }
-            }
-        }
-    }
-    (near_a, near_b)
+    let blocks = leaf_pairs
+        .iter()
+        .map(|&(la, lb)| (bvh_a.node_points(la), bvh_b.node_points(lb)));
+    near_points_in_blocks(blocks, rel, a, b, NearRule::new(epsilon, context))
 }
 
 /// The brute-force reference of [`near_points`]: the same rule tested on every
@@ -102,17 +84,37 @@ pub fn near_points_brute_force(
     epsilon: Real,
     context: Real,
 ) -> (Vec<bool>, Vec<bool>) {
+    let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
+    let (ia, ib) = (all(a.len()), all(b.len()));
+    let blocks = std::iter::once((&ia[..], &ib[..]));
+    near_points_in_blocks(blocks, rel, a, b, NearRule::new(epsilon, context))
+}
+
+/// The near rule over every pair `(i, j)` of each block of point indices.
+fn near_points_in_blocks<'a>(
+    blocks: impl Iterator<Item = (&'a [u32], &'a [u32])>,
+    rel: &Pose,
+    a: &PointCloud,
+    b: &PointCloud,
+    rule: NearRule,
+) -> (Vec<bool>, Vec<bool>) {
     let (sp_a, sp_b) = (a.spacing(), b.spacing());
     let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
-    let rule = NearRule::new(epsilon, context);
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
-    for (i, pa) in a.points().iter().enumerate() {
-        let xi = rel * pa;
-        for (j, xj) in b.points().iter().enumerate() {
-            if rule.is_near(&xi, xj, sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
-                near_a[i] = true;
-                near_b[j] = true;
+    for (block_a, block_b) in blocks {
+        for &i in block_a {
+            let i = i as usize;
+            let xi = rel * a.points()[i];
+            for &j in block_b {
+                let j = j as usize;
+                if near_a[i] && near_b[j] {
+                    continue;
+                }
+                if rule.is_near(&xi, &b.points()[j], sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
+                    near_a[i] = true;
+                    near_b[j] = true;
+                }
             }
         }
     }
