@@ -22,14 +22,6 @@ const AGGREGATIONS: [Aggregation; 3] = [
 const ROBUST_MODELS: [RobustModel; 2] = [RobustModel::Gaussian, RobustModel::Chebyshev];
 const SOLVERS: [SocpSolver; 2] = [SocpSolver::Barrier, SocpSolver::Clarabel];
 
-/// The lowercase name of a robust model (the core has none).
-pub fn robust_model_name(model: RobustModel) -> &'static str {
-    match model {
-        RobustModel::Gaussian => "gaussian",
-        RobustModel::Chebyshev => "chebyshev",
-    }
-}
-
 fn parse_name<T: Copy>(
     py: Python<'_>,
     option: &str,
@@ -90,7 +82,7 @@ impl RequestOptions {
         }
         if let Some(s) = &self.robust_model {
             r.classify.robust_model =
-                parse_name(py, "robust_model", s, &ROBUST_MODELS, robust_model_name)?;
+                parse_name(py, "robust_model", s, &ROBUST_MODELS, RobustModel::name)?;
         }
         if let Some(s) = &self.solver {
             r.classify.solver = parse_name(py, "solver", s, &SOLVERS, SocpSolver::name)?;
@@ -140,7 +132,7 @@ pub fn default_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("near_context", r.near_context)?;
     d.set_item("lambda_", r.classify.lambda)?;
     d.set_item("robust_eta", r.classify.robust_eta)?;
-    d.set_item("robust_model", robust_model_name(r.classify.robust_model))?;
+    d.set_item("robust_model", RobustModel::name(r.classify.robust_model))?;
     d.set_item("solver", r.classify.solver.name())?;
     d.set_item("use_hierarchy", r.use_hierarchy)?;
     Ok(d)
@@ -157,7 +149,7 @@ pub fn option_names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     )?;
     d.set_item(
         "robust_model",
-        PyTuple::new(py, ROBUST_MODELS.map(robust_model_name))?,
+        PyTuple::new(py, ROBUST_MODELS.map(RobustModel::name))?,
     )?;
     d.set_item("solver", PyTuple::new(py, SOLVERS.map(SocpSolver::name))?)?;
     Ok(d)

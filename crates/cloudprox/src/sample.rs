@@ -19,7 +19,14 @@ pub fn sphere(center: &Point3, radius: Real, n: usize) -> Vec<Point3> {
 
 /// The surface of an axis-aligned box (centre, half extents) sampled on a grid of
 /// about `spacing` on each face (edges shared between faces appear once per face).
+///
+/// # Panics
+/// If `spacing` is not finite and positive.
 pub fn box_surface(center: &Point3, half: &Vector3, spacing: Real) -> Vec<Point3> {
+    assert!(
+        spacing.is_finite() && spacing > 0.0,
+        "box_surface: spacing must be finite and > 0, got {spacing}"
+    );
     let mut out = Vec::new();
     for axis in 0..3 {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);

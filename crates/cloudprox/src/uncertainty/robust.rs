@@ -17,6 +17,23 @@ pub enum RobustModel {
 }
 
 impl RobustModel {
+    /// Parses `"gaussian"` or `"chebyshev"`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "gaussian" => Some(RobustModel::Gaussian),
+            "chebyshev" => Some(RobustModel::Chebyshev),
+            _ => None,
+        }
+    }
+
+    /// The lowercase name, as [`RobustModel::from_name`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RobustModel::Gaussian => "gaussian",
+            RobustModel::Chebyshev => "chebyshev",
+        }
+    }
+
     /// The radius `r` for confidence `eta` in `[0.5, 1)`.
     pub fn radius(self, eta: Real) -> Result<Real> {
         if !(0.5..1.0).contains(&eta) {
@@ -44,5 +61,9 @@ mod tests {
         assert!((RobustModel::Chebyshev.radius(0.9).unwrap() - 3.0).abs() < 1e-12);
         assert!(RobustModel::Gaussian.radius(1.0).is_err());
         assert!(RobustModel::Chebyshev.radius(0.2).is_err());
+        for m in [RobustModel::Gaussian, RobustModel::Chebyshev] {
+            assert_eq!(RobustModel::from_name(m.name()), Some(m));
+        }
+        assert_eq!(RobustModel::from_name("student"), None);
     }
 }
