@@ -23,5 +23,8 @@ step "ruff"
 python3 -m ruff check python tests
 python3 -m ruff format --check python tests
 
+step "stubs match the compiled module (mypy.stubtest)"
+python3 -m mypy.stubtest cloudprox._native
+
 step "pytest"
 python3 -m pytest -q
