@@ -19,6 +19,19 @@ fn request(surface: Surface) -> CollisionRequest {
         .unwrap()
 }
 
+/// The query with both clouds' points moved by `t` (B's also by `pb`) and
+/// identity poses, instead of the motion given as poses.
+fn collide_moved_data(
+    a: &PointCloud,
+    b: &PointCloud,
+    t: &Pose,
+    pb: &Pose,
+    req: &CollisionRequest,
+) -> CollisionResult {
+    let (ma, mb) = (a.transformed(t), b.transformed(&(t * pb)));
+    collide(&Pose::identity(), &ma, &Pose::identity(), &mb, req).unwrap()
+}
+
 fn sweep(
     a: &PointCloud,
     b: &PointCloud,
@@ -103,14 +116,7 @@ fn expressing_the_clouds_in_another_frame_changes_nothing() {
     for gap in [-1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0] {
         let pb = sphere_pose(gap * SIGMA);
         let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
-        let r1 = collide(
-            &Pose::identity(),
-            &a.transformed(&t),
-            &Pose::identity(),
-            &b.transformed(&(t * pb)),
-            &req,
-        )
-        .unwrap();
+        let r1 = collide_moved_data(&a, &b, &t, &pb, &req);
         assert_eq!(
             r0.stats.points_classified, r1.stats.points_classified,
             "gap {gap}"
@@ -207,14 +213,7 @@ fn the_classifier_is_equivariant_under_rotations_of_the_data() {
         for gap in [-2.0, 1.0, 3.0] {
             let pb = sphere_pose(gap * SIGMA);
             let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
-            let r2 = collide(
-                &Pose::identity(),
-                &a.transformed(&t),
-                &Pose::identity(),
-                &b.transformed(&(t * pb)),
-                &req,
-            )
-            .unwrap();
+            let r2 = collide_moved_data(&a, &b, &t, &pb, &req);
             assert!(
                 (r0.probability - r2.probability).abs() < 1e-5,
                 "{surface:?} gap {gap}: {} vs {}",

@@ -46,17 +46,6 @@ impl Separator {
         (f, g / self.scale)
     }
 
-    /// First-order signed distance `f(x) / |grad f(x)|` (positive on A's side).
-    pub fn signed_distance(&self, x: &Point3) -> Real {
-        let (f, g) = self.value_and_gradient(x);
-        let n = g.norm();
-        if n > 0.0 {
-            f / n
-        } else {
-            f.signum() * Real::INFINITY
-        }
-    }
-
     /// `x` moved onto the surface by a few Newton steps along the gradient.
     pub fn project(&self, x: &Point3) -> Point3 {
         let mut p = *x;

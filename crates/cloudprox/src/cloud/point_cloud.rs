@@ -238,18 +238,4 @@ impl PointCloud {
         c.transform(pose);
         c
     }
-
-    /// A new cloud holding the points at `indices` (in that order) with their covariances.
-    pub fn select(&self, indices: &[usize]) -> Result<Self> {
-        if let Some(&i) = indices.iter().find(|&&i| i >= self.len()) {
-            return Err(Error::invalid(format!(
-                "index {i} out of range for a cloud of {} points",
-                self.len()
-            )));
-        }
-        let points: Vec<Point3> = indices.iter().map(|&i| self.points[i]).collect();
-        validate_points(&points)?;
-        let covs = indices.iter().map(|&i| self.covariances[i]).collect();
-        Ok(Self::from_parts(points, covs))
-    }
 }

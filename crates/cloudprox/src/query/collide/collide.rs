@@ -151,14 +151,9 @@ pub(crate) fn collide_with_workspace(
             covs.extend(covsb);
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
-            let mut spacings: Vec<Real> = ia
-                .iter()
-                .map(|&i| a.spacing()[i as usize])
-                .chain(ib.iter().map(|&i| b.spacing()[i as usize]))
-                .collect();
-            let mid_k = spacings.len() / 2;
-            let spacing = *spacings.select_nth_unstable_by(mid_k, Real::total_cmp).1;
-            let fit = fit_patch(&pts, &covs, na, &axis, spacing, request)?;
+            let spacing = patch_median(&ia, a.spacing(), &ib, b.spacing());
+            let sigma = patch_median(&ia, a.sigma_max(), &ib, b.sigma_max());
+            let fit = fit_patch(&pts, &covs, na, &axis, spacing, sigma, request)?;
             // A context point (beyond the noise's reach of the other cloud) that
             // the surface puts on the wrong side shows a surface too rigid for the
             // patch (a wrapped or saddle-shaped contact): cut it and fit the halves.
@@ -229,6 +224,17 @@ pub(crate) fn collide_with_workspace(
 /// each cloud.
 const MIN_CUT_POINTS: usize = 16;
 
+/// Median over a patch's points (`ia` of A, `ib` of B) of a per-point quantity.
+fn patch_median(ia: &[u32], of_a: &[Real], ib: &[u32], of_b: &[Real]) -> Real {
+    let mut v: Vec<Real> = ia
+        .iter()
+        .map(|&i| of_a[i as usize])
+        .chain(ib.iter().map(|&i| of_b[i as usize]))
+        .collect();
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, Real::total_cmp).1
+}
+
 /// Per-node margins of `spacings` sampling spacings.
 fn margins(cloud: &PointCloud, spacings: Real) -> Vec<Real> {
     cloud.node_spacing().iter().map(|s| s * spacings).collect()
@@ -267,6 +273,7 @@ fn fit_patch(
     na: usize,
     axis: &Vector3,
     spacing: Real,
+    sigma: Real,
     request: &CollisionRequest,
 ) -> Result<PatchFit> {
     let labels: Vec<Real> = (0..pts.len())
@@ -308,9 +315,6 @@ fn fit_patch(
     let radius = 2.0 * spacing;
     // Along a line, one cloud may show several surfaces (both faces of a thin
     // plate): offsets further apart than this belong to different surfaces.
-    let mut sig: Vec<Real> = covs.iter().map(crate::uncertainty::max_std).collect();
-    let mid_k = sig.len() / 2;
-    let sigma = *sig.select_nth_unstable_by(mid_k, Real::total_cmp).1;
     let split = (4.0 * sigma).max(0.5 * spacing);
     let stride = pts.len().div_ceil(64).max(1);
     let separation = pts
