@@ -8,7 +8,7 @@ arrays. Units are SI: metres, and metres squared for covariances. Poses map an
 object's own frame to the world; ``None`` means identity.
 """
 
-from typing import Final, Literal, final
+from typing import Final, Literal, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -18,7 +18,9 @@ __all__ = [
     "CloudproxError",
     "CollisionResult",
     "ContactRegion",
+    "ExactShape",
     "InvalidInputError",
+    "Mesh",
     "PointCloud",
     "SolverError",
     "__version__",
@@ -26,6 +28,8 @@ __all__ = [
     "collide",
     "collide_many",
     "default_options",
+    "exact_proximity",
+    "exact_proximity_many",
     "option_names",
     "sample_box_surface",
     "sample_sphere",
@@ -223,6 +227,143 @@ class CollisionResult:
         that fell back to a plane) (int),
         ``pruned_bound`` and ``time_seconds`` (float).
         """
+
+@final
+class Mesh:
+    """A triangle mesh, validated on construction.
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n, 3)
+        Vertex positions (metres), all finite.
+    faces : array_like of int, shape (m, 3)
+        Vertex indices of each triangle, counter-clockwise seen from outside
+        when the mesh bounds a solid; ``m >= 1``.
+
+    Raises
+    ------
+    InvalidInputError
+        On a wrong shape or dtype, no vertex or face, a non-finite coordinate, an
+        index out of range or a face that repeats a vertex.
+    """
+
+    def __new__(cls, vertices: npt.ArrayLike, faces: npt.ArrayLike) -> Mesh: ...
+    @staticmethod
+    def cuboid(hx: float, hy: float, hz: float) -> Mesh:
+        """A box centred at the origin with half extents ``(hx, hy, hz)`` (each > 0)."""
+    @staticmethod
+    def cylinder(radius: float, half_height: float, segments: int = 32) -> Mesh:
+        """A cylinder along z centred at the origin: a prism of ``segments`` (>= 3) sides."""
+    @staticmethod
+    def merged(meshes: list[Mesh]) -> Mesh:
+        """Several meshes as one (faces re-indexed)."""
+    @property
+    def vertices(self) -> _FloatArray:
+        """Vertices, shape ``(n, 3)``, float64 (metres)."""
+    @property
+    def faces(self) -> _IntArray:
+        """Faces, shape ``(m, 3)``, int64."""
+    @property
+    def area(self) -> float:
+        """Surface area (square metres)."""
+    @property
+    def volume(self) -> float:
+        """Enclosed volume (cubic metres; meaningful when the mesh is closed)."""
+    @property
+    def is_closed(self) -> bool:
+        """Whether every edge is shared by exactly two faces, once in each direction."""
+    def is_convex(self, tolerance: float = 1e-9) -> bool:
+        """Whether the mesh is closed and convex, within ``tolerance`` metres."""
+    def bounds(self) -> tuple[_FloatArray, _FloatArray]:
+        """Lower and upper corners of the bounding box, each shape ``(3,)``."""
+    def transformed(self, transform: npt.ArrayLike) -> Mesh:
+        """Return a copy moved by the ``(4, 4)`` rigid transform ``transform``."""
+    def sample(
+        self, n: int | None = None, *, density: float | None = None, seed: int = 0
+    ) -> tuple[_FloatArray, _FloatArray, _IntArray]:
+        """Sample the surface uniformly (faces chosen with probability proportional to area).
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of points.
+        density : float, optional
+            Points per square metre instead (``round(density * area)`` points).
+        seed : int, default 0
+            Seed: the same seed gives the same points.
+
+        Returns
+        -------
+        points : ndarray, shape (k, 3)
+        normals : ndarray, shape (k, 3)
+            Unit outward normal of each point's face.
+        faces : ndarray of int64, shape (k,)
+            Face index of each point.
+
+        Raises
+        ------
+        InvalidInputError
+            If not exactly one of ``n`` and ``density`` is given, or the mesh has
+            zero area.
+        """
+
+@final
+class ExactShape:
+    """An object made of mesh parts, prepared for exact queries.
+
+    Closed convex parts become convex polyhedra (exact distance by GJK,
+    penetration depth by EPA); other parts triangle meshes (exact distance and
+    intersection, containment when closed). Built on parry.
+
+    Parameters
+    ----------
+    parts : list of Mesh
+        The parts, in the object's own frame (at least one).
+    """
+
+    def __new__(cls, parts: list[Mesh]) -> ExactShape: ...
+    @property
+    def part_kinds(self) -> list[str]:
+        """Per part, ``"convex"`` or ``"mesh"``."""
+    def __len__(self) -> int: ...
+
+class _Proximity(TypedDict):
+    intersecting: bool
+    distance: float
+    penetration_depth: float | None
+    signed_distance: float
+
+def exact_proximity(
+    a: ExactShape,
+    b: ExactShape,
+    pose_a: npt.ArrayLike | None = None,
+    pose_b: npt.ArrayLike | None = None,
+) -> _Proximity:
+    """Exact proximity of two posed objects (the ground truth of the evaluation).
+
+    Returns
+    -------
+    dict
+        ``intersecting``; ``distance`` (0 when intersecting); ``penetration_depth``,
+        the largest over intersecting convex part pairs (``None`` when a
+        non-convex part intersects); ``signed_distance`` (distance, or minus the
+        depth; NaN when the depth is unknown).
+    """
+
+def exact_proximity_many(
+    a: ExactShape,
+    b: ExactShape,
+    poses_a: npt.ArrayLike,
+    pose_b: npt.ArrayLike | None = None,
+) -> dict[str, npt.NDArray[np.float64] | npt.NDArray[np.bool_]]:
+    """:func:`exact_proximity` for poses ``(m, 4, 4)`` of ``a``, in parallel.
+
+    Returns
+    -------
+    dict
+        Arrays of shape ``(m,)``: ``intersecting`` (bool), ``distance``,
+        ``penetration_depth`` (NaN when unknown) and ``signed_distance``.
+    """
 
 def collide(
     a: PointCloud,

@@ -10,6 +10,7 @@
 //! | `request.rs` | query options -> `CollisionRequest` |
 //! | `collide.rs` | `collide`, `collide_many` |
 //! | `result.rs` | `CollisionResult`, `ContactRegion` |
+//! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
 //! | `sample.rs` | seeded synthetic shapes |
 //!
 //! The Python package `cloudprox` re-exports everything; `_native.pyi` is the stub.
@@ -21,6 +22,7 @@ mod cloud;
 mod collide;
 mod convert;
 mod error;
+mod mesh;
 mod request;
 mod result;
 mod sample;
@@ -37,6 +39,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
     m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
     m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
+    m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<mesh::PyExactShape>()?;
+    m.add_function(wrap_pyfunction!(mesh::exact_proximity, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::exact_proximity_many_py, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_sphere, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_box_surface, m)?)?;
     m.add_function(wrap_pyfunction!(sample::add_noise, m)?)?;

@@ -20,7 +20,8 @@
 //! | bounding volume hierarchy with noise-inflated pruning | [`bvh`] |
 //! | robust separating surface (SOCP) | [`classify`] |
 //! | per-point and pair probability, thresholds, state | [`probability`] |
-//! | queries (`collide`, `collide_many`) | [`query`] |
+//! | queries (`collide`, `collide_many`; exact mesh-vs-mesh ground truth) | [`query`] |
+//! | triangle meshes, primitives, surface sampling | [`shape`] |
 //!
 //! [`sample`] makes synthetic shapes and seeded noise for tests, benchmarks and demos.
 //!
@@ -52,6 +53,7 @@ pub mod math;
 pub mod probability;
 pub mod query;
 pub mod sample;
+pub mod shape;
 pub mod uncertainty;
 
 pub use error::{Error, Result};
@@ -66,9 +68,11 @@ pub mod prelude {
     pub use crate::error::{Error, Result};
     pub use crate::math::{Matrix3, Point3, Pose, Vector3};
     pub use crate::probability::{Aggregation, CollisionState, Thresholds};
+    pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
         collide, collide_many, CollisionRequest, CollisionRequestBuilder, CollisionResult,
         ContactRegion, QueryStats,
     };
+    pub use crate::shape::Mesh;
     pub use crate::uncertainty::{DiscretizationSettings, RobustModel};
 }

@@ -6,6 +6,7 @@
 //! first, each before its object: `collide(pose_a, a, pose_b, b, request)`.
 
 pub mod collide;
+pub mod exact;
 
 pub use collide::{
     collide, collide_many, CollisionRequest, CollisionRequestBuilder, CollisionResult,

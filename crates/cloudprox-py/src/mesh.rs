@@ -1,0 +1,332 @@
+//! `Mesh`, `ExactShape` and the exact mesh-vs-mesh queries.
+
+use std::sync::Arc;
+
+use cloudprox::query::exact::{
+    exact_proximity as core_exact, exact_proximity_many, ExactProximity, ExactShape,
+};
+use cloudprox::shape::Mesh;
+use numpy::prelude::*;
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{
+    points_from, points_to_py, pose_from, poses_from, rows3_to_py, shape_str, vec_to_py,
+};
+use crate::error::{invalid_input, run_detached};
+
+/// What `Mesh.sample` returns: points, normals and face indices.
+type SampleArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// An `(m, 3)` integer array-like as triangle indices.
+fn faces_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let arr = np.call_method1("asarray", (obj,)).map_err(|e| {
+        invalid_input(
+            py,
+            format!("faces must be an integer array-like: {}", e.value(py)),
+        )
+    })?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u") {
+        return Err(invalid_input(
+            py,
+            format!(
+                "faces must be integers, got an array of dtype {}",
+                arr.getattr("dtype")?.str()?
+            ),
+        ));
+    }
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(invalid_input(
+            py,
+            format!(
+                "faces must have shape (m, 3), got shape {}",
+                shape_str(&shape)
+            ),
+        ));
+    }
+    let flat: Vec<i64> = np
+        .call_method1("ravel", (arr.call_method1("astype", ("int64",))?,))?
+        .call_method0("tolist")?
+        .extract()?;
+    flat.chunks_exact(3)
+        .enumerate()
+        .map(|(f, c)| {
+            let idx = |v: i64| {
+                u32::try_from(v).map_err(|_| {
+                    invalid_input(py, format!("mesh face {f} has an invalid vertex index {v}"))
+                })
+            };
+            Ok([idx(c[0])?, idx(c[1])?, idx(c[2])?])
+        })
+        .collect()
+}
+
+/// A triangle mesh (vertices `(n, 3)` in metres, faces `(m, 3)` vertex indices,
+/// counter-clockwise seen from outside), validated on construction.
+#[pyclass(name = "Mesh", frozen, module = "cloudprox._native")]
+pub struct PyMesh {
+    pub(crate) inner: Arc<Mesh>,
+}
+
+impl PyMesh {
+    fn wrap(mesh: Mesh) -> Self {
+        Self {
+            inner: Arc::new(mesh),
+        }
+    }
+}
+
+#[pymethods]
+impl PyMesh {
+    #[new]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let vertices = points_from(vertices, "vertices")?;
+        let faces = faces_from(faces)?;
+        Ok(Self::wrap(run_detached(py, move || {
+            Mesh::new(vertices, faces)
+        })?))
+    }
+
+    /// A box centred at the origin with half extents `(hx, hy, hz)`.
+    #[staticmethod]
+    fn cuboid(py: Python<'_>, hx: f64, hy: f64, hz: f64) -> PyResult<Self> {
+        Ok(Self::wrap(run_detached(py, move || {
+            Mesh::cuboid(hx, hy, hz)
+        })?))
+    }
+
+    /// A cylinder along z centred at the origin (a prism of `segments` sides).
+    #[staticmethod]
+    #[pyo3(signature = (radius, half_height, segments=32))]
+    fn cylinder(py: Python<'_>, radius: f64, half_height: f64, segments: i64) -> PyResult<Self> {
+        let segments = usize::try_from(segments)
+            .map_err(|_| invalid_input(py, format!("segments must be >= 3, got {segments}")))?;
+        Ok(Self::wrap(run_detached(py, move || {
+            Mesh::cylinder(radius, half_height, segments)
+        })?))
+    }
+
+    /// Several meshes as one.
+    #[staticmethod]
+    #[allow(clippy::needless_pass_by_value)] // pyo3 extracts a Vec
+    fn merged(py: Python<'_>, meshes: Vec<PyRef<'_, PyMesh>>) -> PyResult<Self> {
+        let meshes: Vec<Mesh> = meshes.iter().map(|m| (*m.inner).clone()).collect();
+        Ok(Self::wrap(run_detached(py, move || Mesh::merged(&meshes))?))
+    }
+
+    /// Vertices, shape `(n, 3)`.
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points_to_py(py, self.inner.vertices())
+    }
+
+    /// Faces, shape `(m, 3)`, int64.
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let flat: Vec<i64> = self
+            .inner
+            .faces()
+            .iter()
+            .flatten()
+            .map(|&i| i64::from(i))
+            .collect();
+        PyArray1::from_vec(py, flat).reshape([self.inner.faces().len(), 3])
+    }
+
+    /// Surface area (square metres).
+    #[getter]
+    fn area(&self) -> f64 {
+        self.inner.area()
+    }
+
+    /// Enclosed volume (cubic metres; meaningful when closed).
+    #[getter]
+    fn volume(&self) -> f64 {
+        self.inner.volume()
+    }
+
+    /// Whether every edge is shared by two faces of opposite directions.
+    #[getter]
+    fn is_closed(&self) -> bool {
+        self.inner.is_closed()
+    }
+
+    /// Whether the mesh is closed and convex (within `tolerance` metres).
+    #[pyo3(signature = (tolerance=1e-9))]
+    fn is_convex(&self, tolerance: f64) -> bool {
+        self.inner.is_convex(tolerance)
+    }
+
+    /// `(lower, upper)` corners of the bounding box, each shape `(3,)`.
+    fn bounds<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
+        let b = self.inner.aabb();
+        (
+            vec_to_py(py, b.mins.coords.as_slice()),
+            vec_to_py(py, b.maxs.coords.as_slice()),
+        )
+    }
+
+    /// A copy moved by the `(4, 4)` rigid transform `transform`.
+    fn transformed(&self, py: Python<'_>, transform: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let pose = pose_from(py, Some(transform), "transform")?;
+        Ok(Self::wrap(self.inner.transformed(&pose)))
+    }
+
+    /// Area-weighted uniform samples of the surface: `n` points, or
+    /// `round(density * area)` with `density` (points per square metre). Returns
+    /// `(points (k, 3), normals (k, 3), faces (k,))`.
+    #[pyo3(signature = (n=None, *, density=None, seed=0))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        n: Option<i64>,
+        density: Option<f64>,
+        seed: u64,
+    ) -> PyResult<SampleArrays<'py>> {
+        let mesh = Arc::clone(&self.inner);
+        let sample = match (n, density) {
+            (Some(n), None) => {
+                if !(0..=100_000_000).contains(&n) {
+                    return Err(invalid_input(py, format!("n must be in [0, 1e8], got {n}")));
+                }
+                run_detached(py, move || mesh.sample_surface(n as usize, seed))?
+            }
+            (None, Some(d)) => run_detached(py, move || mesh.sample_surface_density(d, seed))?,
+            _ => return Err(invalid_input(py, "give exactly one of n and density")),
+        };
+        let faces: Vec<i64> = sample.faces.iter().map(|&f| i64::from(f)).collect();
+        Ok((
+            points_to_py(py, &sample.points)?,
+            rows3_to_py(py, sample.normals.iter().copied())?,
+            PyArray1::from_vec(py, faces),
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Mesh with {} vertices and {} faces.",
+            self.inner.vertices().len(),
+            self.inner.faces().len()
+        )
+    }
+}
+
+/// An object made of mesh parts, prepared for exact queries (closed convex parts
+/// as convex polyhedra, the others as triangle meshes).
+#[pyclass(name = "ExactShape", frozen, module = "cloudprox._native")]
+pub struct PyExactShape {
+    inner: Arc<ExactShape>,
+    n_parts: usize,
+}
+
+#[pymethods]
+impl PyExactShape {
+    #[new]
+    #[allow(clippy::needless_pass_by_value)] // pyo3 extracts a Vec
+    fn new(py: Python<'_>, parts: Vec<PyRef<'_, PyMesh>>) -> PyResult<Self> {
+        let meshes: Vec<Mesh> = parts.iter().map(|m| (*m.inner).clone()).collect();
+        let n_parts = meshes.len();
+        let inner = run_detached(py, move || ExactShape::new(&meshes))?;
+        Ok(Self {
+            inner: Arc::new(inner),
+            n_parts,
+        })
+    }
+
+    /// Per part: `"convex"` or `"mesh"` (how it is queried).
+    #[getter]
+    fn part_kinds(&self) -> Vec<&'static str> {
+        self.inner
+            .parts()
+            .iter()
+            .map(|p| match p {
+                cloudprox::query::exact::ExactPart::Convex(_) => "convex",
+                cloudprox::query::exact::ExactPart::Mesh { .. } => "mesh",
+            })
+            .collect()
+    }
+
+    fn __len__(&self) -> usize {
+        self.n_parts
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ExactShape with {} parts.", self.n_parts)
+    }
+}
+
+fn proximity_dict<'py>(py: Python<'py>, r: &ExactProximity) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("intersecting", r.intersecting)?;
+    d.set_item("distance", r.distance)?;
+    d.set_item("penetration_depth", r.penetration_depth)?;
+    d.set_item("signed_distance", r.signed_distance())?;
+    Ok(d)
+}
+
+/// Exact proximity of `a` at `pose_a` and `b` at `pose_b`: a dict with
+/// `intersecting`, `distance`, `penetration_depth` (None if unknown) and
+/// `signed_distance`.
+#[pyfunction]
+#[pyo3(signature = (a, b, pose_a=None, pose_b=None))]
+pub fn exact_proximity<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyExactShape>,
+    b: &Bound<'py, PyExactShape>,
+    pose_a: Option<&Bound<'py, PyAny>>,
+    pose_b: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pa = pose_from(py, pose_a, "pose_a")?;
+    let pb = pose_from(py, pose_b, "pose_b")?;
+    let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let r = run_detached(py, move || Ok(core_exact(&pa, &sa, &pb, &sb)))?;
+    proximity_dict(py, &r)
+}
+
+/// [`exact_proximity`] for poses `(m, 4, 4)` of `a`, in parallel: a dict of arrays
+/// `intersecting` (bool), `distance`, `penetration_depth` (NaN if unknown) and
+/// `signed_distance`, each of shape `(m,)`.
+#[pyfunction]
+#[pyo3(name = "exact_proximity_many", signature = (a, b, poses_a, pose_b=None))]
+pub fn exact_proximity_many_py<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyExactShape>,
+    b: &Bound<'py, PyExactShape>,
+    poses_a: &Bound<'py, PyAny>,
+    pose_b: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let poses = poses_from(poses_a, "poses_a")?;
+    let pb = pose_from(py, pose_b, "pose_b")?;
+    let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let rs = run_detached(py, move || Ok(exact_proximity_many(&poses, &sa, &pb, &sb)))?;
+    let d = PyDict::new(py);
+    let inter: Vec<bool> = rs.iter().map(|r| r.intersecting).collect();
+    d.set_item("intersecting", PyArray1::from_vec(py, inter))?;
+    let col = |f: &dyn Fn(&ExactProximity) -> f64| -> Vec<f64> { rs.iter().map(f).collect() };
+    d.set_item("distance", vec_to_py(py, &col(&|r| r.distance)))?;
+    d.set_item(
+        "penetration_depth",
+        vec_to_py(py, &col(&|r| r.penetration_depth.unwrap_or(f64::NAN))),
+    )?;
+    d.set_item(
+        "signed_distance",
+        vec_to_py(py, &col(&ExactProximity::signed_distance)),
+    )?;
+    Ok(d)
+}

@@ -1,0 +1,94 @@
+//! Objects prepared for exact queries: one parry shape per mesh part.
+
+use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
+
+use crate::bvh::Aabb;
+use crate::error::{Error, Result};
+use crate::shape::Mesh;
+use crate::Real;
+
+/// Relative tolerance (of the part's bounding-box diagonal) of the convexity test.
+const CONVEX_TOLERANCE: Real = 1e-9;
+
+/// How one part is represented for exact queries.
+#[derive(Clone)]
+pub enum ExactPart {
+    /// A closed convex part: GJK distances, EPA penetration depths.
+    Convex(ConvexPolyhedron),
+    /// Any other part. `closed` tells whether point containment is meaningful.
+    Mesh {
+        /// The triangle mesh (with pseudo-normals when closed).
+        mesh: TriMesh,
+        /// Whether the part bounds a solid.
+        closed: bool,
+    },
+}
+
+impl std::fmt::Debug for ExactPart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExactPart::Convex(c) => write!(f, "Convex({} vertices)", c.points().len()),
+            ExactPart::Mesh { mesh, closed } => write!(
+                f,
+                "Mesh({} triangles, closed: {closed})",
+                mesh.num_triangles()
+            ),
+        }
+    }
+}
+
+/// An object made of mesh parts, prepared once for many exact queries.
+#[derive(Debug, Clone)]
+pub struct ExactShape {
+    pub(crate) parts: Vec<ExactPart>,
+    pub(crate) aabbs: Vec<Aabb>,
+}
+
+impl ExactShape {
+    /// Prepare `parts` (in the object's own frame).
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] if there is no part, or parry rejects a part (the
+    /// message names the part and parry's reason).
+    pub fn new(parts: &[Mesh]) -> Result<Self> {
+        if parts.is_empty() {
+            return Err(Error::invalid("an exact shape needs at least one part"));
+        }
+        let mut out = Vec::with_capacity(parts.len());
+        for (i, m) in parts.iter().enumerate() {
+            let diag = m.aabb().half_extents().norm() * 2.0;
+            let part = if m.is_convex(CONVEX_TOLERANCE * diag.max(Real::MIN_POSITIVE)) {
+                let c = ConvexPolyhedron::from_convex_mesh(m.vertices().to_vec(), m.faces())
+                    .or_else(|| ConvexPolyhedron::from_convex_hull(m.vertices()))
+                    .ok_or_else(|| {
+                        Error::invalid(format!(
+                            "part {i}: parry could not build its convex polyhedron"
+                        ))
+                    })?;
+                ExactPart::Convex(c)
+            } else {
+                let closed = m.is_closed();
+                let flags = if closed {
+                    TriMeshFlags::ORIENTED
+                } else {
+                    TriMeshFlags::empty()
+                };
+                let mesh = TriMesh::with_flags(m.vertices().to_vec(), m.faces().to_vec(), flags)
+                    .map_err(|e| {
+                        Error::invalid(format!("part {i}: parry rejected the mesh: {e}"))
+                    })?;
+                ExactPart::Mesh { mesh, closed }
+            };
+            out.push(part);
+        }
+        Ok(Self {
+            parts: out,
+            aabbs: parts.iter().map(Mesh::aabb).collect(),
+        })
+    }
+
+    /// The prepared parts.
+    pub fn parts(&self) -> &[ExactPart] {
+        &self.parts
+    }
+}
