@@ -38,7 +38,7 @@ __all__ = [
 _FloatArray = npt.NDArray[np.float64]
 _IntArray = npt.NDArray[np.int64]
 _SurfaceName = Literal["linear", "quadric"]
-_AggregationName = Literal["max", "union", "independent"]
+_AggregationName = Literal["surface", "max", "union", "independent"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
 _SolverName = Literal["barrier", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
@@ -397,8 +397,13 @@ def collide(
         Rigid poses of the clouds (own frame to world); ``None`` is the identity.
     surface : {"quadric", "linear"}, optional
         Family of the separating surface (default ``"quadric"``).
-    aggregation : {"max", "union", "independent"}, optional
-        How per-point probabilities become ``P`` (default ``"max"``).
+    aggregation : {"surface", "max", "union", "independent"}, optional
+        How per-point probabilities become ``P`` (default ``"surface"``): the
+        largest probability that the surface around a point (the point and its 6
+        nearest neighbours, margins averaged) is on the wrong side; or the
+        paper's ``max``, ``union`` (``min(1, sum p_i)``) and ``independent``
+        (``1 - prod(1 - p_i)``) of the per-point probabilities. Only points
+        within the noise's reach of the other cloud count.
     threshold_collision : float, optional
         ``P >= threshold_collision`` is ``"collision"`` (default 0.9).
     threshold_free : float, optional

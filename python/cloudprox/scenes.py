@@ -1,227 +1,308 @@
-"""Procedural test scenes with exact geometry: a grand piano above a table in a room.
+"""Procedural scenes with exact geometry: a grand piano in a room with tables.
 
-Every part is an axis-aligned box, so the exact surface gap between any two parts
-is known in closed form (:func:`box_distance`). The point clouds are the boxes'
-surfaces sampled area-weighted with a seeded numpy generator, plus Gaussian noise
-of a chosen standard deviation. The piano is given in its own frame (origin at
-the centre of the underside of its body, z up); :meth:`Scene.piano_pose` places it
-centred above the main table with an exact gap between the body's underside and
-the table top, which is then the smallest gap between the piano and the room.
+Every object is a union of closed convex triangle meshes (boxes and cylinders,
+:class:`cloudprox.Mesh`), so exact collision, distance and penetration depth
+between two objects come from :func:`cloudprox.exact_proximity` (GJK and EPA
+through parry). Parts of one object may overlap; :meth:`SceneObject.sample`
+samples the surface of the *union* (points of a part that lie inside another part
+are dropped), area-weighted at a chosen density.
+
+The piano is given in its own frame: origin at the centre of the underside of the
+rectangular front part of its body, z up, keyboard towards -y. The room is in the
+world frame: floor top at z = 0, walls at x = +-3 m and y = +-2.5 m.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Box", "Scene", "box_distance", "build_scene", "sample_boxes"]
+from cloudprox._native import ExactShape, Mesh, exact_proximity
+
+__all__ = [
+    "Part",
+    "Scene",
+    "SceneObject",
+    "build_scene",
+    "make_pose",
+    "piano",
+    "room",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
+#: Sides of the prisms that stand for cylinders.
+CYLINDER_SEGMENTS = 48
 
-@dataclass(frozen=True)
-class Box:
-    """An axis-aligned box.
+
+def make_pose(
+    translation: npt.ArrayLike = (0.0, 0.0, 0.0),
+    rpy: npt.ArrayLike = (0.0, 0.0, 0.0),
+) -> FloatArray:
+    """A ``(4, 4)`` rigid transform from a translation and roll-pitch-yaw angles.
 
     Parameters
     ----------
+    translation : array_like, shape (3,)
+        Translation (metres).
+    rpy : array_like, shape (3,)
+        Rotations about x, then y, then z (radians): ``R = Rz(yaw) Ry(pitch) Rx(roll)``.
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+    """
+    r, p, y = (float(v) for v in np.asarray(rpy, dtype=float))
+    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
+                              math.cos(y), math.sin(y))
+    rot = np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+    pose = np.eye(4)
+    pose[:3, :3] = rot
+    pose[:3, 3] = np.asarray(translation, dtype=float)
+    return pose
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """One closed convex piece of an object.
+
+    Attributes
+    ----------
     name : str
-        Name of the part, e.g. ``"body"`` or ``"table 1 top"``.
+        E.g. ``"body"`` or ``"table 2 leg 1"``.
     group : str
-        Object the part belongs to, e.g. ``"piano"``, ``"table 1"``, ``"walls"``.
-    center : tuple of float
-        Centre ``(x, y, z)`` (metres).
-    half : tuple of float
-        Half extents ``(hx, hy, hz)`` (metres, each > 0).
+        The piece of furniture it belongs to, e.g. ``"piano"``, ``"table 2"``, ``"walls"``.
+    mesh : Mesh
+        Its exact surface, in the object's frame.
     """
 
     name: str
     group: str
-    center: tuple[float, float, float]
-    half: tuple[float, float, float]
+    mesh: Mesh
+
+    @cached_property
+    def _planes(self) -> tuple[FloatArray, FloatArray]:
+        """Unit outward face normals ``(m, 3)`` and offsets ``(m,)`` (``n . x <= c`` inside)."""
+        v, f = self.mesh.vertices, self.mesh.faces
+        n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        return n, np.einsum("ij,ij->i", n, v[f[:, 0]])
+
+    def contains(self, points: FloatArray, margin: float = 1e-9) -> npt.NDArray[np.bool_]:
+        """Whether each point ``(k, 3)`` is strictly inside (deeper than ``margin``)."""
+        n, c = self._planes
+        return np.all(points @ n.T < c - margin, axis=1)
+
+
+def _box(name: str, group: str, center: npt.ArrayLike, half: npt.ArrayLike,
+         rpy: npt.ArrayLike = (0.0, 0.0, 0.0)) -> Part:
+    h = [float(x) for x in np.asarray(half, dtype=float)]
+    return Part(name, group, Mesh.cuboid(*h).transformed(make_pose(center, rpy)))
+
+
+def _cylinder(name: str, group: str, center: npt.ArrayLike, radius: float, half_height: float) -> Part:
+    mesh = Mesh.cylinder(radius, half_height, CYLINDER_SEGMENTS)
+    return Part(name, group, mesh.transformed(make_pose(center)))
+
+
+@dataclass(frozen=True, eq=False)
+class SceneObject:
+    """An object made of convex parts, with exact queries and surface sampling.
+
+    Attributes
+    ----------
+    name : str
+        ``"piano"`` or ``"room"``.
+    parts : list of Part
+        Its parts, in the object's frame.
+    """
+
+    name: str
+    parts: list[Part] = field(default_factory=list)
+
+    @cached_property
+    def exact(self) -> ExactShape:
+        """The parts prepared for :func:`cloudprox.exact_proximity`."""
+        return ExactShape([p.mesh for p in self.parts])
 
     @property
-    def lo(self) -> FloatArray:
-        """Lower corner, shape ``(3,)``."""
-        return np.asarray(self.center) - np.asarray(self.half)
+    def groups(self) -> tuple[str, ...]:
+        """The groups of the parts, in order of first appearance."""
+        return tuple(dict.fromkeys(p.group for p in self.parts))
+
+    def bounds(self) -> tuple[FloatArray, FloatArray]:
+        """Lower and upper corners of the bounding box of all parts."""
+        lo = np.min([p.mesh.bounds()[0] for p in self.parts], axis=0)
+        hi = np.max([p.mesh.bounds()[1] for p in self.parts], axis=0)
+        return lo, hi
 
     @property
-    def hi(self) -> FloatArray:
-        """Upper corner, shape ``(3,)``."""
-        return np.asarray(self.center) + np.asarray(self.half)
+    def diagonal(self) -> float:
+        """Length of the bounding box's diagonal (metres)."""
+        lo, hi = self.bounds()
+        return float(np.linalg.norm(hi - lo))
 
-    @property
-    def area(self) -> float:
-        """Surface area (square metres)."""
-        hx, hy, hz = self.half
-        return 8.0 * (hx * hy + hx * hz + hy * hz)
+    def sample(self, density: float, seed: int = 0) -> tuple[FloatArray, FloatArray]:
+        """Sample the surface of the union of the parts, area-weighted.
 
-    def translated(self, offset: npt.ArrayLike) -> Box:
-        """Return the box moved by ``offset`` ``(3,)``."""
-        c = np.asarray(self.center, dtype=float) + np.asarray(offset, dtype=float)
-        return Box(self.name, self.group, (float(c[0]), float(c[1]), float(c[2])), self.half)
-
-    def sample_surface(self, n: int, rng: np.random.Generator) -> FloatArray:
-        """Sample the surface uniformly (each face with probability proportional to its area).
+        Each part is sampled at ``density`` points per square metre; points inside
+        another part of the object are dropped, so the density is uniform over the
+        union's surface.
 
         Parameters
         ----------
-        n : int
-            Number of points.
-        rng : numpy.random.Generator
-            Source of randomness.
+        density : float
+            Points per square metre (> 0).
+        seed : int, default 0
+            Seed of the sampling.
 
         Returns
         -------
-        ndarray, shape (n, 3)
-            Points on the surface.
+        points : ndarray, shape (k, 3)
+        normals : ndarray, shape (k, 3)
+            Unit outward normals of the points' faces.
         """
-        half = np.asarray(self.half, dtype=float)
-        # Faces: axis k at -h_k or +h_k; area of a face normal to k is 4 h_u h_v.
-        face_area = np.array([4.0 * half[(k + 1) % 3] * half[(k + 2) % 3] for k in range(3)])
-        probs = np.repeat(face_area, 2) / (2.0 * face_area.sum())
-        face = rng.choice(6, size=n, p=probs)
-        axis, sign = face // 2, np.where(face % 2 == 0, -1.0, 1.0)
-        u = rng.uniform(-1.0, 1.0, size=(n, 3)) * half
-        u[np.arange(n), axis] = sign * half[axis]
-        return np.asarray(self.center, dtype=float) + u
+        if not (math.isfinite(density) and density > 0.0):
+            raise ValueError(f"density must be finite and > 0, got {density}")
+        pts, nrm = [], []
+        for i, part in enumerate(self.parts):
+            p, n, _ = part.mesh.sample(density=density, seed=seed * 100_003 + i)
+            keep = np.ones(len(p), dtype=bool)
+            for j, other in enumerate(self.parts):
+                if j != i:
+                    keep &= ~other.contains(p)
+            pts.append(p[keep])
+            nrm.append(n[keep])
+        return np.concatenate(pts), np.concatenate(nrm)
+
+    def distances(self, other: SceneObject, pose: npt.ArrayLike | None = None) -> dict[str, float]:
+        """Exact signed distance from this object at ``pose`` to each group of ``other``.
+
+        Parameters
+        ----------
+        other : SceneObject
+            The other object (at the identity pose).
+        pose : array_like, shape (4, 4), optional
+            Pose of this object.
+
+        Returns
+        -------
+        dict of str to float
+            Group of ``other`` to the signed distance (metres; negative: minus
+            the penetration depth).
+        """
+        out: dict[str, float] = {}
+        for group in other.groups:
+            parts = ExactShape([p.mesh for p in other.parts if p.group == group])
+            out[group] = float(exact_proximity(self.exact, parts, pose)["signed_distance"])
+        return out
 
 
-def box_distance(a: Box, b: Box) -> float:
-    """Signed distance between the surfaces of two axis-aligned boxes.
+def piano() -> SceneObject:
+    """A grand piano: body (a box and a rounded tail), open lid, keyboard, three legs.
 
-    Parameters
-    ----------
-    a, b : Box
-        The boxes.
-
-    Returns
-    -------
-    float
-        The Euclidean distance between the boxes if they are disjoint; otherwise
-        minus the penetration depth (the smallest translation along an axis that
-        separates them), so 0 means touching.
+    About 1.5 m wide, 2 m deep and 1.4 m tall (bounding-box diagonal 2.9 m).
     """
-    d = np.abs(np.asarray(a.center) - np.asarray(b.center)) - (
-        np.asarray(a.half) + np.asarray(b.half)
-    )
-    if np.any(d > 0.0):
-        return float(np.linalg.norm(np.maximum(d, 0.0)))
-    return float(np.max(d))
-
-
-def sample_boxes(
-    boxes: list[Box], density: float | list[float], rng: np.random.Generator
-) -> FloatArray:
-    """Sample the surfaces of several boxes at a given density.
-
-    Parameters
-    ----------
-    boxes : list of Box
-        The boxes.
-    density : float or list of float
-        Points per square metre, one for all boxes or one per box. Each box gets
-        ``round(density * area)`` points (at least one).
-    rng : numpy.random.Generator
-        Source of randomness.
-
-    Returns
-    -------
-    ndarray, shape (n, 3)
-        The points, box after box.
-    """
-    if isinstance(density, (int, float)):
-        dens = [float(density)] * len(boxes)
-    else:
-        dens = [float(d) for d in density]
-    if len(dens) != len(boxes):
-        raise ValueError(f"{len(dens)} densities for {len(boxes)} boxes")
-    parts = [b.sample_surface(max(1, round(d * b.area)), rng) for b, d in zip(boxes, dens)]
-    return np.concatenate(parts, axis=0)
-
-
-def _piano_boxes() -> list[Box]:
-    """Make the parts of a grand piano, in its own frame (origin under the body's centre)."""
-    return [
-        Box("body", "piano", (0.0, 0.0, 0.175), (0.80, 0.75, 0.175)),
-        Box("lid", "piano", (0.0, 0.0, 0.36), (0.81, 0.76, 0.01)),
-        Box("keyboard", "piano", (0.0, -0.90, 0.10), (0.60, 0.15, 0.05)),
-        Box("leg front left", "piano", (-0.70, -0.65, -0.25), (0.04, 0.04, 0.25)),
-        Box("leg front right", "piano", (0.70, -0.65, -0.25), (0.04, 0.04, 0.25)),
-        Box("leg back", "piano", (0.0, 0.65, -0.25), (0.04, 0.04, 0.25)),
+    g = "piano"
+    parts = [
+        _box("body front", g, (0.0, -0.15, 0.175), (0.75, 0.45, 0.175)),
+        _cylinder("body tail", g, (0.0, 0.3, 0.175), 0.75, 0.175),
+        # Lid propped open 25 degrees, its left edge resting on the body.
+        _box("lid", g, (0.0, 0.05, 0.362 + 0.68 * math.sin(math.radians(25.0))),
+             (0.68, 0.78, 0.012), (0.0, math.radians(-25.0), 0.0)),
+        _box("keyboard", g, (0.0, -0.75, 0.12), (0.7, 0.15, 0.06)),
+        _cylinder("leg front left", g, (-0.62, -0.45, -0.3), 0.05, 0.3),
+        _cylinder("leg front right", g, (0.62, -0.45, -0.3), 0.05, 0.3),
+        _cylinder("leg back", g, (0.0, 0.9, -0.3), 0.05, 0.3),
+        _box("pedals", g, (0.0, -0.45, -0.5), (0.12, 0.05, 0.04)),
+        _box("lyre", g, (0.0, -0.45, -0.23), (0.02, 0.02, 0.23)),
     ]
+    return SceneObject("piano", parts)
 
 
-def _table_boxes(
-    name: str, center_xy: tuple[float, float], half_xy: tuple[float, float], height: float
-) -> list[Box]:
-    """Make a table: a 4 cm top whose upper face is at ``height``, and four 5 cm legs."""
-    x, y = center_xy
+def _table(name: str, xy: tuple[float, float], half_xy: tuple[float, float], height: float) -> list[Part]:
+    """A rectangular table: a 4 cm top whose upper face is at ``height``, four round legs."""
+    x, y = xy
     hx, hy = half_xy
-    top = Box(f"{name} top", name, (x, y, height - 0.02), (hx, hy, 0.02))
-    leg_h = (height - 0.04) / 2.0
-    legs = [
-        Box(
-            f"{name} leg {k}",
-            name,
-            (x + sx * (hx - 0.05), y + sy * (hy - 0.05), leg_h),
-            (0.025, 0.025, leg_h),
-        )
-        for k, (sx, sy) in enumerate([(-1, -1), (1, -1), (-1, 1), (1, 1)])
+    parts = [_box(f"{name} top", name, (x, y, height - 0.02), (hx, hy, 0.02))]
+    leg = (height - 0.04) / 2.0
+    for k, (sx, sy) in enumerate([(-1, -1), (1, -1), (-1, 1), (1, 1)]):
+        c = (x + sx * (hx - 0.06), y + sy * (hy - 0.06), leg)
+        parts.append(_cylinder(f"{name} leg {k}", name, c, 0.03, leg))
+    return parts
+
+
+def _round_table(name: str, xy: tuple[float, float], radius: float, height: float) -> list[Part]:
+    """A round table: a 4 cm disc top, a central column and a round foot."""
+    x, y = xy
+    return [
+        _cylinder(f"{name} top", name, (x, y, height - 0.02), radius, 0.02),
+        _cylinder(f"{name} column", name, (x, y, (height - 0.04) / 2.0), 0.05, (height - 0.04) / 2.0),
+        _cylinder(f"{name} foot", name, (x, y, 0.02), 0.3, 0.02),
     ]
-    return [top, *legs]
 
 
-def _room_boxes() -> list[Box]:
-    """Make a 6 m x 5 m x 2.6 m room (floor, four 10 cm walls) with three tables."""
+def room() -> SceneObject:
+    """A 6 m x 5 m room (floor, four walls 2.6 m high) with four tables.
+
+    ``table 1`` is a small side table (50 x 40 cm, 75 cm high) at the origin, which
+    fits between the piano's legs; ``table 2`` a desk, ``table 3`` a round table,
+    ``table 4`` a low coffee table.
+    """
     hx, hy, h, t = 3.0, 2.5, 2.6, 0.05
-    shell = [
-        Box("floor", "floor", (0.0, 0.0, -t), (hx + 2 * t, hy + 2 * t, t)),
-        Box("wall north", "walls", (0.0, hy + t, h / 2), (hx + 2 * t, t, h / 2)),
-        Box("wall south", "walls", (0.0, -hy - t, h / 2), (hx + 2 * t, t, h / 2)),
-        Box("wall east", "walls", (hx + t, 0.0, h / 2), (t, hy, h / 2)),
-        Box("wall west", "walls", (-hx - t, 0.0, h / 2), (t, hy, h / 2)),
+    parts = [
+        _box("floor", "floor", (0.0, 0.0, -t), (hx + 2 * t, hy + 2 * t, t)),
+        _box("wall north", "walls", (0.0, hy + t, h / 2), (hx + 2 * t, t, h / 2)),
+        _box("wall south", "walls", (0.0, -hy - t, h / 2), (hx + 2 * t, t, h / 2)),
+        _box("wall east", "walls", (hx + t, 0.0, h / 2), (t, hy, h / 2)),
+        _box("wall west", "walls", (-hx - t, 0.0, h / 2), (t, hy, h / 2)),
+        *_table("table 1", (0.0, 0.0), (0.25, 0.20), 0.75),
+        *_table("table 2", (1.9, 1.5), (0.60, 0.40), 0.75),
+        *_round_table("table 3", (-1.8, -1.3), 0.45, 0.72),
+        *_table("table 4", (1.6, -1.5), (0.50, 0.30), 0.45),
     ]
-    tables = [
-        *_table_boxes("table 1", (0.0, 0.0), (0.25, 0.20), 0.75),
-        *_table_boxes("table 2", (1.9, 1.5), (0.60, 0.40), 0.75),
-        *_table_boxes("table 3", (-1.8, -1.4), (0.45, 0.45), 0.45),
-    ]
-    return shell + tables
+    return SceneObject("room", parts)
 
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A piano and a room, as noisy point clouds and exact boxes.
+    """The piano and the room, with one noisy sampling of each.
 
     Attributes
     ----------
-    piano_points : ndarray, shape (n, 3)
-        Noisy piano surface points in the piano's own frame.
-    room_points : ndarray, shape (m, 3)
-        Noisy room surface points in the world frame.
-    piano_boxes : list of Box
-        The piano's parts in its own frame.
-    room_boxes : list of Box
-        The room's parts (floor, walls, tables) in the world frame.
+    piano, room : SceneObject
+        Exact geometry (piano in its own frame, room in the world frame).
+    piano_points, room_points : ndarray, shapes (n, 3) and (m, 3)
+        Noisy surface samples (piano frame, world frame).
     sigma : float
-        Standard deviation of the noise that was added (metres).
+        Standard deviation of the isotropic noise that was added (metres).
     table : str
-        Group name of the table the piano is placed above.
+        The group of the table :meth:`piano_pose` places the piano above.
     """
 
+    piano: SceneObject
+    room: SceneObject
     piano_points: FloatArray
     room_points: FloatArray
-    piano_boxes: list[Box]
-    room_boxes: list[Box]
     sigma: float
     table: str = "table 1"
-    groups: tuple[str, ...] = field(default=())
+
+    def table_top(self) -> Part:
+        """The top of :attr:`table`."""
+        return next(p for p in self.room.parts if p.name == f"{self.table} top")
 
     def piano_pose(self, gap: float) -> FloatArray:
-        """Pose that puts the piano's underside ``gap`` metres above the table top.
+        """Pose putting the piano's underside ``gap`` metres above :attr:`table`'s top.
 
         Parameters
         ----------
@@ -232,81 +313,45 @@ class Scene:
         Returns
         -------
         ndarray, shape (4, 4)
-            Homogeneous transform from the piano's frame to the world.
         """
-        top = next(b for b in self.room_boxes if b.name == f"{self.table} top")
-        pose = np.eye(4)
-        pose[:3, 3] = (top.center[0], top.center[1], float(top.hi[2]) + gap)
-        return pose
+        lo, hi = self.table_top().mesh.bounds()
+        return make_pose(((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, hi[2] + gap))
 
     def gaps(self, pose: npt.ArrayLike) -> dict[str, float]:
-        """Exact signed gap between the piano at ``pose`` and each room group.
-
-        Parameters
-        ----------
-        pose : array_like, shape (4, 4)
-            Pose of the piano; must be a pure translation (the boxes stay
-            axis-aligned).
-
-        Returns
-        -------
-        dict of str to float
-            Group name (``"floor"``, ``"walls"``, ``"table 1"``, ...) to the
-            smallest signed box distance (metres; negative = interpenetration).
-        """
-        pose = np.asarray(pose, dtype=float)
-        if not np.allclose(pose[:3, :3], np.eye(3)):
-            raise ValueError("exact gaps need a pose without rotation")
-        moved = [b.translated(pose[:3, 3]) for b in self.piano_boxes]
-        out: dict[str, float] = {}
-        for r in self.room_boxes:
-            d = min(box_distance(p, r) for p in moved)
-            out[r.group] = min(out.get(r.group, np.inf), d)
-        return out
+        """Exact signed distance between the piano at ``pose`` and each room group."""
+        return self.piano.distances(self.room, pose)
 
     def exact_gap(self, pose: npt.ArrayLike) -> float:
-        """Smallest exact signed gap between the piano at ``pose`` and the room (metres)."""
-        return min(self.gaps(pose).values())
+        """Exact signed distance between the piano at ``pose`` and the room (metres)."""
+        return float(exact_proximity(self.piano.exact, self.room.exact, pose)["signed_distance"])
 
 
-def build_scene(
-    sigma: float = 0.005, points: int = 3000, seed: int = 0, shell_ratio: float = 30.0
-) -> Scene:
-    """Build the piano-in-a-room scene.
+def build_scene(sigma: float = 0.005, points: int = 3000, seed: int = 0) -> Scene:
+    """Sample the piano and the room at one density and add isotropic noise.
 
     Parameters
     ----------
     sigma : float, default 0.005
-        Standard deviation of the isotropic Gaussian noise added to every point
-        (metres).
+        Standard deviation of the Gaussian noise added to every coordinate (metres).
     points : int, default 3000
-        Approximate number of piano points. The piano and the tables are sampled
-        at the density this gives; the floor and walls at ``shell_ratio`` times
-        less (the room has about as many points as the piano).
+        Approximate number of piano points; the room is sampled at the same density
+        (about 11 times as many points).
     seed : int, default 0
-        Seed of the numpy generator (sampling and noise).
-    shell_ratio : float, default 30
-        How much sparser the floor and walls are sampled than the furniture.
+        Seed of the sampling and the noise.
 
     Returns
     -------
     Scene
-        The clouds and the exact geometry.
     """
     if points < 10:
         raise ValueError(f"points must be >= 10, got {points}")
-    if not (np.isfinite(sigma) and sigma >= 0.0):
+    if not (math.isfinite(sigma) and sigma >= 0.0):
         raise ValueError(f"sigma must be finite and >= 0, got {sigma}")
+    p, r = piano(), room()
+    density = points / sum(part.mesh.area for part in p.parts)
+    piano_pts, _ = p.sample(density, seed)
+    room_pts, _ = r.sample(density, seed + 1)
     rng = np.random.default_rng(seed)
-    piano = _piano_boxes()
-    room = _room_boxes()
-    density = points / sum(b.area for b in piano)
-    room_density = [
-        density / shell_ratio if b.group in ("floor", "walls") else density for b in room
-    ]
-    piano_pts = sample_boxes(piano, density, rng)
-    room_pts = sample_boxes(room, room_density, rng)
     piano_pts = piano_pts + rng.normal(0.0, sigma, size=piano_pts.shape)
     room_pts = room_pts + rng.normal(0.0, sigma, size=room_pts.shape)
-    groups = tuple(dict.fromkeys(b.group for b in room))
-    return Scene(piano_pts, room_pts, piano, room, float(sigma), "table 1", groups)
+    return Scene(p, r, piano_pts, room_pts, float(sigma))

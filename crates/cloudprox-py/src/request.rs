@@ -14,7 +14,8 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::error::{invalid_input, CoreResultExt};
 
 const SURFACES: [Surface; 2] = [Surface::Linear, Surface::Quadric];
-const AGGREGATIONS: [Aggregation; 3] = [
+const AGGREGATIONS: [Aggregation; 4] = [
+    Aggregation::Surface,
     Aggregation::Max,
     Aggregation::Union,
     Aggregation::Independent,

@@ -275,7 +275,7 @@ fn refitted_cloud_answers_like_a_fresh_one() {
     let shift = Vector3::new(0.05, 0.0, 0.0);
     let moved: Vec<Point3> = a.points().iter().map(|p| p + shift).collect();
     a.set_points(moved.clone()).unwrap();
-    a.bvh().assert_well_formed(a.points(), a.sigma_max());
+    a.bvh().assert_well_formed(a.points(), a.sensor_sigma_max());
     let fresh = PointCloud::from_sigma(moved, SIGMA).unwrap();
     let req = request(Surface::Quadric);
     let pb = sphere_pose(0.05 + 2.0 * SIGMA);

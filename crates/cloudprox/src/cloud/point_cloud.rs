@@ -14,21 +14,34 @@ use crate::Real;
 /// sensor part comes from a [`NoiseModel`], the discretization part is added by
 /// [`PointCloud::with_discretization`]. The bounding volume hierarchy over the
 /// points is built on first use and shared by all queries (and threads) after.
+///
+/// The sensor part is kept on its own: it is how far noise can carry a point
+/// towards the other cloud, which decides pruning and the near region. The
+/// discretization part spreads along the surface and stands for where between
+/// the samples the surface is; there the near rule counts half a sampling
+/// spacing instead (see `query::collide`).
 #[derive(Debug)]
 pub struct PointCloud {
     points: Vec<Point3>,
     covariances: Vec<Matrix3>,
     sigma_max: Vec<Real>,
+    /// Sensor covariances when a discretization part was added (else `covariances`).
+    sensor: Option<Vec<Matrix3>>,
+    sensor_sigma_max: Vec<Real>,
     bvh_settings: BvhSettings,
     bvh: OnceLock<Bvh>,
     spacing: OnceLock<Spacing>,
 }
 
-/// Sampling spacing per point and its maximum per hierarchy node.
+/// Sampling spacing per point, its maximum per hierarchy node, and each point's
+/// nearest neighbours.
 #[derive(Debug, Clone)]
 struct Spacing {
     per_point: Vec<Real>,
     per_node: Vec<Real>,
+    /// `k` neighbour indices per point (`k = min(6, n - 1)`), nearest first.
+    neighbours: Vec<u32>,
+    k: usize,
 }
 
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
@@ -48,6 +61,8 @@ impl Clone for PointCloud {
             points: self.points.clone(),
             covariances: self.covariances.clone(),
             sigma_max: self.sigma_max.clone(),
+            sensor: self.sensor.clone(),
+            sensor_sigma_max: self.sensor_sigma_max.clone(),
             bvh_settings: self.bvh_settings,
             bvh,
             spacing,
@@ -96,11 +111,13 @@ impl PointCloud {
     }
 
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
-        let sigma_max = covariances.iter().map(max_std).collect();
+        let sigma_max: Vec<Real> = covariances.iter().map(max_std).collect();
         Self {
             points,
             covariances,
+            sensor_sigma_max: sigma_max.clone(),
             sigma_max,
+            sensor: None,
             bvh_settings: BvhSettings::default(),
             bvh: OnceLock::new(),
             spacing: OnceLock::new(),
@@ -110,15 +127,19 @@ impl PointCloud {
     /// Adds the k-nearest-neighbour discretization covariance to every point's
     /// covariance (see [`discretization_covariances`]).
     pub fn with_discretization(mut self, settings: &DiscretizationSettings) -> Result<Self> {
-        let disc =
-            discretization_covariances(&self.points, &self.covariances, self.bvh(), settings)?;
+        let disc = discretization_covariances(
+            &self.points,
+            self.sensor_covariances(),
+            self.bvh(),
+            settings,
+        )?;
+        if self.sensor.is_none() {
+            self.sensor = Some(self.covariances.clone());
+        }
         for (c, d) in self.covariances.iter_mut().zip(disc) {
             *c += d;
         }
         self.sigma_max = self.covariances.iter().map(max_std).collect();
-        if let Some(bvh) = self.bvh.get_mut() {
-            bvh.refit(&self.points, &self.sigma_max)?;
-        }
         Ok(self)
     }
 
@@ -147,10 +168,21 @@ impl PointCloud {
         &self.sigma_max
     }
 
+    /// Per-point sensor covariances (the total without the discretization part).
+    pub fn sensor_covariances(&self) -> &[Matrix3] {
+        self.sensor.as_deref().unwrap_or(&self.covariances)
+    }
+
+    /// Per-point largest sensor standard deviation: what the hierarchy's pruning
+    /// and the near rule use.
+    pub fn sensor_sigma_max(&self) -> &[Real] {
+        &self.sensor_sigma_max
+    }
+
     /// The hierarchy over the points, built on first call.
     pub fn bvh(&self) -> &Bvh {
         self.bvh.get_or_init(|| {
-            Bvh::build(&self.points, &self.sigma_max, &self.bvh_settings)
+            Bvh::build(&self.points, &self.sensor_sigma_max, &self.bvh_settings)
                 .expect("a validated non-empty cloud always has a hierarchy")
         })
     }
@@ -160,6 +192,13 @@ impl PointCloud {
     /// their farthest point). Computed on first call.
     pub fn spacing(&self) -> &[Real] {
         &self.spacing_data().per_point
+    }
+
+    /// The nearest neighbours of point `i` in the cloud (up to 6, nearest
+    /// first; the ones behind [`PointCloud::spacing`]). Computed on first call.
+    pub fn neighbours(&self, i: usize) -> &[u32] {
+        let s = self.spacing_data();
+        &s.neighbours[i * s.k..(i + 1) * s.k]
     }
 
     /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].
@@ -173,11 +212,22 @@ impl PointCloud {
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
             let mut ws = crate::bvh::BvhWorkspace::default();
             let mut nn = Vec::with_capacity(k + 1);
+            let mut neighbours = Vec::with_capacity(k * self.points.len());
             let per_point: Vec<Real> = self
                 .points
                 .iter()
-                .map(|p| {
+                .enumerate()
+                .map(|(i, p)| {
                     bvh.nearest_k(&self.points, p, k + 1, &mut ws, &mut nn);
+                    // The point itself is among the k + 1 (first, unless duplicated).
+                    let own = nn.iter().position(|&(_, j)| j as usize == i).unwrap_or(k);
+                    neighbours.extend(
+                        nn.iter()
+                            .enumerate()
+                            .filter(|&(m, _)| m != own)
+                            .take(k)
+                            .map(|(_, &(_, j))| j),
+                    );
                     nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
                 })
                 .collect();
@@ -185,6 +235,8 @@ impl PointCloud {
             Spacing {
                 per_point,
                 per_node,
+                neighbours,
+                k,
             }
         })
     }
@@ -211,7 +263,7 @@ impl PointCloud {
         validate_points(&points)?;
         self.points = points;
         if let Some(bvh) = self.bvh.get_mut() {
-            bvh.refit(&self.points, &self.sigma_max)?;
+            bvh.refit(&self.points, &self.sensor_sigma_max)?;
         }
         self.spacing = OnceLock::new();
         Ok(())
@@ -225,7 +277,11 @@ impl PointCloud {
         for p in &mut self.points {
             *p = pose * *p;
         }
-        for c in &mut self.covariances {
+        for c in self
+            .covariances
+            .iter_mut()
+            .chain(self.sensor.iter_mut().flatten())
+        {
             *c = r * *c * r.transpose();
         }
         self.bvh = OnceLock::new();

@@ -4,13 +4,24 @@ use crate::Real;
 
 /// How the per-point probabilities `p_i` become the pair's `P`.
 ///
-/// All three are driven by the noisiest single point; they differ in how much the
-/// other points add.
+/// `Max`, `Union` and `Independent` (the paper's) are driven by the noisiest
+/// single point; they differ in how much the other points add. `Surface` asks
+/// where the sampled *surfaces* are, from each point's neighbourhood.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Aggregation {
+    /// `P = max_i q_i` with `q_i` the probability that the *surface* around point
+    /// `i` lies on the wrong side: the margins `c_j f(x_j)` of the point and its 6
+    /// nearest neighbours in its cloud are averaged, with the standard deviation
+    /// of that mean (`sqrt(sum_j s_j^2) / 7`, `s_j = sqrt(grad^T Sigma_j grad)`),
+    /// so `q_i = Phi(-mean / sd)` ([`surface_probability`]). A surface is located
+    /// far better than one sample's noise; the worst single sample is not the
+    /// surface. The default: on the piano-in-room evaluation against exact ground
+    /// truth (`cloudprox reproduce`) it decides more poses, and more of them
+    /// correctly, than `Max` at every noise level.
+    #[default]
+    Surface,
     /// `P = max_i p_i`: the probability that the single most doubtful point is on
     /// the wrong side. What the first implementation of the method (FCL) reported.
-    #[default]
     Max,
     /// `P = min(1, sum_i p_i)`: the union (Boole) bound on the probability that any
     /// point is on the wrong side, valid whatever the correlation between points. A
@@ -22,11 +33,12 @@ pub enum Aggregation {
 }
 
 impl Aggregation {
-    /// Aggregates `probabilities` (an empty slice gives 0).
+    /// Aggregates `probabilities` (an empty slice gives 0); for `Surface`, the
+    /// surface probabilities `q_i` (their maximum).
     pub fn aggregate<I: IntoIterator<Item = Real>>(self, probabilities: I) -> Real {
         let it = probabilities.into_iter();
         match self {
-            Aggregation::Max => it.fold(0.0, Real::max),
+            Aggregation::Max | Aggregation::Surface => it.fold(0.0, Real::max),
             Aggregation::Union => it.sum::<Real>().min(1.0),
             Aggregation::Independent => {
                 // sum of log(1 - p), with ln_1p for accuracy at small p.
@@ -36,9 +48,10 @@ impl Aggregation {
         }
     }
 
-    /// Parses `"max"`, `"union"` or `"independent"`.
+    /// Parses `"surface"`, `"max"`, `"union"` or `"independent"`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
+            "surface" => Some(Aggregation::Surface),
             "max" => Some(Aggregation::Max),
             "union" => Some(Aggregation::Union),
             "independent" => Some(Aggregation::Independent),
@@ -49,6 +62,7 @@ impl Aggregation {
     /// The lowercase name, as [`Aggregation::from_name`] reads it.
     pub fn name(self) -> &'static str {
         match self {
+            Aggregation::Surface => "surface",
             Aggregation::Max => "max",
             Aggregation::Union => "union",
             Aggregation::Independent => "independent",
@@ -69,16 +83,57 @@ mod tests {
         assert!((Aggregation::Independent.aggregate(p) - ind).abs() < 1e-15);
         assert_eq!(Aggregation::Union.aggregate([0.7, 0.8]), 1.0);
         assert_eq!(Aggregation::Independent.aggregate([1.0, 0.3]), 1.0);
+        assert_eq!(Aggregation::Surface.aggregate(p), 0.2);
         for a in [
+            Aggregation::Surface,
             Aggregation::Max,
             Aggregation::Union,
             Aggregation::Independent,
         ] {
             assert_eq!(a.aggregate(std::iter::empty()), 0.0);
             assert_eq!(Aggregation::from_name(a.name()), Some(a));
-            // max <= independent <= union
+            // max <= independent <= union (surface aggregates other inputs)
             assert!(Aggregation::Max.aggregate(p) <= a.aggregate(p) + 1e-15);
             assert!(a.aggregate(p) <= Aggregation::Union.aggregate(p) + 1e-15);
         }
+    }
+}
+
+/// The probability that the surface around a point lies on the wrong side, from
+/// the margins `c_j f(x_j)` and standard deviations `s_j` along the gradient of
+/// the point and its neighbours: `Phi(-mean(m) / (sqrt(sum s_j^2) / n))`, the
+/// noise of the points taken as independent. Exact (0 or 1) when every `s_j` is 0.
+pub fn surface_probability(margins: &[Real], stds: &[Real]) -> Real {
+    let n = margins.len() as Real;
+    if margins.is_empty() {
+        return 0.0;
+    }
+    let mean = margins.iter().sum::<Real>() / n;
+    let sd = stds.iter().map(|s| s * s).sum::<Real>().sqrt() / n;
+    if sd > 0.0 && sd.is_finite() {
+        crate::probability::normal_cdf(-mean / sd)
+    } else if mean > 0.0 {
+        0.0
+    } else {
+        1.0
+    }
+}
+
+#[cfg(test)]
+mod surface_tests {
+    use super::*;
+    use crate::probability::normal_cdf;
+
+    #[test]
+    fn surface_probability_shrinks_with_the_neighbourhood() {
+        // Seven points all 1 sigma on the right side: the mean is known to
+        // sigma / sqrt(7), so the surface is sqrt(7) sigma clear.
+        let p = surface_probability(&[1.0; 7], &[1.0; 7]);
+        assert!((p - normal_cdf(-(7f64).sqrt())).abs() < 1e-15);
+        // One point alone is Eq. 3.
+        assert!((surface_probability(&[0.5], &[2.0]) - normal_cdf(-0.25)).abs() < 1e-15);
+        assert_eq!(surface_probability(&[0.1, 0.2], &[0.0, 0.0]), 0.0);
+        assert_eq!(surface_probability(&[-0.1, 0.0], &[0.0, 0.0]), 1.0);
+        assert_eq!(surface_probability(&[], &[]), 0.0);
     }
 }

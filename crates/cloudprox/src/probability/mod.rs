@@ -2,6 +2,7 @@
 //!
 //! - [`point_probability`]: the paper's Eq. 3 for one point;
 //! - [`Aggregation`]: how per-point probabilities become the pair's `P`;
+//! - [`surface_probability`]: the same for the surface around a point;
 //! - [`Thresholds`] and [`CollisionState`]: the decision `free` / `contact` / `collision`.
 
 mod aggregation;
@@ -9,7 +10,7 @@ mod gaussian;
 mod point;
 mod state;
 
-pub use aggregation::Aggregation;
+pub use aggregation::{surface_probability, Aggregation};
 pub use gaussian::{normal_cdf, normal_quantile};
 pub use point::point_probability;
 pub use state::{CollisionState, Thresholds};

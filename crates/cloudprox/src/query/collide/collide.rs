@@ -3,15 +3,16 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{train, Classification, SocpSolver, SolveStatus};
+use crate::classify::{train, Classification, Separator, SocpSolver, SolveStatus};
 use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
-use crate::probability::point_probability;
+use crate::probability::{point_probability, surface_probability, Aggregation};
 use crate::query::collide::region::{
     cut, near_points, near_points_brute_force, near_regions, split_patches, Patch, SAMPLING_MARGIN,
 };
 use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
+use crate::uncertainty::directional_std_of;
 use crate::Real;
 
 /// The probabilistic collision query between cloud `a` at world pose `pose_a` and
@@ -127,6 +128,9 @@ pub(crate) fn collide_with_workspace(
 
     let mut probabilities_a = vec![0.0; a.len()];
     let mut probabilities_b = vec![0.0; b.len()];
+    // What the aggregation reads per point: p_i, or the surface probability q_i.
+    let mut inputs_a = vec![0.0; a.len()];
+    let mut inputs_b = vec![0.0; b.len()];
     let mut regions = Vec::new();
     for component in components {
         let (pa, ca) = in_frame(&rel, a, &component.a);
@@ -178,6 +182,31 @@ pub(crate) fn collide_with_workspace(
             for (&i, &p) in ib.iter().zip(&fit.probabilities[na..]) {
                 probabilities_b[i as usize] = p;
             }
+            let sep = &fit.classification.separator;
+            let (qa, qb) = if request.aggregation == Aggregation::Surface {
+                (
+                    surface_probabilities(sep, &pts[..na], &covs[..na], 1.0),
+                    surface_probabilities(sep, &pts[na..], &covs[na..], -1.0),
+                )
+            } else {
+                (
+                    fit.probabilities[..na].to_vec(),
+                    fit.probabilities[na..].to_vec(),
+                )
+            };
+            for (&i, &q) in ia.iter().zip(&qa) {
+                inputs_a[i as usize] = q;
+            }
+            for (&i, &q) in ib.iter().zip(&qb) {
+                inputs_b[i as usize] = q;
+            }
+            let patch_probability = request.aggregation.aggregate(
+                ia.iter()
+                    .zip(&qa)
+                    .filter(|(&i, _)| core.0[i as usize])
+                    .chain(ib.iter().zip(&qb).filter(|(&i, _)| core.1[i as usize]))
+                    .map(|(_, &q)| q),
+            );
             stats.points_classified += pts.len();
             stats.solver_iterations += u64::from(fit.classification.iterations);
             stats.barrier_fallbacks += usize::from(
@@ -195,9 +224,7 @@ pub(crate) fn collide_with_workspace(
                 point: pose_b * fit.point,
                 normal: pose_b.rotation * fit.normal,
                 separation: fit.separation,
-                probability: request
-                    .aggregation
-                    .aggregate(fit.probabilities.iter().copied()),
+                probability: patch_probability,
                 surface: separator.surface,
                 separator,
                 status: fit.classification.status,
@@ -206,9 +233,22 @@ pub(crate) fn collide_with_workspace(
         }
     }
     stats.patches = regions.len();
-    let probability = request
-        .aggregation
-        .aggregate(probabilities_a.iter().chain(&probabilities_b).copied());
+    // Only core points count: a context point is beyond the noise's reach of the
+    // other cloud, so the surface putting it on the wrong side is the surface's
+    // misfit, not evidence of a collision.
+    let counted = |inputs: &[Real], core: &[bool]| -> Vec<Real> {
+        inputs
+            .iter()
+            .zip(core)
+            .filter(|(_, &c)| c)
+            .map(|(&p, _)| p)
+            .collect()
+    };
+    let probability = request.aggregation.aggregate(
+        counted(&inputs_a, &core.0)
+            .into_iter()
+            .chain(counted(&inputs_b, &core.1)),
+    );
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,
@@ -218,6 +258,51 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
+}
+
+/// Neighbours behind a surface probability: the point and its 6 nearest.
+const SURFACE_NEIGHBOURS: usize = 7;
+
+/// The surface probability `q_i` ([`surface_probability`]) of each of one side's
+/// points of a patch (`pts`, `covs` in the separator's frame, label `label`),
+/// from the point and its nearest neighbours among that side's patch points
+/// (neighbours beyond the patch belong to surfaces the separator was not
+/// fitted to, e.g. the far face of a thin plate).
+fn surface_probabilities(
+    sep: &Separator,
+    pts: &[Point3],
+    covs: &[Matrix3],
+    label: Real,
+) -> Vec<Real> {
+    let (margins, stds): (Vec<Real>, Vec<Real>) = pts
+        .iter()
+        .zip(covs)
+        .map(|(x, c)| {
+            let (f, g) = sep.value_and_gradient_local(x);
+            (label * f, directional_std_of(c, &g))
+        })
+        .unzip();
+    let k = SURFACE_NEIGHBOURS.min(pts.len());
+    let mut by_distance: Vec<(Real, usize)> = Vec::with_capacity(pts.len());
+    let (mut m, mut s) = (Vec::with_capacity(k), Vec::with_capacity(k));
+    pts.iter()
+        .map(|x| {
+            by_distance.clear();
+            by_distance.extend(
+                pts.iter()
+                    .enumerate()
+                    .map(|(j, y)| ((x - y).norm_squared(), j)),
+            );
+            by_distance.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+            m.clear();
+            s.clear();
+            for &(_, j) in &by_distance[..k] {
+                m.push(margins[j]);
+                s.push(stds[j]);
+            }
+            surface_probability(&m, &s)
+        })
+        .collect()
 }
 
 /// Patches are cut on a misfit only while both halves keep this many points of

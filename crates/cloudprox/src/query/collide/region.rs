@@ -25,19 +25,46 @@ pub const SAMPLING_MARGIN: Real = 0.5;
 
 /// The near rule for points `x_i`, `x_j` at distance `d`, with `h` the larger
 /// of their sampling spacings: near when the noise reaches across the distance
-/// less half a spacing, `prune_bound(max(0, d - h/2), sigma_i, sigma_j, 2) >=
-/// epsilon` (sampled surfaces can meet between samples), or, as context, when
+/// less half a spacing, `prune_bound(max(0, d - h/2), s_i, s_j, 2) >= epsilon`
+/// (sampled surfaces can meet between samples), or, as context, when
 /// `d <= context * h`: the classifier sees at least `context` spacings of
 /// surface around the contact, which matters where the sampling is sparse
 /// against the noise, and adds nothing where the noise's reach is wider.
 ///
-/// The bound is evaluated through its inverse, `max(0, d - h/2) <= (sigma_i +
-/// sigma_j) k` with `k = Phi^-1(1 - epsilon / 2)` ([`NearRule::new`]), so no
+/// `s_i = sqrt(u^T Sigma_i u)` is point `i`'s *sensor* standard deviation along
+/// the line `u` joining the two points (the noise that can carry one towards the
+/// other). The discretization part of the covariance is left out: it spreads
+/// along the surface and stands for where between the samples the surface is,
+/// which the half spacing already covers; counting it across the gap made every
+/// region as wide as the sampling is sparse (measured: near regions of 400-1000
+/// points and 31% false collisions beyond 3 sigma on the piano scene at 5 cm
+/// spacing, 1.45 cm noise). The hierarchy prunes with the largest sensor
+/// standard deviations (a superset).
+///
+/// The bound is evaluated through its inverse, `max(0, d - h/2) <= (s_i + s_j)
+/// k` with `k = Phi^-1(1 - epsilon / 2)` ([`NearRule::new`]), so no
 /// transcendental function runs per pair.
 #[derive(Debug, Clone, Copy)]
 struct NearRule {
     k: Real,
     context: Real,
+}
+
+/// One point's side of a pair test: position (B's frame), spacing, largest
+/// standard deviation, covariance and the rotation of its cloud's frame into B's.
+struct PointNoise<'a> {
+    x: Point3,
+    spacing: Real,
+    sigma_max: Real,
+    cov: &'a Matrix3,
+    to_own_frame: &'a Matrix3,
+}
+
+impl PointNoise<'_> {
+    fn std_along(&self, u: &Vector3) -> Real {
+        let v = self.to_own_frame * u;
+        v.dot(&(self.cov * v)).max(0.0).sqrt()
+    }
 }
 
 impl NearRule {
@@ -48,9 +75,19 @@ impl NearRule {
         }
     }
 
-    fn is_near(&self, xi: &Point3, xj: &Point3, h: Real, si: Real, sj: Real) -> bool {
-        let d = (xi - xj).norm();
-        d <= self.context * h || (d - SAMPLING_MARGIN * h).max(0.0) <= (si + sj) * self.k
+    fn is_near(&self, i: &PointNoise<'_>, j: &PointNoise<'_>) -> bool {
+        let diff = j.x - i.x;
+        let d = diff.norm();
+        let h = i.spacing.max(j.spacing);
+        if d <= self.context * h {
+            return true;
+        }
+        let gap = (d - SAMPLING_MARGIN * h).max(0.0);
+        if gap > (i.sigma_max + j.sigma_max) * self.k {
+            return false;
+        }
+        let u = diff / d;
+        gap <= (i.std_along(&u) + j.std_along(&u)) * self.k
     }
 }
 
@@ -99,19 +136,36 @@ fn near_points_in_blocks<'a>(
     rule: NearRule,
 ) -> (Vec<bool>, Vec<bool>) {
     let (sp_a, sp_b) = (a.spacing(), b.spacing());
-    let (sg_a, sg_b) = (a.sigma_max(), b.sigma_max());
+    let (sg_a, sg_b) = (a.sensor_sigma_max(), b.sensor_sigma_max());
+    let (cov_a, cov_b) = (a.sensor_covariances(), b.sensor_covariances());
+    // Directions in B's frame, rotated into A's own frame for A's covariances.
+    let b_to_a: Matrix3 = rel.rotation.inverse().to_rotation_matrix().into_inner();
+    let identity = Matrix3::identity();
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     for (block_a, block_b) in blocks {
         for &i in block_a {
             let i = i as usize;
-            let xi = rel * a.points()[i];
+            let pi = PointNoise {
+                x: rel * a.points()[i],
+                spacing: sp_a[i],
+                sigma_max: sg_a[i],
+                cov: &cov_a[i],
+                to_own_frame: &b_to_a,
+            };
             for &j in block_b {
                 let j = j as usize;
                 if near_a[i] && near_b[j] {
                     continue;
                 }
-                if rule.is_near(&xi, &b.points()[j], sp_a[i].max(sp_b[j]), sg_a[i], sg_b[j]) {
+                let pj = PointNoise {
+                    x: b.points()[j],
+                    spacing: sp_b[j],
+                    sigma_max: sg_b[j],
+                    cov: &cov_b[j],
+                    to_own_frame: &identity,
+                };
+                if rule.is_near(&pi, &pj) {
                     near_a[i] = true;
                     near_b[j] = true;
                 }

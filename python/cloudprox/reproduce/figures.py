@@ -1,0 +1,85 @@
+"""The reproduction's pictures (matplotlib's Agg canvas, no pyplot state)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from cloudprox.reproduce.metrics import NEAR_SIGMA, Metrics, roc_curve
+
+__all__ = ["plot_flip_rates", "plot_probability_vs_distance", "plot_roc"]
+
+
+def _figure(width: float, height: float):  # type: ignore[no-untyped-def]
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def plot_probability_vs_distance(
+    panels: list[tuple[str, float, npt.NDArray[np.float64], dict[str, npt.NDArray[np.float64]]]],
+    path: Path,
+) -> None:
+    """The paper's Fig. 2 made real: score against exact signed distance, one panel per level.
+
+    ``panels`` holds ``(title, sigma, signed_distance (m,), {method: score (draws, m)})``.
+    """
+    fig = _figure(5.0 * len(panels), 4.2)
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
+    colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+    for ax, (title, sigma, dist, scores) in zip(axes, panels):
+        for (name, s), c in zip(scores.items(), colors):
+            x = np.broadcast_to(dist / sigma, s.shape).ravel()
+            ax.scatter(x, s.ravel(), s=7, alpha=0.5, color=c, label=name, linewidths=0)
+        ax.axvline(0.0, color="k", lw=0.8)
+        ax.axhspan(0.1, 0.9, color="0.9", zorder=0, label="contact band (0.1-0.9)")
+        ax.set_xlabel("exact signed distance / sigma (negative: penetration)")
+        ax.set_ylabel("collision probability P")
+        ax.set_title(title)
+        ax.set_xlim(-4.0, 12.0)
+        ax.legend(fontsize=7, loc="upper right")
+    fig.savefig(path, dpi=120)
+
+
+def plot_flip_rates(levels: list[str], flips: dict[str, list[float]], path: Path) -> None:
+    """Hard-flip rate (free <-> collision under fresh noise) against noise level, per method."""
+    fig = _figure(6.5, 4.0)
+    ax = fig.subplots()
+    x = np.arange(len(levels))
+    width = 0.8 / max(1, len(flips))
+    for k, (name, values) in enumerate(flips.items()):
+        ax.bar(x + k * width - 0.4 + width / 2, values, width, label=name)
+    ax.set_xticks(x, levels)
+    ax.set_xlabel("noise level (share of the piano's bounding-box diagonal)")
+    ax.set_ylabel("hard-flip rate")
+    ax.legend(fontsize=7)
+    fig.savefig(path, dpi=120)
+
+
+def plot_roc(
+    panels: list[tuple[str, npt.NDArray[np.float64], dict[str, npt.NDArray[np.float64]]]],
+    metrics: dict[tuple[str, str], Metrics],
+    path: Path,
+) -> None:
+    """ROC curves over the near queries (|exact distance| <= 5 sigma), one panel per level.
+
+    ``panels`` holds ``(level, near-query labels (m,), {method: score (draws, m)})``.
+    """
+    fig = _figure(5.0 * len(panels), 4.5)
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
+    for ax, (level, label, scores) in zip(axes, panels):
+        for name, s in scores.items():
+            y = np.broadcast_to(label, s.shape).ravel()
+            fpr, tpr = roc_curve(s.ravel(), y)
+            ax.plot(fpr, tpr, label=f"{name} (AUC {metrics[(level, name)].auc_near:.3f})")
+        ax.plot([0, 1], [0, 1], color="0.6", lw=0.8, ls="--")
+        ax.set_xlabel("false-positive rate")
+        ax.set_ylabel("true-positive rate")
+        ax.set_title(f"near queries (|d| <= {NEAR_SIGMA:g} sigma), noise {level}")
+        ax.legend(fontsize=7, loc="lower right")
+    fig.savefig(path, dpi=120)

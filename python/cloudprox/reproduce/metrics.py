@@ -1,0 +1,125 @@
+"""Metrics of one method at one noise level, against the exact ground truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.stats import rankdata, spearmanr
+
+__all__ = ["Metrics", "auc", "compute_metrics", "roc_curve"]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Exact separation (in sigma) within which a query counts as near contact.
+NEAR_SIGMA = 5.0
+#: Exact distance / penetration (in sigma) beyond which a wrong state is a hard error.
+HARD_SIGMA = 3.0
+
+
+def auc(score: FloatArray, label: npt.NDArray[np.bool_]) -> float:
+    """ROC AUC (Mann-Whitney, ties count one half); NaN if one class is missing."""
+    pos, neg = int(label.sum()), int((~label).sum())
+    if pos == 0 or neg == 0:
+        return float("nan")
+    ranks = rankdata(score)
+    return float((ranks[label].sum() - pos * (pos + 1) / 2.0) / (pos * neg))
+
+
+def roc_curve(score: FloatArray, label: npt.NDArray[np.bool_]) -> tuple[FloatArray, FloatArray]:
+    """False- and true-positive rates over every threshold (from strictest)."""
+    order = np.argsort(-score, kind="stable")
+    s, y = score[order], label[order]
+    distinct = np.r_[np.nonzero(np.diff(s))[0], len(s) - 1]
+    tp = np.cumsum(y)[distinct]
+    fp = np.cumsum(~y)[distinct]
+    tpr = np.r_[0.0, tp / max(1, int(y.sum()))]
+    fpr = np.r_[0.0, fp / max(1, int((~y).sum()))]
+    return fpr, tpr
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Every metric of one method at one level (see the module's docs for each).
+
+    Attributes
+    ----------
+    auc_all, auc_near : float
+        ROC AUC against the exact label, over all queries and over the near ones.
+    spearman : float
+        Spearman correlation of the score with minus the exact signed distance
+        (1 = perfect ordering).
+    decided_accuracy : float
+        Share of correct states among ``free`` and ``collision`` answers.
+    undecided : float
+        Share of ``contact`` answers.
+    hard_flip : float
+        Share of poses whose state is ``free`` under one noise draw and
+        ``collision`` under the other.
+    false_positive_3s : float
+        Share of ``collision`` answers among poses farther than 3 sigma.
+    false_negative_3s : float
+        Share of ``free`` answers among poses penetrating deeper than 3 sigma.
+    median_ms : float
+        Median time per query (milliseconds).
+    n : int
+        Number of answers (poses times draws).
+    """
+
+    auc_all: float
+    auc_near: float
+    spearman: float
+    decided_accuracy: float
+    undecided: float
+    hard_flip: float
+    false_positive_3s: float
+    false_negative_3s: float
+    median_ms: float
+    n: int
+
+
+def _share(mask: npt.NDArray[np.bool_], among: npt.NDArray[np.bool_]) -> float:
+    k = int(among.sum())
+    return float((mask & among).sum() / k) if k else float("nan")
+
+
+def compute_metrics(
+    score: FloatArray,
+    state: npt.NDArray[np.str_],
+    seconds: FloatArray,
+    signed_distance: FloatArray,
+    sigma: float,
+) -> Metrics:
+    """Metrics of answers of shape ``(draws, poses)`` against exact distances ``(poses,)``.
+
+    The label is ``signed_distance <= 0`` (exact contact counts as collision).
+    """
+    draws = score.shape[0]
+    d = np.broadcast_to(signed_distance, score.shape).ravel()
+    s, st = score.ravel(), state.ravel()
+    label = d <= 0.0
+    near = np.abs(d) <= NEAR_SIGMA * sigma
+    decided = st != "contact"
+    correct = (st == "collision") == label
+    rho = spearmanr(s, -d).statistic if np.ptp(s) > 0 else float("nan")
+    flips = (
+        np.mean(
+            ((state[0] == "free") & (state[1] == "collision"))
+            | ((state[0] == "collision") & (state[1] == "free"))
+        )
+        if draws >= 2
+        else float("nan")
+    )
+    return Metrics(
+        auc_all=auc(s, label),
+        auc_near=auc(s[near], label[near]),
+        spearman=float(rho),
+        decided_accuracy=_share(correct, decided),
+        undecided=float(np.mean(~decided)),
+        hard_flip=float(flips),
+        false_positive_3s=_share(st == "collision", d > HARD_SIGMA * sigma),
+        false_negative_3s=_share(st == "free", d < -HARD_SIGMA * sigma),
+        median_ms=float(np.median(seconds) * 1e3),
+        n=int(s.size),
+    )
