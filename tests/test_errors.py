@@ -111,7 +111,7 @@ def bad_last_row() -> np.ndarray:
         ({"surface": "cubic"}, r"unknown surface 'cubic'; valid names: 'linear', 'quadric'"),
         (
             {"aggregation": "mean"},
-            r"unknown aggregation 'mean'; valid names: 'max', 'union', 'independent'",
+            r"unknown aggregation 'mean'; valid names: 'surface', 'max', 'union', 'independent'",
         ),
         (
             {"robust_model": "student"},

@@ -3,54 +3,79 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cloudprox.scenes import Box, box_distance, build_scene, sample_boxes
+import cloudprox
+from cloudprox.scenes import build_scene, make_pose, piano, room
 
 
-def test_box_distance_cases() -> None:
-    a = Box("a", "g", (0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
-    # Face to face along x, 0.5 apart.
-    assert box_distance(a, Box("b", "g", (2.5, 0.0, 0.0), (1.0, 1.0, 1.0))) == pytest.approx(0.5)
-    # Edge to edge: 3-4-5 triangle.
-    b = Box("b", "g", (2.0 + 0.3, 2.0 + 0.4, 0.0), (1.0, 1.0, 1.0))
-    assert box_distance(a, b) == pytest.approx(0.5)
-    # Touching and overlapping: minus the smallest overlap along an axis.
-    assert box_distance(a, Box("b", "g", (2.0, 0.0, 0.0), (1.0, 1.0, 1.0))) == pytest.approx(0.0)
-    assert box_distance(a, Box("b", "g", (1.9, 0.5, 0.0), (1.0, 1.0, 1.0))) == pytest.approx(-0.1)
-    assert box_distance(a, Box("b", "g", (0.0, 0.0, 0.0), (0.5, 0.5, 0.5))) == pytest.approx(-1.5)
-    assert box_distance(a, b) == box_distance(b, a)
+def test_meshes_and_exact_queries_from_python() -> None:
+    cube = cloudprox.Mesh.cuboid(0.1, 0.1, 0.1)
+    assert cube.area == pytest.approx(0.24) and cube.volume == pytest.approx(0.008)
+    assert cube.is_closed and cube.is_convex()
+    pts, normals, faces = cube.sample(500, seed=1)
+    assert pts.shape == (500, 3) and normals.shape == (500, 3) and faces.shape == (500,)
+    assert np.allclose(np.max(np.abs(pts), axis=1), 0.1)
+    shape = cloudprox.ExactShape([cube])
+    assert shape.part_kinds == ["convex"]
+    r = cloudprox.exact_proximity(shape, shape, None, make_pose((0.5, 0.0, 0.0)))
+    assert not r["intersecting"] and r["distance"] == pytest.approx(0.3)
+    # (Offset sideways a little: EPA misjudges the depth of two boxes whose faces
+    # are exactly coplanar.)
+    many = cloudprox.exact_proximity_many(
+        shape, shape, np.stack([make_pose((x, 0.001, 0.002)) for x in (0.15, 0.25)])
+    )
+    assert list(many["intersecting"]) == [True, False]
+    assert many["signed_distance"] == pytest.approx([-0.05, 0.05])
+    with pytest.raises(cloudprox.InvalidInputError, match="refers to vertex 5"):
+        cloudprox.Mesh(np.eye(3), [[0, 1, 5]])
+    with pytest.raises(cloudprox.InvalidInputError, match="faces must be integers"):
+        cloudprox.Mesh(np.eye(3), [[0.0, 1.0, 2.0]])
+    with pytest.raises(cloudprox.InvalidInputError, match="shape \\(m, 3\\)"):
+        cloudprox.Mesh(np.eye(3), [0, 1, 2])
+    with pytest.raises(cloudprox.InvalidInputError, match="exactly one of n and density"):
+        cube.sample()
 
 
-def test_box_sampling_is_on_the_surface_and_area_weighted() -> None:
-    box = Box("slab", "g", (1.0, 2.0, 3.0), (0.5, 0.25, 0.01))
-    rng = np.random.default_rng(0)
-    pts = box.sample_surface(4000, rng)
-    d = np.abs(pts - box.center)
-    assert np.all(d <= np.asarray(box.half) + 1e-12)
-    on = np.isclose(d, box.half)
-    assert np.all(on.any(axis=1))
-    # The two big faces hold 0.5 * 0.25 / (0.5 * 0.25 + 0.5 * 0.01 + 0.25 * 0.01) of the area.
-    big = on[:, 2].mean()
-    assert big == pytest.approx(0.125 / 0.1325, abs=0.02)
-    assert box.area == pytest.approx(8 * 0.1325)
-    both = sample_boxes([box, box.translated([1.0, 0.0, 0.0])], 1000.0, rng)
-    assert len(both) == 2 * round(1000.0 * box.area)
+def test_make_pose_is_rigid_and_composes_rpy() -> None:
+    t = make_pose((1.0, 2.0, 3.0), (0.3, -0.2, 1.1))
+    assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3))
+    assert np.linalg.det(t[:3, :3]) == pytest.approx(1.0)
+    yaw = make_pose((0, 0, 0), (0, 0, np.pi / 2))
+    assert np.allclose(yaw[:3, :3] @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+
+
+def test_union_sampling_stays_on_the_union_surface() -> None:
+    p = piano()
+    pts, normals = p.sample(2000.0, seed=4)
+    # No sample lies inside another part (the union's surface only) ...
+    for part in p.parts:
+        assert not part.contains(pts, margin=1e-6).any(), part.name
+    # ... and every sample lies on some part's surface: a tiny probe at it touches the piano.
+    probe = cloudprox.ExactShape([cloudprox.Mesh.cuboid(1e-4, 1e-4, 1e-4)])
+    poses = np.stack([make_pose(x) for x in pts[::50]])
+    hits = [cloudprox.exact_proximity(p.exact, probe, None, pose)["intersecting"] for pose in poses]
+    assert all(hits)
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
+    with pytest.raises(ValueError, match="density"):
+        p.sample(0.0)
 
 
 def test_scene_gaps_are_exact() -> None:
     scene = build_scene(sigma=0.005, points=400, seed=3)
     assert scene.piano_points.shape[1] == 3 and scene.room_points.shape[1] == 3
-    assert {"floor", "walls", "table 1", "table 2", "table 3"} <= set(scene.groups)
+    assert {"floor", "walls", "table 1", "table 2", "table 3", "table 4"} <= set(scene.room.groups)
+    assert 2.5 < scene.piano.diagonal < 3.2
     for gap in (-0.015, 0.0, 0.01, 0.075):
         pose = scene.piano_pose(gap)
         gaps = scene.gaps(pose)
-        assert gaps[scene.table] == pytest.approx(gap, abs=1e-12)
-        assert scene.exact_gap(pose) == pytest.approx(gap, abs=1e-12)
+        assert gaps[scene.table] == pytest.approx(gap, abs=1e-9)
+        assert scene.exact_gap(pose) == pytest.approx(gap, abs=1e-9)
         assert min(gaps, key=gaps.get) == scene.table
-    # The noise has the requested spread: distance of the points to their box surface.
+    # The noise has the requested spread.
     clean = build_scene(sigma=0.0, points=400, seed=3)
     noise = scene.piano_points - clean.piano_points
     assert np.std(noise) == pytest.approx(0.005, rel=0.1)
-    with pytest.raises(ValueError, match="rotation"):
-        scene.gaps(np.diag([1.0, -1.0, -1.0, 1.0]))
+    # The room holds the piano: its parts' boxes span the walls.
+    lo, hi = room().bounds()
+    assert lo[0] < -3.0 and hi[0] > 3.0 and lo[2] < 0.0
     with pytest.raises(ValueError, match="points must be >= 10"):
         build_scene(points=1)

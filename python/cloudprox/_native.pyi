@@ -250,10 +250,10 @@ class Mesh:
     def __new__(cls, vertices: npt.ArrayLike, faces: npt.ArrayLike) -> Mesh: ...
     @staticmethod
     def cuboid(hx: float, hy: float, hz: float) -> Mesh:
-        """A box centred at the origin with half extents ``(hx, hy, hz)`` (each > 0)."""
+        """Make a box centred at the origin with half extents ``(hx, hy, hz)`` (each > 0)."""
     @staticmethod
     def cylinder(radius: float, half_height: float, segments: int = 32) -> Mesh:
-        """A cylinder along z centred at the origin: a prism of ``segments`` (>= 3) sides."""
+        """Make a cylinder along z centred at the origin: a prism of ``segments`` (>= 3) sides."""
     @staticmethod
     def merged(meshes: list[Mesh]) -> Mesh:
         """Several meshes as one (faces re-indexed)."""
@@ -397,13 +397,15 @@ def collide(
         Rigid poses of the clouds (own frame to world); ``None`` is the identity.
     surface : {"quadric", "linear"}, optional
         Family of the separating surface (default ``"quadric"``).
-    aggregation : {"surface", "max", "union", "independent"}, optional
-        How per-point probabilities become ``P`` (default ``"surface"``): the
-        largest probability that the surface around a point (the point and its 6
-        nearest neighbours, margins averaged) is on the wrong side; or the
+    aggregation : {"max", "surface", "union", "independent"}, optional
+        How per-point probabilities become ``P`` (default ``"max"``): the
         paper's ``max``, ``union`` (``min(1, sum p_i)``) and ``independent``
-        (``1 - prod(1 - p_i)``) of the per-point probabilities. Only points
-        within the noise's reach of the other cloud count.
+        (``1 - prod(1 - p_i)``) of the per-point probabilities, or ``surface``:
+        the largest probability that the surface around a point (the point and
+        its 6 nearest neighbours of its patch, margins averaged) is on the wrong
+        side, better near contact on the piano scene but blind to deep crossings
+        (see the README). Only points within the noise's reach of the other
+        cloud count.
     threshold_collision : float, optional
         ``P >= threshold_collision`` is ``"collision"`` (default 0.9).
     threshold_free : float, optional

@@ -326,28 +326,46 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         f"Reproducing on the piano-in-room scene: {config.piano_points} piano points, "
         f"{config.poses} poses x {config.draws} noise draws per level, levels "
         f"{', '.join(f'{100 * x:g}%' for x in config.levels)}"
-        + (f" + anisotropic {', '.join(f'{100 * x:g}%' for x in config.anisotropic_levels)}"
-           if config.anisotropic_levels else "")
+        + (
+            f" + anisotropic {', '.join(f'{100 * x:g}%' for x in config.anisotropic_levels)}"
+            if config.anisotropic_levels
+            else ""
+        )
         + "."
     )
     with Progress(
-        TextColumn("{task.description:<42}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-        TimeElapsedColumn(), console=console, transient=False,
+        TextColumn("{task.description:<42}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total}"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=False,
     ) as bar:
         task = bar.add_task("starting", total=steps(config))
         summary = run(config, out, lambda desc, n: bar.update(task, advance=n, description=desc))
-    table = Table(title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma")
+    table = Table(
+        title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma"
+    )
     for col in ("level", "method", "AUC near", "decided", "undecided", "flips", "FP>3s", "ms"):
         table.add_column(col, justify="left" if col in ("level", "method") else "right")
     for (level, method), mt in summary.metrics.items():
-        table.add_row(level, method, f"{mt.auc_near:.3f}", f"{mt.decided_accuracy:.3f}",
-                      f"{mt.undecided:.1%}", f"{mt.hard_flip:.1%}", f"{mt.false_positive_3s:.1%}",
-                      f"{mt.median_ms:.2f}")
+        table.add_row(
+            level,
+            method,
+            f"{mt.auc_near:.3f}",
+            f"{mt.decided_accuracy:.3f}",
+            f"{mt.undecided:.1%}",
+            f"{mt.hard_flip:.1%}",
+            f"{mt.false_positive_3s:.1%}",
+            f"{mt.median_ms:.2f}",
+        )
     console.print(table)
     for c in summary.claims:
         mark = "[green]holds[/green]" if c.holds else "[red]does not hold[/red]"
         console.print(f"{c.level}: {c.claim}: {mark} ({c.detail})")
-    console.print(f"Figures, summary.md and results.csv in {out.resolve()} ({summary.seconds:.0f} s).")
+    console.print(
+        f"Figures, summary.md and results.csv in {out.resolve()} ({summary.seconds:.0f} s)."
+    )
     return 0
 
 
@@ -432,13 +450,18 @@ def _parser() -> argparse.ArgumentParser:
     rep = sub.add_parser(
         "reproduce", help="the paper's experiments against exact ground truth and baselines"
     )
-    rep.add_argument("--quick", action="store_true",
-                     help="the CI smoke run: 3000 piano points, 100 poses, 0.5%% and 2%% noise")
-    rep.add_argument("--out", default="cloudprox-reproduce",
-                     help="output directory (default: %(default)s)")
+    rep.add_argument(
+        "--quick",
+        action="store_true",
+        help="the CI smoke run: 3000 piano points, 100 poses, 0.5%% and 2%% noise",
+    )
+    rep.add_argument(
+        "--out", default="cloudprox-reproduce", help="output directory (default: %(default)s)"
+    )
     rep.add_argument("--poses", type=int, default=None, help="poses per noise level (overrides)")
-    rep.add_argument("--points", type=int, default=None,
-                     help="approximate number of piano points (overrides)")
+    rep.add_argument(
+        "--points", type=int, default=None, help="approximate number of piano points (overrides)"
+    )
     rep.set_defaults(func=_cmd_reproduce)
     return parser
 
@@ -463,7 +486,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return e.code if isinstance(e.code, int) else 2
     if args.command is None:
         parser.print_usage(sys.stderr)
-        print("cloudprox: error: a command is required (demo, collide, bench or reproduce)", file=sys.stderr)
+        print(
+            "cloudprox: error: a command is required (demo, collide, bench or reproduce)",
+            file=sys.stderr,
+        )
         return 2
     try:
         return int(args.func(args))

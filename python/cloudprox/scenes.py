@@ -43,7 +43,7 @@ def make_pose(
     translation: npt.ArrayLike = (0.0, 0.0, 0.0),
     rpy: npt.ArrayLike = (0.0, 0.0, 0.0),
 ) -> FloatArray:
-    """A ``(4, 4)`` rigid transform from a translation and roll-pitch-yaw angles.
+    """Make a ``(4, 4)`` rigid transform from a translation and roll-pitch-yaw angles.
 
     Parameters
     ----------
@@ -57,8 +57,14 @@ def make_pose(
     ndarray, shape (4, 4)
     """
     r, p, y = (float(v) for v in np.asarray(rpy, dtype=float))
-    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
-                              math.cos(y), math.sin(y))
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(r),
+        math.sin(r),
+        math.cos(p),
+        math.sin(p),
+        math.cos(y),
+        math.sin(y),
+    )
     rot = np.array(
         [
             [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
@@ -104,13 +110,20 @@ class Part:
         return np.all(points @ n.T < c - margin, axis=1)
 
 
-def _box(name: str, group: str, center: npt.ArrayLike, half: npt.ArrayLike,
-         rpy: npt.ArrayLike = (0.0, 0.0, 0.0)) -> Part:
+def _box(
+    name: str,
+    group: str,
+    center: npt.ArrayLike,
+    half: npt.ArrayLike,
+    rpy: npt.ArrayLike = (0.0, 0.0, 0.0),
+) -> Part:
     h = [float(x) for x in np.asarray(half, dtype=float)]
     return Part(name, group, Mesh.cuboid(*h).transformed(make_pose(center, rpy)))
 
 
-def _cylinder(name: str, group: str, center: npt.ArrayLike, radius: float, half_height: float) -> Part:
+def _cylinder(
+    name: str, group: str, center: npt.ArrayLike, radius: float, half_height: float
+) -> Part:
     mesh = Mesh.cylinder(radius, half_height, CYLINDER_SEGMENTS)
     return Part(name, group, mesh.transformed(make_pose(center)))
 
@@ -209,7 +222,7 @@ class SceneObject:
 
 
 def piano() -> SceneObject:
-    """A grand piano: body (a box and a rounded tail), open lid, keyboard, three legs.
+    """Make a grand piano: body (a box and a rounded tail), open lid, keyboard, three legs.
 
     About 1.5 m wide, 2 m deep and 1.4 m tall (bounding-box diagonal 2.9 m).
     """
@@ -218,8 +231,13 @@ def piano() -> SceneObject:
         _box("body front", g, (0.0, -0.15, 0.175), (0.75, 0.45, 0.175)),
         _cylinder("body tail", g, (0.0, 0.3, 0.175), 0.75, 0.175),
         # Lid propped open 25 degrees, its left edge resting on the body.
-        _box("lid", g, (0.0, 0.05, 0.362 + 0.68 * math.sin(math.radians(25.0))),
-             (0.68, 0.78, 0.012), (0.0, math.radians(-25.0), 0.0)),
+        _box(
+            "lid",
+            g,
+            (0.0, 0.05, 0.362 + 0.68 * math.sin(math.radians(25.0))),
+            (0.68, 0.78, 0.012),
+            (0.0, math.radians(-25.0), 0.0),
+        ),
         _box("keyboard", g, (0.0, -0.75, 0.12), (0.7, 0.15, 0.06)),
         _cylinder("leg front left", g, (-0.62, -0.45, -0.3), 0.05, 0.3),
         _cylinder("leg front right", g, (0.62, -0.45, -0.3), 0.05, 0.3),
@@ -230,8 +248,10 @@ def piano() -> SceneObject:
     return SceneObject("piano", parts)
 
 
-def _table(name: str, xy: tuple[float, float], half_xy: tuple[float, float], height: float) -> list[Part]:
-    """A rectangular table: a 4 cm top whose upper face is at ``height``, four round legs."""
+def _table(
+    name: str, xy: tuple[float, float], half_xy: tuple[float, float], height: float
+) -> list[Part]:
+    """Make a rectangular table: a 4 cm top whose upper face is at ``height``, four round legs."""
     x, y = xy
     hx, hy = half_xy
     parts = [_box(f"{name} top", name, (x, y, height - 0.02), (hx, hy, 0.02))]
@@ -243,17 +263,19 @@ def _table(name: str, xy: tuple[float, float], half_xy: tuple[float, float], hei
 
 
 def _round_table(name: str, xy: tuple[float, float], radius: float, height: float) -> list[Part]:
-    """A round table: a 4 cm disc top, a central column and a round foot."""
+    """Make a round table: a 4 cm disc top, a central column and a round foot."""
     x, y = xy
     return [
         _cylinder(f"{name} top", name, (x, y, height - 0.02), radius, 0.02),
-        _cylinder(f"{name} column", name, (x, y, (height - 0.04) / 2.0), 0.05, (height - 0.04) / 2.0),
+        _cylinder(
+            f"{name} column", name, (x, y, (height - 0.04) / 2.0), 0.05, (height - 0.04) / 2.0
+        ),
         _cylinder(f"{name} foot", name, (x, y, 0.02), 0.3, 0.02),
     ]
 
 
 def room() -> SceneObject:
-    """A 6 m x 5 m room (floor, four walls 2.6 m high) with four tables.
+    """Make a 6 m x 5 m room (floor, four walls 2.6 m high) with four tables.
 
     ``table 1`` is a small side table (50 x 40 cm, 75 cm high) at the origin, which
     fits between the piano's legs; ``table 2`` a desk, ``table 3`` a round table,
@@ -298,7 +320,7 @@ class Scene:
     table: str = "table 1"
 
     def table_top(self) -> Part:
-        """The top of :attr:`table`."""
+        """Return the top of :attr:`table`."""
         return next(p for p in self.room.parts if p.name == f"{self.table} top")
 
     def piano_pose(self, gap: float) -> FloatArray:

@@ -25,7 +25,7 @@ def plot_probability_vs_distance(
     panels: list[tuple[str, float, npt.NDArray[np.float64], dict[str, npt.NDArray[np.float64]]]],
     path: Path,
 ) -> None:
-    """The paper's Fig. 2 made real: score against exact signed distance, one panel per level.
+    """Draw the paper's Fig. 2 made real: score against exact signed distance, one panel per level.
 
     ``panels`` holds ``(title, sigma, signed_distance (m,), {method: score (draws, m)})``.
     """

@@ -107,7 +107,7 @@ class Draw:
     _cache: dict[str, object] = field(default_factory=dict, repr=False)
 
     def clouds(self) -> tuple[PointCloud, PointCloud]:
-        """cloudprox clouds: sensor covariance plus estimated discretization error."""
+        """Cloudprox clouds: sensor covariance plus estimated discretization error."""
         if "clouds" not in self._cache:
             self._cache["clouds"] = (
                 PointCloud(self.piano_points, cov=self.piano_sensor_cov, discretization=True),
@@ -125,13 +125,14 @@ class Draw:
         """Largest sensor standard deviation per point, piano and room."""
         if "std" not in self._cache:
             self._cache["std"] = tuple(
-                np.sqrt(np.linalg.eigvalsh(c)[:, -1]) for c in (self.piano_sensor_cov, self.room_sensor_cov)
+                np.sqrt(np.linalg.eigvalsh(c)[:, -1])
+                for c in (self.piano_sensor_cov, self.room_sensor_cov)
             )
         return self._cache["std"]  # type: ignore[return-value]
 
 
 def sampling_spacing(points: FloatArray, k: int = 6) -> float:
-    """The side of the square cell each point stands for on the surface.
+    """Return the side of the square cell each point stands for on the surface.
 
     From the median distance ``d_k`` to the ``k``-th nearest neighbour: a surface
     density of ``k / (pi d_k^2)`` points per square metre gives cells of side
@@ -145,11 +146,11 @@ def _world(points: FloatArray, pose: FloatArray) -> FloatArray:
     return points @ pose[:3, :3].T + pose[:3, 3]
 
 
-def cloudprox_answer(
-    draw: Draw, poses: FloatArray, surface: str, aggregation: str
-) -> MethodAnswer:
-    """cloudprox on every pose (``collide_many``, in parallel) with default settings
-    but for the surface family and the aggregation."""
+def cloudprox_answer(draw: Draw, poses: FloatArray, surface: str, aggregation: str) -> MethodAnswer:
+    """Answer every pose with cloudprox (``collide_many``, in parallel).
+
+    Default settings but for the surface family and the aggregation.
+    """
     piano, room = draw.clouds()
     results = collide_many(piano, room, poses, surface=surface, aggregation=aggregation)
     return MethodAnswer(
@@ -160,7 +161,7 @@ def cloudprox_answer(
 
 
 def nn_gap_answer(draw: Draw, poses: FloatArray) -> MethodAnswer:
-    """The nearest-neighbour gap score ``max_i Phi(-(d_i - 2 s_i) / s_i)``."""
+    """Score by the nearest-neighbour gap ``max_i Phi(-(d_i - 2 s_i) / s_i)``."""
     tree = draw.room_tree()
     std_a, std_b = draw.sensor_std()
     scores, seconds = np.empty(len(poses)), np.empty(len(poses))
@@ -179,7 +180,9 @@ def collision_map_answer(draw: Draw, poses: FloatArray, resolution: float) -> Me
     hit, seconds = np.empty(len(poses), dtype=bool), np.empty(len(poses))
     for i, pose in enumerate(poses):
         t0 = time.perf_counter()
-        d, _ = tree.query(_world(draw.piano_points, pose), p=np.inf, distance_upper_bound=resolution)
+        d, _ = tree.query(
+            _world(draw.piano_points, pose), p=np.inf, distance_upper_bound=resolution
+        )
         hit[i] = bool(np.any(d < resolution))
         seconds[i] = time.perf_counter() - t0
     return _boolean(hit, seconds)

@@ -28,7 +28,7 @@ def auc(score: FloatArray, label: npt.NDArray[np.bool_]) -> float:
 
 
 def roc_curve(score: FloatArray, label: npt.NDArray[np.bool_]) -> tuple[FloatArray, FloatArray]:
-    """False- and true-positive rates over every threshold (from strictest)."""
+    """Return false- and true-positive rates over every threshold (from strictest)."""
     order = np.argsort(-score, kind="stable")
     s, y = score[order], label[order]
     distinct = np.r_[np.nonzero(np.diff(s))[0], len(s) - 1]

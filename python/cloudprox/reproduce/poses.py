@@ -108,9 +108,16 @@ def sample_poses(
         starts = np.stack(
             [
                 make_pose(
-                    (rng.uniform(lo[0] + 0.5, hi[0] - 0.5), rng.uniform(lo[1] + 0.5, hi[1] - 0.5),
-                     rng.uniform(0.65, 1.6)),
-                    (rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), rng.uniform(0, 2 * math.pi)),
+                    (
+                        rng.uniform(lo[0] + 0.5, hi[0] - 0.5),
+                        rng.uniform(lo[1] + 0.5, hi[1] - 0.5),
+                        rng.uniform(0.65, 1.6),
+                    ),
+                    (
+                        rng.uniform(-tilt, tilt),
+                        rng.uniform(-tilt, tilt),
+                        rng.uniform(0, 2 * math.pi),
+                    ),
                 )
                 for _ in range(m)
             ]
@@ -118,7 +125,9 @@ def sample_poses(
         # Directions: polar angle from straight down uniform in [0, 100] degrees.
         polar = np.radians(rng.uniform(0.0, 100.0, m))
         azim = rng.uniform(0.0, 2 * math.pi, m)
-        dirs = np.stack([np.sin(polar) * np.cos(azim), np.sin(polar) * np.sin(azim), -np.cos(polar)], 1)
+        dirs = np.stack(
+            [np.sin(polar) * np.cos(azim), np.sin(polar) * np.sin(azim), -np.cos(polar)], 1
+        )
         # Scan the line for the first step at or below the target.
         t_prev = np.zeros(m)
         g_prev = _signed(piano, room, starts) - target
@@ -130,7 +139,9 @@ def sample_poses(
             if not todo.any():
                 break
             g = np.full(m, np.inf)
-            g[todo] = _signed(piano, room, _translated(starts[todo], dirs[todo], t[todo])) - target[todo]
+            g[todo] = (
+                _signed(piano, room, _translated(starts[todo], dirs[todo], t[todo])) - target[todo]
+            )
             hit = todo & (g <= 0.0)
             found[hit] = t[hit]
             t_prev = np.where(todo & ~hit, t, t_prev)

@@ -78,7 +78,7 @@ class Config:
 
     @classmethod
     def quick(cls) -> Config:
-        """The CI smoke run: 3000 piano points, 100 poses, 0.5% and 2% (under 3 minutes)."""
+        """Return the CI smoke run: 3000 piano points, 100 poses, 0.5% and 2% (under 3 minutes)."""
         return cls(piano_points=3000, poses=100, levels=(0.005, 0.02), anisotropic_levels=())
 
 
@@ -108,7 +108,7 @@ def _level_name(share: float, anisotropic: bool) -> str:
 
 
 def check_claims(summary: Summary) -> list[Claim]:
-    """The issue's headline claims, per level, on ``summary``'s own metrics.
+    """Check the issue's headline claims, per level, on ``summary``'s own metrics.
 
     Near-contact AUC above every baseline's; decided accuracy above the
     nearest-neighbour baseline's with no larger undecided share; hard-flip rate at
@@ -117,35 +117,60 @@ def check_claims(summary: Summary) -> list[Claim]:
     out: list[Claim] = []
     for level in summary.sigmas:
         ours = summary.metrics[(level, OURS)]
-        base = {k[1]: v for k, v in summary.metrics.items() if k[0] == level and not k[1].startswith("cloudprox")}
+        base = {
+            k[1]: v
+            for k, v in summary.metrics.items()
+            if k[0] == level and not k[1].startswith("cloudprox")
+        }
         best = max(base, key=lambda k: base[k].auc_near)
-        out.append(Claim(level, "near-contact AUC above every baseline's",
-                         all(ours.auc_near > b.auc_near for b in base.values()),
-                         f"{ours.auc_near:.3f} vs best baseline {best} {base[best].auc_near:.3f}"))
+        out.append(
+            Claim(
+                level,
+                "near-contact AUC above every baseline's",
+                all(ours.auc_near > b.auc_near for b in base.values()),
+                f"{ours.auc_near:.3f} vs best baseline {best} {base[best].auc_near:.3f}",
+            )
+        )
         nn = base[NN]
-        out.append(Claim(level, "decided accuracy above nn-gap's with no larger undecided share",
-                         ours.decided_accuracy > nn.decided_accuracy and ours.undecided <= nn.undecided,
-                         f"{ours.decided_accuracy:.3f} / {ours.undecided:.1%} undecided vs "
-                         f"{nn.decided_accuracy:.3f} / {nn.undecided:.1%}"))
+        out.append(
+            Claim(
+                level,
+                "decided accuracy above nn-gap's with no larger undecided share",
+                ours.decided_accuracy > nn.decided_accuracy and ours.undecided <= nn.undecided,
+                f"{ours.decided_accuracy:.3f} / {ours.undecided:.1%} undecided vs "
+                f"{nn.decided_accuracy:.3f} / {nn.undecided:.1%}",
+            )
+        )
         cm = base[MAP]
-        out.append(Claim(level, "hard-flip rate at most a third of the collision map's",
-                         ours.hard_flip <= cm.hard_flip / 3.0,
-                         f"{ours.hard_flip:.3f} vs {cm.hard_flip:.3f}"))
+        out.append(
+            Claim(
+                level,
+                "hard-flip rate at most a third of the collision map's",
+                ours.hard_flip <= cm.hard_flip / 3.0,
+                f"{ours.hard_flip:.3f} vs {cm.hard_flip:.3f}",
+            )
+        )
         fp = ours.false_positive_3s
-        out.append(Claim(level, "false positives beyond 3 sigma below 1%", bool(fp < 0.01), f"{fp:.2%}"))
+        out.append(
+            Claim(level, "false positives beyond 3 sigma below 1%", bool(fp < 0.01), f"{fp:.2%}")
+        )
     return out
 
 
 def _table(summary: Summary) -> str:
-    head = ("| level | method | AUC all | AUC near | Spearman | decided acc. | undecided | "
-            "hard flips | FP > 3σ | FN < -3σ | median ms |")
+    head = (
+        "| level | method | AUC all | AUC near | Spearman | decided acc. | undecided | "
+        "hard flips | FP > 3σ | FN < -3σ | median ms |"
+    )
     lines = [head, "|" + "---|" * 11]
     fmt = lambda x, p=".3f": "–" if not math.isfinite(x) else format(x, p)  # noqa: E731
     for (level, name), mt in summary.metrics.items():
         lines.append(
             f"| {level} | {name} | {fmt(mt.auc_all)} | {fmt(mt.auc_near)} | {fmt(mt.spearman)} | "
-            f"{fmt(mt.decided_accuracy)} | {fmt(mt.undecided, '.1%')} | {fmt(mt.hard_flip, '.1%')} | "
-            f"{fmt(mt.false_positive_3s, '.1%')} | {fmt(mt.false_negative_3s, '.1%')} | {fmt(mt.median_ms, '.2f')} |"
+            f"{fmt(mt.decided_accuracy)} | {fmt(mt.undecided, '.1%')} | "
+            f"{fmt(mt.hard_flip, '.1%')} | "
+            f"{fmt(mt.false_positive_3s, '.1%')} | {fmt(mt.false_negative_3s, '.1%')} | "
+            f"{fmt(mt.median_ms, '.2f')} |"
         )
     return "\n".join(lines)
 
@@ -153,13 +178,17 @@ def _table(summary: Summary) -> str:
 def _markdown(summary: Summary) -> str:
     c = summary.config
     sig = ", ".join(f"{k}: σ = {1e3 * v:.1f} mm" for k, v in summary.sigmas.items())
-    claims = "\n".join(f"| {x.level} | {x.claim} | {'yes' if x.holds else '**no**'} | {x.detail} |" for x in summary.claims)
+    claims = "\n".join(
+        f"| {x.level} | {x.claim} | {'yes' if x.holds else '**no**'} | {x.detail} |"
+        for x in summary.claims
+    )
     return (
         "# cloudprox reproduce\n\n"
         f"Piano ({c.piano_points} points requested) in a room sampled at the same density; "
         f"{c.poses} poses per level, {c.draws} noise draws each; seed {c.seed}; {sig}. "
         f"Near = exact |signed distance| <= {NEAR_SIGMA:g} σ. Run time {summary.seconds:.0f} s.\n\n"
-        f"{_table(summary)}\n\n## Headline claims\n\n| level | claim | holds | measured |\n|---|---|---|---|\n{claims}\n"
+        f"{_table(summary)}\n\n## Headline claims\n\n"
+        f"| level | claim | holds | measured |\n|---|---|---|---|\n{claims}\n"
     )
 
 
@@ -218,7 +247,9 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             tick(f"{name}: {key}", 1)
         answers[NN] = [m.nn_gap_answer(d, q.poses) for d in draws]
         answers[MAP] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
-        answers[SPHERES] = [m.sphere_union_answer(d, q.poses, spacing / math.sqrt(2.0)) for d in draws]
+        answers[SPHERES] = [
+            m.sphere_union_answer(d, q.poses, spacing / math.sqrt(2.0)) for d in draws
+        ]
         tick(f"{name}: baselines", 1)
         scores: dict[str, np.ndarray] = {}
         for method, ans in answers.items():
@@ -229,39 +260,85 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             summary.metrics[(name, method)] = compute_metrics(sc, st, sec, q.signed_distance, sigma)
             for j in range(len(q.poses)):
                 for r in range(len(ans)):
-                    rows.append((name, sigma, j, r, method, q.signed_distance[j], bool(q.intersecting[j]),
-                                 sc[r, j], st[r, j], sec[r, j]))
+                    rows.append(
+                        (
+                            name,
+                            sigma,
+                            j,
+                            r,
+                            method,
+                            q.signed_distance[j],
+                            bool(q.intersecting[j]),
+                            sc[r, j],
+                            st[r, j],
+                            sec[r, j],
+                        )
+                    )
         shown = {k2: scores[k2] for k2 in (OURS, "cloudprox quadric max", NN)}
         fig_p.append((f"noise {name} (σ = {1e3 * sigma:.1f} mm)", sigma, q.signed_distance, shown))
         near = np.abs(q.signed_distance) <= NEAR_SIGMA * sigma
-        fig_roc.append((name, q.signed_distance[near] <= 0.0,
-                        {k2: v[:, near] for k2, v in scores.items() if k2 in (OURS, "cloudprox linear surface", NN, MAP, SPHERES)}))
+        fig_roc.append(
+            (
+                name,
+                q.signed_distance[near] <= 0.0,
+                {
+                    k2: v[:, near]
+                    for k2, v in scores.items()
+                    if k2 in (OURS, "cloudprox linear surface", NN, MAP, SPHERES)
+                },
+            )
+        )
     summary.seconds = time.perf_counter() - t0
     summary.claims = check_claims(summary)
     with (out / "results.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["level", "sigma_m", "pose", "draw", "method", "exact_signed_distance_m", "exact_collision",
-                    "score", "state", "seconds"])
+        w.writerow(
+            [
+                "level",
+                "sigma_m",
+                "pose",
+                "draw",
+                "method",
+                "exact_signed_distance_m",
+                "exact_collision",
+                "score",
+                "state",
+                "seconds",
+            ]
+        )
         w.writerows(rows)
     figures.plot_probability_vs_distance(fig_p, out / "p_vs_distance.png")
     methods_shown = [OURS, "cloudprox quadric max", "cloudprox linear surface", NN, MAP, SPHERES]
-    figures.plot_flip_rates(list(summary.sigmas),
-                            {k2: [summary.metrics[(lv, k2)].hard_flip for lv in summary.sigmas] for k2 in methods_shown},
-                            out / "flip_rate.png")
+    figures.plot_flip_rates(
+        list(summary.sigmas),
+        {
+            k2: [summary.metrics[(lv, k2)].hard_flip for lv in summary.sigmas]
+            for k2 in methods_shown
+        },
+        out / "flip_rate.png",
+    )
     figures.plot_roc(fig_roc, summary.metrics, out / "roc.png")
     (out / "summary.md").write_text(_markdown(summary))
-    (out / "summary.json").write_text(json.dumps({
-        "config": asdict(config),
-        "sigmas_m": summary.sigmas,
-        "metrics": [{"level": lv, "method": mt, **asdict(x)} for (lv, mt), x in summary.metrics.items()],
-        "claims": [asdict(c) for c in summary.claims],
-        "seconds": summary.seconds,
-    }, indent=1))
+    (out / "summary.json").write_text(
+        json.dumps(
+            {
+                "config": asdict(config),
+                "sigmas_m": summary.sigmas,
+                "metrics": [
+                    {"level": lv, "method": mt, **asdict(x)}
+                    for (lv, mt), x in summary.metrics.items()
+                ],
+                "claims": [asdict(c) for c in summary.claims],
+                "seconds": summary.seconds,
+            },
+            indent=1,
+        )
+    )
     tick("wrote the outputs", 1)
     return summary
 
 
 def steps(config: Config) -> int:
-    """Number of progress steps :func:`run` reports."""
+    """Return the number of progress steps :func:`run` reports."""
     n_levels = len(config.levels) + len(config.anisotropic_levels)
     return 2 + n_levels * (3 + len(VARIANTS))

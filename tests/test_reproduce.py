@@ -1,0 +1,150 @@
+"""The reproduction: metrics on known cases, noise models, poses, and the quick run."""
+
+from __future__ import annotations
+
+import json
+from itertools import product
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cloudprox.cli import main
+from cloudprox.reproduce.methods import sampling_spacing, states_from
+from cloudprox.reproduce.metrics import auc, compute_metrics, roc_curve
+from cloudprox.reproduce.noise import NoiseModel
+from cloudprox.reproduce.poses import sample_poses
+from cloudprox.scenes import piano, room
+
+
+def _auc_brute(score: np.ndarray, label: np.ndarray) -> float:
+    pos, neg = score[label], score[~label]
+    wins = sum((p > n) + 0.5 * (p == n) for p, n in product(pos, neg))
+    return wins / (len(pos) * len(neg))
+
+
+def test_auc_equals_the_pairwise_definition_and_roc_ends_at_one() -> None:
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        label = rng.random(40) < 0.4
+        score = np.round(rng.random(40) + 0.3 * label, 1)  # ties on purpose
+        assert auc(score, label) == pytest.approx(_auc_brute(score, label))
+        fpr, tpr = roc_curve(score, label)
+        assert fpr[0] == 0 and tpr[0] == 0 and fpr[-1] == 1 and tpr[-1] == 1
+        assert np.all(np.diff(fpr) >= 0) and np.all(np.diff(tpr) >= 0)
+        # The trapezoid area under the curve is the AUC.
+        area = float(np.sum(np.diff(fpr) * (tpr[1:] + tpr[:-1]) / 2))
+        assert area == pytest.approx(auc(score, label))
+    assert np.isnan(auc(np.array([1.0, 2.0]), np.array([True, True])))  # one class only
+
+
+def test_metrics_on_a_hand_made_case() -> None:
+    sigma = 0.01
+    d = np.array([-0.05, -0.005, 0.005, 0.05, 0.2])  # -5, -0.5, 0.5, 5, 20 sigma
+    score = np.array([[0.99, 0.6, 0.4, 0.95, 0.0], [0.99, 0.95, 0.05, 0.0, 0.0]])
+    state = states_from(score)
+    assert state[0].tolist() == ["collision", "contact", "contact", "collision", "free"]
+    m = compute_metrics(score, state, np.full(score.shape, 2e-3), d, sigma)
+    # Decided answers: draw 0: 3 (2 right), draw 1: 5 (5 right).
+    assert m.decided_accuracy == pytest.approx(7 / 8)
+    assert m.undecided == pytest.approx(2 / 10)
+    # Pose 3 (5 sigma apart) is collision then free: one hard flip in five poses.
+    assert m.hard_flip == pytest.approx(1 / 5)
+    # Beyond 3 sigma: poses 3 and 4, twice each; one collision answer.
+    assert m.false_positive_3s == pytest.approx(1 / 4)
+    assert m.false_negative_3s == pytest.approx(0.0)
+    assert m.median_ms == pytest.approx(2.0)
+    assert m.n == 10
+
+
+def test_anisotropic_noise_has_its_axial_and_lateral_spread() -> None:
+    pts = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.5]])
+    model = NoiseModel(0.03, origin=(0.0, 0.0, 2.0), lateral_ratio=0.25)
+    cov = model.covariances(pts)
+    for p, c in zip(pts, cov):
+        ray = (p - np.array([0.0, 0.0, 2.0])) / np.linalg.norm(p - np.array([0.0, 0.0, 2.0]))
+        assert ray @ c @ ray == pytest.approx(0.03**2)
+        side = np.cross(ray, [1.0, 0.0, 0.0])
+        side /= np.linalg.norm(side)
+        assert side @ c @ side == pytest.approx((0.03 * 0.25) ** 2)
+    rng = np.random.default_rng(1)
+    many = np.repeat(pts[1:], 20000, axis=0)
+    noisy, _ = model.draw(many, rng)
+    emp = np.cov((noisy - many).T)
+    assert np.allclose(emp, cov[1], atol=3e-5)
+    iso = NoiseModel(0.01)
+    assert np.allclose(iso.covariances(pts), 1e-4 * np.eye(3))
+
+
+def test_poses_hit_their_target_band_with_exact_labels() -> None:
+    p, r = piano(), room()
+    sigma = 0.02
+    q = sample_poses(p, r, 40, sigma, np.random.default_rng(3), far_share=0.25)
+    assert q.poses.shape == (40, 4, 4)
+    assert np.all(np.isfinite(q.signed_distance))
+    near = ~q.far
+    assert np.all(q.signed_distance[near] >= -3.0 * sigma - 1e-9)
+    assert np.all(q.signed_distance[near] <= 10.0 * sigma + 1e-9)
+    assert np.all(q.signed_distance[q.far] >= 10.0 * sigma - 1e-9)
+    assert np.array_equal(q.intersecting, q.signed_distance <= 0.0)
+    for t in q.poses:
+        assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3), atol=1e-12)
+
+
+def test_sampling_spacing_of_a_grid_is_its_pitch() -> None:
+    g = np.stack(np.meshgrid(np.arange(60) * 0.01, np.arange(60) * 0.01, [0.0]), -1).reshape(-1, 3)
+    # 6th neighbour of a square grid at pitch h: sqrt(2) h, giving sqrt(2 pi / 6) h.
+    assert sampling_spacing(g) == pytest.approx(0.01 * np.sqrt(2 * np.pi / 6), rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("reproduce")
+    assert main(["reproduce", "--quick", "--out", str(out)]) == 0
+    return out
+
+
+def test_quick_run_writes_every_output(quick_run: Path) -> None:
+    for name in (
+        "results.csv",
+        "summary.md",
+        "summary.json",
+        "p_vs_distance.png",
+        "flip_rate.png",
+        "roc.png",
+    ):
+        assert (quick_run / name).stat().st_size > 0, name
+    summary = json.loads((quick_run / "summary.json").read_text())
+    methods = {m["method"] for m in summary["metrics"]}
+    assert {
+        "cloudprox quadric surface",
+        "cloudprox quadric max",
+        "cloudprox quadric union",
+        "cloudprox quadric independent",
+        "cloudprox linear surface",
+        "nn-gap",
+        "collision-map",
+        "spheres",
+    } <= methods
+    lines = (quick_run / "results.csv").read_text().splitlines()
+    # 2 levels x 100 poses x 2 draws x 9 methods, plus the header.
+    assert len(lines) == 1 + 2 * 100 * 2 * 9
+    assert "Headline claims" in (quick_run / "summary.md").read_text()
+
+
+#: The headline claims that the quick run's own output supports (README: at 0.5%
+#: the method does not reach them on this scene; the numbers are in the table).
+HOLDING = {
+    ("2%", "near-contact AUC above every baseline's"),
+    ("2%", "decided accuracy above nn-gap's with no larger undecided share"),
+    ("2%", "hard-flip rate at most a third of the collision map's"),
+    ("2%", "false positives beyond 3 sigma below 1%"),
+}
+
+
+def test_quick_run_supports_the_headline_claims_it_states(quick_run: Path) -> None:
+    claims = json.loads((quick_run / "summary.json").read_text())["claims"]
+    verdict = {(c["level"], c["claim"]): c for c in claims}
+    assert HOLDING <= set(verdict)
+    for key in HOLDING:
+        assert verdict[key]["holds"], f"{key}: {verdict[key]['detail']}"
