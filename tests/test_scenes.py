@@ -52,8 +52,7 @@ def test_union_sampling_stays_on_the_union_surface() -> None:
     # ... and every sample lies on some part's surface: a tiny probe at it touches the piano.
     probe = cloudprox.ExactShape([cloudprox.Mesh.cuboid(1e-4, 1e-4, 1e-4)])
     poses = np.stack([make_pose(x) for x in pts[::50]])
-    hits = [cloudprox.exact_proximity(p.exact, probe, None, pose)["intersecting"] for pose in poses]
-    assert all(hits)
+    assert cloudprox.exact_proximity_many(probe, p.exact, poses)["intersecting"].all()
     assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
     with pytest.raises(ValueError, match="density"):
         p.sample(0.0)

@@ -306,6 +306,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
@@ -315,11 +317,11 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     if args.poses is not None:
         if args.poses < 10:
             raise CliError(f"--poses must be >= 10, got {args.poses}")
-        config = Config(**{**config.__dict__, "poses": args.poses})
+        config = replace(config, poses=args.poses)
     if args.points is not None:
         if args.points < 500:
             raise CliError(f"--points must be >= 500, got {args.points}")
-        config = Config(**{**config.__dict__, "piano_points": args.points})
+        config = replace(config, piano_points=args.points)
     out = Path(args.out)
     console = _console()
     console.print(

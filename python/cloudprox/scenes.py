@@ -148,6 +148,11 @@ class SceneObject:
         """The parts prepared for :func:`cloudprox.exact_proximity`."""
         return ExactShape([p.mesh for p in self.parts])
 
+    @cached_property
+    def group_shapes(self) -> dict[str, ExactShape]:
+        """Each group's parts prepared for exact queries."""
+        return {g: ExactShape([p.mesh for p in self.parts if p.group == g]) for g in self.groups}
+
     @property
     def groups(self) -> tuple[str, ...]:
         """The groups of the parts, in order of first appearance."""
@@ -214,11 +219,10 @@ class SceneObject:
             Group of ``other`` to the signed distance (metres; negative: minus
             the penetration depth).
         """
-        out: dict[str, float] = {}
-        for group in other.groups:
-            parts = ExactShape([p.mesh for p in other.parts if p.group == group])
-            out[group] = float(exact_proximity(self.exact, parts, pose)["signed_distance"])
-        return out
+        return {
+            group: float(exact_proximity(self.exact, shape, pose)["signed_distance"])
+            for group, shape in other.group_shapes.items()
+        }
 
 
 def piano() -> SceneObject:

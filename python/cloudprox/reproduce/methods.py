@@ -84,10 +84,6 @@ def states_from(p: FloatArray) -> npt.NDArray[np.str_]:
     )
 
 
-def _boolean(hit: npt.NDArray[np.bool_], seconds: FloatArray) -> MethodAnswer:
-    return MethodAnswer(hit.astype(float), np.where(hit, "collision", "free"), seconds)
-
-
 @dataclass
 class Draw:
     """One draw of the noise on both clouds, with everything prepared from it.
@@ -174,27 +170,27 @@ def nn_gap_answer(draw: Draw, poses: FloatArray) -> MethodAnswer:
     return MethodAnswer(scores, states_from(scores), seconds)
 
 
-def collision_map_answer(draw: Draw, poses: FloatArray, resolution: float) -> MethodAnswer:
-    """Axis-aligned cubes of side ``resolution`` on every point; collision iff two overlap."""
+def _overlap_answer(draw: Draw, poses: FloatArray, reach: float, norm: float) -> MethodAnswer:
+    """Collision iff some piano point is within ``reach`` of a room point (``norm``-distance)."""
     tree = draw.room_tree()
     hit, seconds = np.empty(len(poses), dtype=bool), np.empty(len(poses))
     for i, pose in enumerate(poses):
         t0 = time.perf_counter()
-        d, _ = tree.query(
-            _world(draw.piano_points, pose), p=np.inf, distance_upper_bound=resolution
-        )
-        hit[i] = bool(np.any(d < resolution))
+        d, _ = tree.query(_world(draw.piano_points, pose), p=norm, distance_upper_bound=reach)
+        hit[i] = bool(np.any(d < reach))
         seconds[i] = time.perf_counter() - t0
-    return _boolean(hit, seconds)
+    return MethodAnswer(hit.astype(float), np.where(hit, "collision", "free"), seconds)
+
+
+def collision_map_answer(draw: Draw, poses: FloatArray, resolution: float) -> MethodAnswer:
+    """Axis-aligned cubes of side ``resolution`` on every point; collision iff two overlap.
+
+    Two such cubes overlap iff their centres are closer than ``resolution`` in the
+    Chebyshev (max) norm.
+    """
+    return _overlap_answer(draw, poses, resolution, np.inf)
 
 
 def sphere_union_answer(draw: Draw, poses: FloatArray, radius: float) -> MethodAnswer:
     """Spheres of one ``radius`` on every point; collision iff two overlap."""
-    tree = draw.room_tree()
-    hit, seconds = np.empty(len(poses), dtype=bool), np.empty(len(poses))
-    for i, pose in enumerate(poses):
-        t0 = time.perf_counter()
-        d, _ = tree.query(_world(draw.piano_points, pose), distance_upper_bound=2.0 * radius)
-        hit[i] = bool(np.any(d < 2.0 * radius))
-        seconds[i] = time.perf_counter() - t0
-    return _boolean(hit, seconds)
+    return _overlap_answer(draw, poses, 2.0 * radius, 2.0)

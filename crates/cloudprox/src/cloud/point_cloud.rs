@@ -33,15 +33,11 @@ pub struct PointCloud {
     spacing: OnceLock<Spacing>,
 }
 
-/// Sampling spacing per point, its maximum per hierarchy node, and each point's
-/// nearest neighbours.
+/// Sampling spacing per point and its maximum per hierarchy node.
 #[derive(Debug, Clone)]
 struct Spacing {
     per_point: Vec<Real>,
     per_node: Vec<Real>,
-    /// `k` neighbour indices per point (`k = min(6, n - 1)`), nearest first.
-    neighbours: Vec<u32>,
-    k: usize,
 }
 
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
@@ -194,13 +190,6 @@ impl PointCloud {
         &self.spacing_data().per_point
     }
 
-    /// The nearest neighbours of point `i` in the cloud (up to 6, nearest
-    /// first; the ones behind [`PointCloud::spacing`]). Computed on first call.
-    pub fn neighbours(&self, i: usize) -> &[u32] {
-        let s = self.spacing_data();
-        &s.neighbours[i * s.k..(i + 1) * s.k]
-    }
-
     /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].
     pub fn node_spacing(&self) -> &[Real] {
         &self.spacing_data().per_node
@@ -212,22 +201,11 @@ impl PointCloud {
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
             let mut ws = crate::bvh::BvhWorkspace::default();
             let mut nn = Vec::with_capacity(k + 1);
-            let mut neighbours = Vec::with_capacity(k * self.points.len());
             let per_point: Vec<Real> = self
                 .points
                 .iter()
-                .enumerate()
-                .map(|(i, p)| {
+                .map(|p| {
                     bvh.nearest_k(&self.points, p, k + 1, &mut ws, &mut nn);
-                    // The point itself is among the k + 1 (first, unless duplicated).
-                    let own = nn.iter().position(|&(_, j)| j as usize == i).unwrap_or(k);
-                    neighbours.extend(
-                        nn.iter()
-                            .enumerate()
-                            .filter(|&(m, _)| m != own)
-                            .take(k)
-                            .map(|(_, &(_, j))| j),
-                    );
                     nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
                 })
                 .collect();
@@ -235,8 +213,6 @@ impl PointCloud {
             Spacing {
                 per_point,
                 per_node,
-                neighbours,
-                k,
             }
         })
     }

@@ -201,11 +201,8 @@ pub(crate) fn collide_with_workspace(
                 inputs_b[i as usize] = q;
             }
             let patch_probability = request.aggregation.aggregate(
-                ia.iter()
-                    .zip(&qa)
-                    .filter(|(&i, _)| core.0[i as usize])
-                    .chain(ib.iter().zip(&qb).filter(|(&i, _)| core.1[i as usize]))
-                    .map(|(_, &q)| q),
+                core_values(indexed(&ia, &qa), &core.0)
+                    .chain(core_values(indexed(&ib, &qb), &core.1)),
             );
             stats.points_classified += pts.len();
             stats.solver_iterations += u64::from(fit.classification.iterations);
@@ -233,21 +230,9 @@ pub(crate) fn collide_with_workspace(
         }
     }
     stats.patches = regions.len();
-    // Only core points count: a context point is beyond the noise's reach of the
-    // other cloud, so the surface putting it on the wrong side is the surface's
-    // misfit, not evidence of a collision.
-    let counted = |inputs: &[Real], core: &[bool]| -> Vec<Real> {
-        inputs
-            .iter()
-            .zip(core)
-            .filter(|(_, &c)| c)
-            .map(|(&p, _)| p)
-            .collect()
-    };
     let probability = request.aggregation.aggregate(
-        counted(&inputs_a, &core.0)
-            .into_iter()
-            .chain(counted(&inputs_b, &core.1)),
+        core_values(inputs_a.iter().copied().enumerate(), &core.0)
+            .chain(core_values(inputs_b.iter().copied().enumerate(), &core.1)),
     );
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
@@ -258,6 +243,22 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
+}
+
+/// The values of the `(point index, value)` pairs whose point is a core point.
+/// Only they count towards `P`: a context point is beyond the noise's reach of
+/// the other cloud, so a surface that puts it on the wrong side misfits; that is
+/// no evidence of a collision.
+fn core_values<'a>(
+    points: impl Iterator<Item = (usize, Real)> + 'a,
+    core: &'a [bool],
+) -> impl Iterator<Item = Real> + 'a {
+    points.filter(|&(i, _)| core[i]).map(|(_, v)| v)
+}
+
+/// `(point index, value)` pairs of a patch's points `idx` and their `values`.
+fn indexed<'a>(idx: &'a [u32], values: &'a [Real]) -> impl Iterator<Item = (usize, Real)> + 'a {
+    idx.iter().map(|&i| i as usize).zip(values.iter().copied())
 }
 
 /// Neighbours behind a surface probability: the point and its 6 nearest.

@@ -60,7 +60,18 @@ struct PointNoise<'a> {
     to_own_frame: &'a Matrix3,
 }
 
-impl PointNoise<'_> {
+impl<'a> PointNoise<'a> {
+    /// Point `i` of `cloud`, moved into B's frame by `pose`.
+    fn of(cloud: &'a PointCloud, i: usize, pose: &Pose, to_own_frame: &'a Matrix3) -> Self {
+        Self {
+            x: pose * cloud.points()[i],
+            spacing: cloud.spacing()[i],
+            sigma_max: cloud.sensor_sigma_max()[i],
+            cov: &cloud.sensor_covariances()[i],
+            to_own_frame,
+        }
+    }
+
     fn std_along(&self, u: &Vector3) -> Real {
         let v = self.to_own_frame * u;
         v.dot(&(self.cov * v)).max(0.0).sqrt()
@@ -135,9 +146,6 @@ fn near_points_in_blocks<'a>(
     b: &PointCloud,
     rule: NearRule,
 ) -> (Vec<bool>, Vec<bool>) {
-    let (sp_a, sp_b) = (a.spacing(), b.spacing());
-    let (sg_a, sg_b) = (a.sensor_sigma_max(), b.sensor_sigma_max());
-    let (cov_a, cov_b) = (a.sensor_covariances(), b.sensor_covariances());
     // Directions in B's frame, rotated into A's own frame for A's covariances.
     let b_to_a: Matrix3 = rel.rotation.inverse().to_rotation_matrix().into_inner();
     let identity = Matrix3::identity();
@@ -146,25 +154,13 @@ fn near_points_in_blocks<'a>(
     for (block_a, block_b) in blocks {
         for &i in block_a {
             let i = i as usize;
-            let pi = PointNoise {
-                x: rel * a.points()[i],
-                spacing: sp_a[i],
-                sigma_max: sg_a[i],
-                cov: &cov_a[i],
-                to_own_frame: &b_to_a,
-            };
+            let pi = PointNoise::of(a, i, rel, &b_to_a);
             for &j in block_b {
                 let j = j as usize;
                 if near_a[i] && near_b[j] {
                     continue;
                 }
-                let pj = PointNoise {
-                    x: b.points()[j],
-                    spacing: sp_b[j],
-                    sigma_max: sg_b[j],
-                    cov: &cov_b[j],
-                    to_own_frame: &identity,
-                };
+                let pj = PointNoise::of(b, j, &Pose::identity(), &identity);
                 if rule.is_near(&pi, &pj) {
                     near_a[i] = true;
                     near_b[j] = true;
