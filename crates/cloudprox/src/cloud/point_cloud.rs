@@ -5,7 +5,9 @@ use std::sync::OnceLock;
 use crate::bvh::{Bvh, BvhSettings};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
-use crate::uncertainty::{discretization_covariances, max_std, DiscretizationSettings, NoiseModel};
+use crate::uncertainty::{
+    discretization_covariances, max_std, min_std, DiscretizationSettings, NoiseModel,
+};
 use crate::Real;
 
 /// Points with a 3x3 covariance each, in the cloud's own frame.
@@ -28,6 +30,7 @@ pub struct PointCloud {
     /// Sensor covariances when a discretization part was added (else `covariances`).
     sensor: Option<Vec<Matrix3>>,
     sensor_sigma_max: Vec<Real>,
+    sensor_sigma_min: Vec<Real>,
     bvh_settings: BvhSettings,
     bvh: OnceLock<Bvh>,
     spacing: OnceLock<Spacing>,
@@ -59,6 +62,7 @@ impl Clone for PointCloud {
             sigma_max: self.sigma_max.clone(),
             sensor: self.sensor.clone(),
             sensor_sigma_max: self.sensor_sigma_max.clone(),
+            sensor_sigma_min: self.sensor_sigma_min.clone(),
             bvh_settings: self.bvh_settings,
             bvh,
             spacing,
@@ -108,10 +112,12 @@ impl PointCloud {
 
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
         let sigma_max: Vec<Real> = covariances.iter().map(max_std).collect();
+        let sensor_sigma_min = covariances.iter().map(min_std).collect();
         Self {
             points,
             covariances,
             sensor_sigma_max: sigma_max.clone(),
+            sensor_sigma_min,
             sigma_max,
             sensor: None,
             bvh_settings: BvhSettings::default(),
@@ -173,6 +179,11 @@ impl PointCloud {
     /// and the near rule use.
     pub fn sensor_sigma_max(&self) -> &[Real] {
         &self.sensor_sigma_max
+    }
+
+    /// Per-point smallest sensor standard deviation (the near rule's quick accept).
+    pub fn sensor_sigma_min(&self) -> &[Real] {
+        &self.sensor_sigma_min
     }
 
     /// The hierarchy over the points, built on first call.

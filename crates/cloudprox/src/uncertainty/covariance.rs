@@ -47,6 +47,11 @@ pub fn max_std(cov: &Matrix3) -> Real {
     cov.symmetric_eigenvalues().max().max(0.0).sqrt()
 }
 
+/// The smallest standard deviation along any direction: `sqrt(lambda_min(cov))`.
+pub fn min_std(cov: &Matrix3) -> Real {
+    cov.symmetric_eigenvalues().min().max(0.0).sqrt()
+}
+
 /// `sqrt(v^T cov v)`, the standard deviation of the projection on `v` (times `|v|`).
 pub(crate) fn directional_std_of(cov: &Matrix3, v: &Vector3) -> Real {
     v.dot(&(cov * v)).max(0.0).sqrt()

@@ -12,7 +12,7 @@ mod noise;
 mod robust;
 
 pub(crate) use covariance::directional_std_of;
-pub use covariance::{covariance_factor, max_std, validate_covariance};
+pub use covariance::{covariance_factor, max_std, min_std, validate_covariance};
 pub use discretization::{discretization_covariances, DiscretizationSettings};
 pub use noise::NoiseModel;
 pub use robust::RobustModel;

@@ -50,28 +50,52 @@ struct NearRule {
     context: Real,
 }
 
-/// One point's side of a pair test: position (B's frame), spacing, largest
-/// standard deviation, covariance and the rotation of its cloud's frame into B's.
+/// One cloud's noise as the near rule reads it: spacings, smallest and largest
+/// sensor standard deviations, sensor covariances, and the rotation from B's
+/// frame into the cloud's own.
+struct CloudNoise<'a> {
+    spacing: &'a [Real],
+    sigma_min: &'a [Real],
+    sigma_max: &'a [Real],
+    cov: &'a [Matrix3],
+    to_own_frame: Matrix3,
+}
+
+impl<'a> CloudNoise<'a> {
+    fn new(cloud: &'a PointCloud, to_own_frame: Matrix3) -> Self {
+        Self {
+            spacing: cloud.spacing(),
+            sigma_min: cloud.sensor_sigma_min(),
+            sigma_max: cloud.sensor_sigma_max(),
+            cov: cloud.sensor_covariances(),
+            to_own_frame,
+        }
+    }
+
+    /// Point `i`, at `x` in B's frame.
+    fn point(&self, i: usize, x: Point3) -> PointNoise<'_> {
+        PointNoise {
+            x,
+            spacing: self.spacing[i],
+            sigma_min: self.sigma_min[i],
+            sigma_max: self.sigma_max[i],
+            cov: &self.cov[i],
+            to_own_frame: &self.to_own_frame,
+        }
+    }
+}
+
+/// One point's side of a pair test (see [`CloudNoise`]).
 struct PointNoise<'a> {
     x: Point3,
     spacing: Real,
+    sigma_min: Real,
     sigma_max: Real,
     cov: &'a Matrix3,
     to_own_frame: &'a Matrix3,
 }
 
-impl<'a> PointNoise<'a> {
-    /// Point `i` of `cloud`, moved into B's frame by `pose`.
-    fn of(cloud: &'a PointCloud, i: usize, pose: &Pose, to_own_frame: &'a Matrix3) -> Self {
-        Self {
-            x: pose * cloud.points()[i],
-            spacing: cloud.spacing()[i],
-            sigma_max: cloud.sensor_sigma_max()[i],
-            cov: &cloud.sensor_covariances()[i],
-            to_own_frame,
-        }
-    }
-
+impl PointNoise<'_> {
     fn std_along(&self, u: &Vector3) -> Real {
         let v = self.to_own_frame * u;
         v.dot(&(self.cov * v)).max(0.0).sqrt()
@@ -96,6 +120,9 @@ impl NearRule {
         let gap = (d - SAMPLING_MARGIN * h).max(0.0);
         if gap > (i.sigma_max + j.sigma_max) * self.k {
             return false;
+        }
+        if gap <= (i.sigma_min + j.sigma_min) * self.k {
+            return true;
         }
         let u = diff / d;
         gap <= (i.std_along(&u) + j.std_along(&u)) * self.k
@@ -147,20 +174,20 @@ fn near_points_in_blocks<'a>(
     rule: NearRule,
 ) -> (Vec<bool>, Vec<bool>) {
     // Directions in B's frame, rotated into A's own frame for A's covariances.
-    let b_to_a: Matrix3 = rel.rotation.inverse().to_rotation_matrix().into_inner();
-    let identity = Matrix3::identity();
+    let noise_a = CloudNoise::new(a, rel.rotation.inverse().to_rotation_matrix().into_inner());
+    let noise_b = CloudNoise::new(b, Matrix3::identity());
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     for (block_a, block_b) in blocks {
         for &i in block_a {
             let i = i as usize;
-            let pi = PointNoise::of(a, i, rel, &b_to_a);
+            let pi = noise_a.point(i, rel * a.points()[i]);
             for &j in block_b {
                 let j = j as usize;
                 if near_a[i] && near_b[j] {
                     continue;
                 }
-                let pj = PointNoise::of(b, j, &Pose::identity(), &identity);
+                let pj = noise_b.point(j, b.points()[j]);
                 if rule.is_near(&pi, &pj) {
                     near_a[i] = true;
                     near_b[j] = true;
