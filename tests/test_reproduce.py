@@ -79,11 +79,12 @@ def test_anisotropic_noise_has_its_axial_and_lateral_spread() -> None:
 def test_poses_hit_their_target_band_with_exact_labels() -> None:
     p, r = piano(), room()
     sigma = 0.02
-    q = sample_poses(p, r, 40, sigma, np.random.default_rng(3), far_share=0.25)
+    q = sample_poses(p, r, 40, sigma, np.random.default_rng(3), far_share=0.25, deep_share=0.2)
     assert q.poses.shape == (40, 4, 4)
     assert np.all(np.isfinite(q.signed_distance))
     near = ~q.far
-    assert np.all(q.signed_distance[near] >= -3.0 * sigma - 1e-9)
+    assert np.all(q.signed_distance[near] >= -8.0 * sigma - 1e-9)
+    assert np.any(q.signed_distance < -3.0 * sigma)
     assert np.all(q.signed_distance[near] <= 10.0 * sigma + 1e-9)
     assert np.all(q.signed_distance[q.far] >= 10.0 * sigma - 1e-9)
     assert np.array_equal(q.intersecting, q.signed_distance <= 0.0)
@@ -125,20 +126,36 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
         "nn-gap",
         "collision-map",
         "spheres",
+        "reconstruct",
     } <= methods
+    kinect = {m["method"] for m in summary["metrics"] if m["level"] == "kinect"}
+    assert kinect == {
+        "cloudprox quadric surface",
+        "cloudprox quadric max",
+        "cloudprox linear surface",
+        "nn-gap",
+        "collision-map",
+        "spheres",
+        "reconstruct",
+    }
+    assert summary["kinect"]["frame_points"] == 273225
     lines = (quick_run / "results.csv").read_text().splitlines()
-    # 2 levels x 100 poses x 2 draws x 9 methods, plus the header.
-    assert len(lines) == 1 + 2 * 100 * 2 * 9
+    # Piano: 2 levels x 100 poses x 2 draws x 10 methods; Kinect: 100 poses x 2
+    # draws x 7 methods; plus the header.
+    assert len(lines) == 1 + 2 * 100 * 2 * 10 + 100 * 2 * 7
     assert "Headline claims" in (quick_run / "summary.md").read_text()
 
 
-#: The headline claims that the quick run's own output supports (README: at 0.5%
-#: the method does not reach them on this scene; the numbers are in the table).
+#: The headline claims that the quick run's own output supports (README: decided
+#: accuracy at 0.5% and false positives at 2% are not reached; the numbers are in
+#: the table).
 HOLDING = {
+    ("0.5%", "near-contact AUC above every baseline's"),
+    ("0.5%", "hard-flip rate at most a third of the collision map's"),
+    ("0.5%", "false positives beyond 3 sigma below 1%"),
     ("2%", "near-contact AUC above every baseline's"),
     ("2%", "decided accuracy above nn-gap's with no larger undecided share"),
     ("2%", "hard-flip rate at most a third of the collision map's"),
-    ("2%", "false positives beyond 3 sigma below 1%"),
 }
 
 

@@ -319,12 +319,16 @@ class ExactShape:
     ----------
     parts : list of Mesh
         The parts, in the object's own frame (at least one).
+    solid : bool, default True
+        False: every part is a bare surface, closed or not (intersection iff
+        triangles cross; no containment, no penetration depth), for meshes whose
+        orientation is not to be trusted, such as reconstructions from scans.
     """
 
-    def __new__(cls, parts: list[Mesh]) -> ExactShape: ...
+    def __new__(cls, parts: list[Mesh], *, solid: bool = True) -> ExactShape: ...
     @property
     def part_kinds(self) -> list[str]:
-        """Per part, ``"convex"`` or ``"mesh"``."""
+        """Per part, ``"convex"``, ``"solid"`` (closed mesh) or ``"surface"``."""
     def __len__(self) -> int: ...
 
 class _Proximity(TypedDict):
@@ -348,6 +352,18 @@ def exact_proximity(
         the largest over intersecting convex part pairs (``None`` when a
         non-convex part intersects); ``signed_distance`` (distance, or minus the
         depth; NaN when the depth is unknown).
+    """
+
+def exact_intersects_many(
+    a: ExactShape,
+    b: ExactShape,
+    poses_a: npt.ArrayLike,
+    pose_b: npt.ArrayLike | None = None,
+) -> npt.NDArray[np.bool_]:
+    """Whether ``a`` at each pose ``(m, 4, 4)`` intersects ``b``, in parallel.
+
+    The ``intersecting`` of :func:`exact_proximity_many` without the distances,
+    which cost far more for large meshes that are apart.
     """
 
 def exact_proximity_many(

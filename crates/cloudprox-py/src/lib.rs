@@ -43,6 +43,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::PyExactShape>()?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity_many_py, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::exact_intersects_many_py, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_sphere, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_box_surface, m)?)?;
     m.add_function(wrap_pyfunction!(sample::add_noise, m)?)?;

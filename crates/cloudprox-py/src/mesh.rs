@@ -3,7 +3,8 @@
 use std::sync::Arc;
 
 use cloudprox::query::exact::{
-    exact_proximity as core_exact, exact_proximity_many, ExactProximity, ExactShape,
+    exact_intersects_many, exact_proximity as core_exact, exact_proximity_many, ExactProximity,
+    ExactShape,
 };
 use cloudprox::shape::Mesh;
 use numpy::prelude::*;
@@ -238,18 +239,26 @@ pub struct PyExactShape {
 #[pymethods]
 impl PyExactShape {
     #[new]
+    #[pyo3(signature = (parts, *, solid = true))]
     #[allow(clippy::needless_pass_by_value)] // pyo3 extracts a Vec
-    fn new(py: Python<'_>, parts: Vec<PyRef<'_, PyMesh>>) -> PyResult<Self> {
+    fn new(py: Python<'_>, parts: Vec<PyRef<'_, PyMesh>>, solid: bool) -> PyResult<Self> {
         let meshes: Vec<Mesh> = parts.iter().map(|m| (*m.inner).clone()).collect();
         let n_parts = meshes.len();
-        let inner = run_detached(py, move || ExactShape::new(&meshes))?;
+        let inner = run_detached(py, move || {
+            if solid {
+                ExactShape::new(&meshes)
+            } else {
+                ExactShape::surfaces(&meshes)
+            }
+        })?;
         Ok(Self {
             inner: Arc::new(inner),
             n_parts,
         })
     }
 
-    /// Per part: `"convex"` or `"mesh"` (how it is queried).
+    /// Per part: `"convex"`, `"solid"` (closed mesh, with containment) or
+    /// `"surface"` (triangles only), how it is queried.
     #[getter]
     fn part_kinds(&self) -> Vec<&'static str> {
         self.inner
@@ -257,7 +266,8 @@ impl PyExactShape {
             .iter()
             .map(|p| match p {
                 cloudprox::query::exact::ExactPart::Convex(_) => "convex",
-                cloudprox::query::exact::ExactPart::Mesh { .. } => "mesh",
+                cloudprox::query::exact::ExactPart::Mesh { closed: true, .. } => "solid",
+                cloudprox::query::exact::ExactPart::Mesh { closed: false, .. } => "surface",
             })
             .collect()
     }
@@ -329,4 +339,23 @@ pub fn exact_proximity_many_py<'py>(
         vec_to_py(py, &col(&ExactProximity::signed_distance)),
     )?;
     Ok(d)
+}
+
+/// Whether `a` at each of the poses `(m, 4, 4)` intersects `b`, in parallel: a
+/// bool array `(m,)`, the `intersecting` of [`exact_proximity_many`] without
+/// the distances (much cheaper for large meshes that are apart).
+#[pyfunction]
+#[pyo3(name = "exact_intersects_many", signature = (a, b, poses_a, pose_b=None))]
+pub fn exact_intersects_many_py<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyExactShape>,
+    b: &Bound<'py, PyExactShape>,
+    poses_a: &Bound<'py, PyAny>,
+    pose_b: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let poses = poses_from(poses_a, "poses_a")?;
+    let pb = pose_from(py, pose_b, "pose_b")?;
+    let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let hits = run_detached(py, move || Ok(exact_intersects_many(&poses, &sa, &pb, &sb)))?;
+    Ok(PyArray1::from_vec(py, hits))
 }

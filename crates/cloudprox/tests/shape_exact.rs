@@ -205,6 +205,32 @@ fn non_convex_parts_use_the_triangle_mesh_and_detect_containment() {
 }
 
 #[test]
+fn surfaces_intersect_only_where_triangles_cross() {
+    let big = ExactShape::surfaces(&[cube(0.1)]).unwrap();
+    let probe = ExactShape::surfaces(&[cube(0.02)]).unwrap();
+    assert!(matches!(
+        big.parts()[0],
+        ExactPart::Mesh { closed: false, .. }
+    ));
+    // Inside the big cube: a solid would contain the probe; as surfaces the
+    // probe's face at x = 0.04 is 0.06 from the cube's at x = 0.1.
+    let inside = exact_proximity(&Pose::identity(), &big, &at(0.02, 0.0, 0.0), &probe);
+    assert!(!inside.intersecting, "{inside:?}");
+    assert!((inside.distance - 0.06).abs() < 1e-9, "{inside:?}");
+    // Across a face: the triangles cross.
+    let across = exact_proximity(&Pose::identity(), &big, &at(0.1, 0.0, 0.0), &probe);
+    assert!(across.intersecting && across.penetration_depth.is_none());
+    // The same cubes as solids: contained, so intersecting.
+    let solid = exact_proximity(
+        &Pose::identity(),
+        &shape(&[cube(0.1)]),
+        &at(0.02, 0.0, 0.0),
+        &shape(&[cube(0.02)]),
+    );
+    assert!(solid.intersecting);
+}
+
+#[test]
 fn many_poses_equal_a_loop() {
     let a = shape(&[cube(0.1)]);
     let b = shape(&[Mesh::cylinder(0.2, 0.1, 32).unwrap()]);
@@ -223,4 +249,45 @@ fn many_poses_equal_a_loop() {
             "z={z}: {r:?}"
         );
     }
+}
+
+#[test]
+fn the_intersection_only_query_agrees_with_the_full_one() {
+    use cloudprox::query::exact::{exact_intersects, exact_intersects_many};
+    let two = Mesh::merged(&[cube(0.1), cube(0.1).transformed(&at(0.5, 0.0, 0.0))]).unwrap();
+    let solids = shape(&[two.clone(), Mesh::cylinder(0.05, 0.3, 16).unwrap()]);
+    let surfaces = ExactShape::surfaces(&[two]).unwrap();
+    let probe = shape(&[cube(0.02)]);
+    // Probe along x through both cubes (inside, across faces, in the gap).
+    let poses: Vec<Pose> = (0..=70)
+        .map(|i| at(-0.1 + 0.01 * f64::from(i), 0.0, 0.0))
+        .collect();
+    for target in [&solids, &surfaces] {
+        let fast = exact_intersects_many(&poses, &probe, &Pose::identity(), target);
+        for (p, hit) in poses.iter().zip(&fast) {
+            let full = exact_proximity(p, &probe, &Pose::identity(), target);
+            assert_eq!(*hit, full.intersecting, "{p:?}");
+            assert_eq!(*hit, exact_intersects(p, &probe, &Pose::identity(), target));
+        }
+    }
+    // Inside the first cube: the solid holds the probe, the surface does not.
+    assert!(exact_intersects(
+        &at(0.0, 0.0, 0.0),
+        &probe,
+        &Pose::identity(),
+        &solids
+    ));
+    assert!(!exact_intersects(
+        &at(0.0, 0.0, 0.0),
+        &probe,
+        &Pose::identity(),
+        &surfaces
+    ));
+    // Across the face at x = 0.1.
+    assert!(exact_intersects(
+        &at(0.1, 0.0, 0.0),
+        &probe,
+        &Pose::identity(),
+        &surfaces
+    ));
 }

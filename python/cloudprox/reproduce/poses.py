@@ -4,8 +4,12 @@ A pose starts at a random place in the room (random yaw, a small random tilt)
 where the piano is farther from everything than the distance wanted; it then
 moves along a random direction (downwards or sideways) until the exact signed
 distance to the room equals a target drawn from ``[-3, 10]`` sigma (or, for the
-far share, from ``[10 sigma, 0.5 m]``): a scan along the line brackets the first
-crossing and bisection pins it down. The exact signed distance of the final pose
+far share, from ``[10 sigma, 0.5 m]``, and for the deep share from ``[-8, -3]``
+sigma, so that false negatives at penetrations beyond 3 sigma are measured): a
+scan along the line brackets the first crossing and bisection pins it down. The
+target is drawn first and the start redrawn until it reaches it, so the targets
+keep their designed distribution (rejecting targets instead favours the ones that
+are easy to reach: penetrations). The exact signed distance of the final pose
 (:func:`cloudprox.exact_proximity_many`: distance, or minus the EPA penetration
 depth) is the ground truth.
 """
@@ -29,6 +33,8 @@ FloatArray = npt.NDArray[np.float64]
 _REACH, _STEP = 3.0, 0.05
 #: Bisection steps (the bracket shrinks to 0.05 m / 2^40).
 _BISECT = 40
+#: Rounds of fresh starts for the targets not yet reached.
+_ROUNDS = 200
 
 
 @dataclass(frozen=True)
@@ -70,9 +76,10 @@ def sample_poses(
     sigma: float,
     rng: np.random.Generator,
     far_share: float = 0.2,
+    deep_share: float = 0.1,
     max_tilt_deg: float = 10.0,
 ) -> QueryPoses:
-    """Draw ``n`` piano poses, ``1 - far_share`` of them within [-3, 10] sigma of contact.
+    """Draw ``n`` piano poses, ``1 - far_share - deep_share`` of them in [-3, 10] sigma.
 
     Parameters
     ----------
@@ -86,6 +93,8 @@ def sample_poses(
         Source of randomness.
     far_share : float, default 0.2
         Share of poses with a target distance in ``[10 sigma, 0.5 m]``.
+    deep_share : float, default 0.1
+        Share of poses with a target penetration in ``[3, 8]`` sigma.
     max_tilt_deg : float, default 10
         Largest roll and pitch (degrees).
 
@@ -94,24 +103,34 @@ def sample_poses(
     QueryPoses
     """
     lo, hi = room.bounds()
-    out_poses: list[FloatArray] = []
-    out_far: list[bool] = []
-    while len(out_poses) < n:
-        m = 2 * (n - len(out_poses)) + 8
-        far = rng.random(m) < far_share
-        target = np.where(
-            far,
-            rng.uniform(10.0 * sigma, max(0.5, 12.0 * sigma), m),
-            rng.uniform(-3.0 * sigma, 10.0 * sigma, m),
-        )
-        tilt = math.radians(max_tilt_deg)
+    # Targets first, then starts drawn until each target is reached: redrawing
+    # the start (never the target) keeps the targets' distribution as designed.
+    u = rng.random(n)
+    far, deep = u < far_share, u >= 1.0 - deep_share
+    target = np.where(
+        far,
+        rng.uniform(10.0 * sigma, max(0.5, 12.0 * sigma), n),
+        np.where(
+            deep,
+            rng.uniform(-8.0 * sigma, -3.0 * sigma, n),
+            rng.uniform(-3.0 * sigma, 10.0 * sigma, n),
+        ),
+    )
+    poses = np.empty((n, 4, 4))
+    pending = np.arange(n)
+    tilt = math.radians(max_tilt_deg)
+    for _ in range(_ROUNDS):
+        if len(pending) == 0:
+            break
+        m = len(pending)
+        tg = target[pending]
         starts = np.stack(
             [
                 make_pose(
                     (
                         rng.uniform(lo[0] + 0.5, hi[0] - 0.5),
                         rng.uniform(lo[1] + 0.5, hi[1] - 0.5),
-                        rng.uniform(0.65, 1.6),
+                        rng.uniform(0.65, 2.4),
                     ),
                     (
                         rng.uniform(-tilt, tilt),
@@ -130,7 +149,7 @@ def sample_poses(
         )
         # Scan the line for the first step at or below the target.
         t_prev = np.zeros(m)
-        g_prev = _signed(piano, room, starts) - target
+        g_prev = _signed(piano, room, starts) - tg
         found = np.full(m, np.nan)
         valid = g_prev > 0.0
         for k in range(1, int(_REACH / _STEP) + 1):
@@ -140,27 +159,30 @@ def sample_poses(
                 break
             g = np.full(m, np.inf)
             g[todo] = (
-                _signed(piano, room, _translated(starts[todo], dirs[todo], t[todo])) - target[todo]
+                _signed(piano, room, _translated(starts[todo], dirs[todo], t[todo])) - tg[todo]
             )
             hit = todo & (g <= 0.0)
             found[hit] = t[hit]
             t_prev = np.where(todo & ~hit, t, t_prev)
         ok = ~np.isnan(found)
         a, b = t_prev[ok], found[ok]
-        st, dr, tg = starts[ok], dirs[ok], target[ok]
+        st, dr, tk = starts[ok], dirs[ok], tg[ok]
         for _ in range(_BISECT):
             mid = 0.5 * (a + b)
-            below = _signed(piano, room, _translated(st, dr, mid)) - tg <= 0.0
+            below = _signed(piano, room, _translated(st, dr, mid)) - tk <= 0.0
             b = np.where(below, mid, b)
             a = np.where(below, a, mid)
-        final = _translated(st, dr, b)
-        out_poses.extend(final)
-        out_far.extend(far[ok])
-    poses = np.stack(out_poses[:n])
+        poses[pending[ok]] = _translated(st, dr, b)
+        pending = pending[~ok]
+    if len(pending):
+        raise RuntimeError(
+            f"could not place {len(pending)} of {n} poses at their target distances "
+            f"in {_ROUNDS} rounds (targets {np.round(target[pending], 3).tolist()} m)"
+        )
     r = exact_proximity_many(piano.exact, room.exact, poses)
     return QueryPoses(
         poses=poses,
         signed_distance=np.asarray(r["signed_distance"], dtype=float),
         intersecting=np.asarray(r["intersecting"], dtype=bool),
-        far=np.asarray(out_far[:n], dtype=bool),
+        far=far,
     )

@@ -56,6 +56,13 @@ fn contains(part: &ExactPart, pose: &Pose, other: &ExactPart, other_pose: &Pose)
     closed && as_shape(part).contains_point(pose, &(other_pose * some_point(other)))
 }
 
+/// Whether one part pair intersects (surfaces crossing, or one solid holding the other).
+fn pair_intersects(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> bool {
+    query::intersection_test(pa, as_shape(a), pb, as_shape(b)).unwrap_or(false)
+        || contains(a, pa, b, pb)
+        || contains(b, pb, a, pa)
+}
+
 /// One part pair: `(intersecting, distance, penetration depth if known)`.
 fn part_pair(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> (bool, Real, Option<Real>) {
     let (sa, sb) = (as_shape(a), as_shape(b));
@@ -70,10 +77,7 @@ fn part_pair(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> (bool, Real,
             .map_or(0.0, |c| (-c.dist).max(0.0));
         return (true, 0.0, Some(depth));
     }
-    let touching = query::intersection_test(pa, sa, pb, sb).unwrap_or(false)
-        || contains(a, pa, b, pb)
-        || contains(b, pb, a, pa);
-    if touching {
+    if pair_intersects(pa, a, pb, b) {
         (true, 0.0, None)
     } else {
         (
@@ -136,6 +140,33 @@ pub fn exact_proximity(
         out.penetration_depth = None;
     }
     out
+}
+
+/// Whether `a` at `pose_a` and `b` at `pose_b` intersect: the `intersecting` of
+/// [`exact_proximity`] without the distance, which costs far more for large
+/// meshes that are apart.
+pub fn exact_intersects(pose_a: &Pose, a: &ExactShape, pose_b: &Pose, b: &ExactShape) -> bool {
+    let boxes_b: Vec<_> = b.aabbs.iter().map(|x| x.transformed(pose_b)).collect();
+    a.aabbs.iter().enumerate().any(|(i, box_a)| {
+        let box_a = box_a.transformed(pose_a);
+        boxes_b.iter().enumerate().any(|(j, box_b)| {
+            box_a.distance(box_b) <= 0.0
+                && pair_intersects(pose_a, &a.parts[i], pose_b, &b.parts[j])
+        })
+    })
+}
+
+/// [`exact_intersects`] for many poses of `a`, in parallel.
+pub fn exact_intersects_many(
+    poses_a: &[Pose],
+    a: &ExactShape,
+    pose_b: &Pose,
+    b: &ExactShape,
+) -> Vec<bool> {
+    poses_a
+        .par_iter()
+        .map(|p| exact_intersects(p, a, pose_b, b))
+        .collect()
 }
 
 /// [`exact_proximity`] for many poses of `a`, in parallel.

@@ -45,19 +45,35 @@ pub struct ExactShape {
 }
 
 impl ExactShape {
-    /// Prepare `parts` (in the object's own frame).
+    /// Prepare `parts` (in the object's own frame) as solids where they are
+    /// closed: closed convex parts get GJK/EPA, other closed parts containment.
     ///
     /// # Errors
     /// [`Error::InvalidInput`] if there is no part, or parry rejects a part (the
     /// message names the part and parry's reason).
     pub fn new(parts: &[Mesh]) -> Result<Self> {
+        Self::build(parts, true)
+    }
+
+    /// Prepare `parts` as bare surfaces, closed or not: two objects intersect iff
+    /// their triangles do (no containment, no penetration depth). For meshes
+    /// whose orientation or closedness is not to be trusted, such as surfaces
+    /// reconstructed from a scan.
+    ///
+    /// # Errors
+    /// As [`ExactShape::new`].
+    pub fn surfaces(parts: &[Mesh]) -> Result<Self> {
+        Self::build(parts, false)
+    }
+
+    fn build(parts: &[Mesh], solid: bool) -> Result<Self> {
         if parts.is_empty() {
             return Err(Error::invalid("an exact shape needs at least one part"));
         }
         let mut out = Vec::with_capacity(parts.len());
         for (i, m) in parts.iter().enumerate() {
             let diag = m.aabb().half_extents().norm() * 2.0;
-            let part = if m.is_convex(CONVEX_TOLERANCE * diag.max(Real::MIN_POSITIVE)) {
+            let part = if solid && m.is_convex(CONVEX_TOLERANCE * diag.max(Real::MIN_POSITIVE)) {
                 let c = ConvexPolyhedron::from_convex_mesh(m.vertices().to_vec(), m.faces())
                     .or_else(|| ConvexPolyhedron::from_convex_hull(m.vertices()))
                     .ok_or_else(|| {
@@ -67,7 +83,7 @@ impl ExactShape {
                     })?;
                 ExactPart::Convex(c)
             } else {
-                let closed = m.is_closed();
+                let closed = solid && m.is_closed();
                 let flags = if closed {
                     TriMeshFlags::ORIENTED
                 } else {

@@ -10,5 +10,7 @@
 mod exact;
 mod exact_shape;
 
-pub use exact::{exact_proximity, exact_proximity_many, ExactProximity};
+pub use exact::{
+    exact_intersects, exact_intersects_many, exact_proximity, exact_proximity_many, ExactProximity,
+};
 pub use exact_shape::{ExactPart, ExactShape};
