@@ -16,6 +16,9 @@ cargo clippy --workspace --all-targets -- -D warnings
 step "cargo test (core crate: unit, integration, doc tests)"
 cargo test -p cloudprox
 
+step "system packages (Open3D's libraries, apt lists for the Kinect frame)"
+bash scripts/system-deps.sh
+
 step "build and install the Python package"
 python3 -m pip install --quiet --disable-pip-version-check -e '.[test]'
 

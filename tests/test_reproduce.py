@@ -113,6 +113,7 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
         "p_vs_distance.png",
         "flip_rate.png",
         "roc.png",
+        "kinect_scene.png",
     ):
         assert (quick_run / name).stat().st_size > 0, name
     summary = json.loads((quick_run / "summary.json").read_text())

@@ -281,6 +281,8 @@ class ScanResult:
         Per method, seconds per query of shape ``(draws, m)``.
     facts : dict
         Numbers describing the setup (points, spacing, sigma range, reference size).
+    cloud, gripper_points : ndarray
+        The first draw's scan cloud and the gripper's points (own frame), for pictures.
     """
 
     metrics: dict[str, Metrics]
@@ -289,6 +291,8 @@ class ScanResult:
     states: dict[str, npt.NDArray[np.str_]]
     seconds: dict[str, FloatArray]
     facts: dict[str, float]
+    cloud: FloatArray
+    gripper_points: FloatArray
 
 
 def _grid(frame: DepthFrame, offset: int) -> npt.NDArray[np.bool_]:
@@ -353,7 +357,7 @@ def run_scan(
         answers["reconstruct"] = [m.reconstruct_answer(d, q.poses, spacing, 0.0) for d in draws]
     tick("kinect: baselines", 1)
     unit_distance = q.signed_distance / q.sigma
-    out = ScanResult({}, q, {}, {}, {}, {})
+    out = ScanResult({}, q, {}, {}, {}, {}, draws[0].room_points, g_pts)
     for name, ans in answers.items():
         sc = np.stack([x.score for x in ans])
         st = np.stack([x.state for x in ans])

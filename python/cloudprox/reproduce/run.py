@@ -336,6 +336,13 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
                     scan.seconds[method],
                 )
             )
+        figures.plot_scan_scene(
+            scan.cloud,
+            scan.gripper_points,
+            scan.poses.poses,
+            scan.scores[OURS][0],
+            out / "kinect_scene.png",
+        )
         shown = {k2: scan.scores[k2] for k2 in (OURS, "cloudprox quadric max", NN)}
         fig_p.append(("real Kinect frame, Panda gripper (approx. truth)", 1.0, unit, shown))
         near = np.abs(unit) <= NEAR_SIGMA
