@@ -18,11 +18,14 @@ pub enum Aggregation {
     /// so `q_i = Phi(-mean / sd)` ([`surface_probability`]). A surface is located
     /// far better than one sample's noise; the worst single sample is not the
     /// surface. On the piano-in-room evaluation against exact ground truth
-    /// (`cloudprox reproduce`, poses from -3 to +10 sigma) it decides more poses,
-    /// and more of them correctly, than `Max`. **Not the default**: where two
-    /// surfaces cross (deep interpenetration, e.g. two spheres overlapping by half
-    /// their radius at 1 mm noise) the neighbourhoods straddle the crossing and
-    /// their means cancel, and it answers `free` (measured P = 0.08).
+    /// (`cloudprox reproduce`) it decides more poses, and more of them correctly,
+    /// than `Max`. Where two surfaces cross, the neighbourhood means cancel (two
+    /// spheres overlapping by half at 1 mm noise read P = 0.08), so each point's
+    /// value is the larger of `q_i` and the probability that the surfaces cross
+    /// there ([`crate::probability::crossing_probabilities`]). **Not the
+    /// default**: a deep crossing seen by sparse or noisy points can still pass
+    /// (3-6% of the poses 3-8 sigma deep in the reproduction read `free`, where
+    /// `Max` reads none).
     Surface,
     /// `P = max_i p_i`: the probability that the single most doubtful point is on
     /// the wrong side. What the first implementation of the method (FCL) reported.

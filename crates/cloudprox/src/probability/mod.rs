@@ -3,14 +3,17 @@
 //! - [`point_probability`]: the paper's Eq. 3 for one point;
 //! - [`Aggregation`]: how per-point probabilities become the pair's `P`;
 //! - [`surface_probability`]: the same for the surface around a point;
+//! - [`crossing_probabilities`]: where two sampled surfaces cross;
 //! - [`Thresholds`] and [`CollisionState`]: the decision `free` / `contact` / `collision`.
 
 mod aggregation;
+mod crossing;
 mod gaussian;
 mod point;
 mod state;
 
 pub use aggregation::{surface_probability, Aggregation};
+pub use crossing::crossing_probabilities;
 pub use gaussian::{normal_cdf, normal_quantile};
 pub use point::point_probability;
 pub use state::{CollisionState, Thresholds};

@@ -7,7 +7,9 @@ use crate::classify::{train, Classification, Separator, SocpSolver, SolveStatus}
 use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
-use crate::probability::{point_probability, surface_probability, Aggregation};
+use crate::probability::{
+    crossing_probabilities, point_probability, surface_probability, Aggregation,
+};
 use crate::query::collide::region::{
     cut, near_points, near_points_brute_force, near_regions, split_patches, Patch, SAMPLING_MARGIN,
 };
@@ -184,9 +186,20 @@ pub(crate) fn collide_with_workspace(
             }
             let sep = &fit.classification.separator;
             let (qa, qb) = if request.aggregation == Aggregation::Surface {
+                let (own_a, own_b) = (&pts[..na], &pts[na..]);
+                let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
+                let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
+                    q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
+                };
                 (
-                    surface_probabilities(sep, &pts[..na], &covs[..na], 1.0),
-                    surface_probabilities(sep, &pts[na..], &covs[na..], -1.0),
+                    either(
+                        surface_probabilities(sep, own_a, cov_a, 1.0),
+                        crossing_probabilities(own_a, cov_a, own_b, cov_b),
+                    ),
+                    either(
+                        surface_probabilities(sep, own_b, cov_b, -1.0),
+                        crossing_probabilities(own_b, cov_b, own_a, cov_a),
+                    ),
                 )
             } else {
                 (
