@@ -28,6 +28,7 @@ __all__ = [
     "collide",
     "collide_many",
     "default_options",
+    "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
     "option_names",

@@ -9,7 +9,7 @@ use crate::math::Pose;
 use crate::query::collide::collide::collide_with_workspace;
 use crate::query::collide::{CollisionRequest, CollisionResult};
 
-/// [`crate::query::collide`] for cloud `a` at each of `poses_a` against cloud `b`
+/// [`crate::query::collide()`] for cloud `a` at each of `poses_a` against cloud `b`
 /// at `pose_b`, on rayon's thread pool. Both hierarchies are built once, before
 /// the parallel part. Results are in the order of `poses_a`.
 pub fn collide_many(
