@@ -31,7 +31,8 @@ def test_kinect_noise_follows_nguyen_et_al() -> None:
     for p, c in zip(pts, cov):
         ray = p / np.linalg.norm(p)
         assert np.allclose(c, c.T)
-        assert ray @ c @ ray == pytest.approx(kinect_axial_sigma(p[2]) ** 2)
+        stretch = np.linalg.norm(p) / p[2]
+        assert ray @ c @ ray == pytest.approx((kinect_axial_sigma(p[2]) * stretch) ** 2)
         across = np.cross(ray, [0.0, 1.0, 0.0])
         across /= np.linalg.norm(across)
         assert across @ c @ across == pytest.approx((0.8 * p[2] / 575.0) ** 2)

@@ -81,7 +81,7 @@ def reconstruct(
     spacing : float
         Sampling spacing ``h`` of the cloud (metres, > 0).
     sigma : float
-        Largest sensor standard deviation (metres, >= 0).
+        Typical sensor standard deviation (metres, >= 0).
     sensor_origin : sequence of 3 floats, optional
         Where the sensor was, in the cloud's frame; orients the normals towards it.
 

@@ -319,7 +319,12 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
                 },
             )
         )
-    if config.scan_poses > 0:
+    if config.scan_poses > 0 and not with_reconstruction:
+        summary.notes.append(
+            "real-scan experiment skipped: its reference surface is a reconstruction, "
+            "which needs Open3D"
+        )
+    if config.scan_poses > 0 and with_reconstruction:
         scan = run_scan(config.scan_poses, config.seed, SCAN_VARIANTS, tick)
         summary.scan_facts = scan.facts
         unit = scan.poses.signed_distance / scan.poses.sigma
@@ -417,7 +422,8 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
 def steps(config: Config) -> int:
     """Return the number of progress steps :func:`run` reports."""
     n_levels = len(config.levels) + len(config.anisotropic_levels)
-    scan = SCAN_STEPS + len(SCAN_VARIANTS) if config.scan_poses > 0 else 0
+    with_scan = config.scan_poses > 0 and reconstruction_available()
+    scan = SCAN_STEPS + len(SCAN_VARIANTS) if with_scan else 0
     return 2 + n_levels * (3 + len(VARIANTS)) + scan
 
 

@@ -111,6 +111,10 @@ pub fn crossing_probabilities(
                 up = up.max(along / s);
                 down = down.max(-along / s);
             }
+            // Evidence needs own points on both sides of the plane.
+            if m < 2 || up <= 0.0 || down <= 0.0 {
+                return 0.0;
+            }
             let m = m as Real;
             let side = |z: Real| (1.0 - m * normal_cdf(-z)).max(0.0);
             side(up) * side(down)
@@ -203,6 +207,20 @@ mod tests {
             &iso(floor.len(), s),
         );
         assert!(p.iter().all(|&q| q < 1e-6));
+    }
+
+    #[test]
+    fn no_evidence_over_a_hole() {
+        // The other plane has a hole under the probe: no own point lies over it,
+        // so there is no evidence of a crossing (not certainty).
+        let s = 0.001;
+        let holed: Vec<Point3> = grid(|_, _| 0.0, 0.005, 8)
+            .into_iter()
+            .filter(|p| p.x.abs() > 0.012 || p.y.abs() > 0.012)
+            .collect();
+        let probe = grid(|_, _| 0.0005, 0.002, 2);
+        let p = crossing_probabilities(&probe, &iso(probe.len(), s), &holed, &iso(holed.len(), s));
+        assert!(p.iter().all(|&q| q == 0.0), "{p:?}");
     }
 
     #[test]
