@@ -166,3 +166,24 @@ def test_quick_run_supports_the_headline_claims_it_states(quick_run: Path) -> No
     assert HOLDING <= set(verdict)
     for key in HOLDING:
         assert verdict[key]["holds"], f"{key}: {verdict[key]['detail']}"
+
+
+def test_without_open3d_the_reconstruction_and_the_scan_are_skipped_with_notes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import importlib
+
+    run_module = importlib.import_module("cloudprox.reproduce.run")
+
+    monkeypatch.setattr(run_module, "reconstruction_available", lambda: False)
+    config = run_module.Config(
+        piano_points=600, poses=10, levels=(0.02,), anisotropic_levels=(), scan_poses=5
+    )
+    summary = run_module.run(config, tmp_path)
+    methods = {m for (_, m) in summary.metrics}
+    assert "reconstruct" not in methods and "nn-gap" in methods
+    assert {lv for (lv, _) in summary.metrics} == {"2%"}
+    text = (tmp_path / "summary.md").read_text()
+    assert "reconstruct-then-collide skipped: Open3D is not installed" in text
+    assert "real-scan experiment skipped" in text
+    assert run_module.steps(config) == 2 + 1 * (3 + len(run_module.VARIANTS))
