@@ -39,7 +39,13 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 from scipy.special import ndtr
 
-from cloudprox._native import PointCloud, collide_many, exact_proximity, exact_proximity_many
+from cloudprox._native import (
+    ExactShape,
+    PointCloud,
+    collide_many,
+    exact_proximity,
+    exact_proximity_many,
+)
 from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
 
 __all__ = [
@@ -134,19 +140,29 @@ class Draw:
         return self._cache["std"]  # type: ignore[return-value]
 
 
-def reconstruct_answer(draw: Draw, poses: FloatArray, spacing: float, sigma: float) -> MethodAnswer:
+def reconstruct_answer(
+    draw: Draw,
+    poses: FloatArray,
+    spacing: float,
+    sigma: float,
+    shapes: tuple[ExactShape, ExactShape] | None = None,
+) -> MethodAnswer:
     """Reconstruct both clouds (once per draw), then the exact surface check per pose.
 
-    The answers come from :func:`cloudprox.exact_proximity_many` (in parallel); the
-    time per query is the median of :data:`TIMED_QUERIES` of them run one by one
-    (every query gets that median).
+    ``shapes`` replaces the reconstructions (the moving object's, the other's)
+    where the caller has them, e.g. a robot's own mesh. The answers come from
+    :func:`cloudprox.exact_proximity_many` (in parallel); the time per query is
+    the median of :data:`TIMED_QUERIES` of them run one by one (every query gets
+    that median).
     """
-    if "meshes" not in draw._cache:
-        draw._cache["meshes"] = tuple(
-            surface_shape(reconstruct(p, spacing, sigma))
-            for p in (draw.piano_points, draw.room_points)
-        )
-    piano, room = draw._cache["meshes"]  # type: ignore[misc]
+    if shapes is None:
+        if "meshes" not in draw._cache:
+            draw._cache["meshes"] = tuple(
+                surface_shape(reconstruct(p, spacing, sigma))
+                for p in (draw.piano_points, draw.room_points)
+            )
+        shapes = draw._cache["meshes"]  # type: ignore[assignment]
+    piano, room = shapes
     r = exact_proximity_many(piano, room, poses)
     hit = np.asarray(r["intersecting"], dtype=bool)
     scores = np.where(hit, 1.0, -np.asarray(r["distance"], dtype=float))

@@ -25,7 +25,7 @@ import numpy.typing as npt
 from cloudprox._native import exact_proximity_many
 from cloudprox.scenes import SceneObject, make_pose
 
-__all__ = ["QueryPoses", "sample_poses"]
+__all__ = ["QueryPoses", "draw_target_units", "sample_poses"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -69,6 +69,28 @@ def _signed(piano: SceneObject, room: SceneObject, poses: FloatArray) -> FloatAr
     return np.asarray(r["signed_distance"], dtype=float)
 
 
+def draw_target_units(
+    n: int,
+    rng: np.random.Generator,
+    far_high: float,
+    far_share: float = 0.2,
+    deep_share: float = 0.1,
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """Target signed distances in units of sigma, and which are far.
+
+    ``far_share`` of them uniform in ``[10, far_high]``, ``deep_share`` in
+    ``[-8, -3]``, the rest in ``[-3, 10]``.
+    """
+    u = rng.random(n)
+    far, deep = u < far_share, u >= 1.0 - deep_share
+    unit = np.where(
+        far,
+        rng.uniform(10.0, far_high, n),
+        np.where(deep, rng.uniform(-8.0, -3.0, n), rng.uniform(-3.0, 10.0, n)),
+    )
+    return unit, far
+
+
 def sample_poses(
     piano: SceneObject,
     room: SceneObject,
@@ -105,17 +127,10 @@ def sample_poses(
     lo, hi = room.bounds()
     # Targets first, then starts drawn until each target is reached: redrawing
     # the start (never the target) keeps the targets' distribution as designed.
-    u = rng.random(n)
-    far, deep = u < far_share, u >= 1.0 - deep_share
-    target = np.where(
-        far,
-        rng.uniform(10.0 * sigma, max(0.5, 12.0 * sigma), n),
-        np.where(
-            deep,
-            rng.uniform(-8.0 * sigma, -3.0 * sigma, n),
-            rng.uniform(-3.0 * sigma, 10.0 * sigma, n),
-        ),
+    unit, far = draw_target_units(
+        n, rng, max(0.5 / sigma, 12.0), far_share=far_share, deep_share=deep_share
     )
+    target = unit * sigma
     poses = np.empty((n, 4, 4))
     pending = np.arange(n)
     tilt = math.radians(max_tilt_deg)

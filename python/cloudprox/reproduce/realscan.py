@@ -57,6 +57,7 @@ from cloudprox.reproduce.data import (
     panda_gripper_parts,
 )
 from cloudprox.reproduce.metrics import Metrics, compute_metrics
+from cloudprox.reproduce.poses import draw_target_units
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
 from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
 
@@ -186,10 +187,7 @@ def sample_scan_poses(
     rng : numpy.random.Generator
         Source of randomness.
     """
-    u = rng.random(n)
-    far, deep = u < 0.2, u >= 0.9
-    unit = np.where(far, rng.uniform(10, 20, n), np.where(deep, rng.uniform(-8, -3, n), 0.0))
-    unit = np.where(~far & ~deep, rng.uniform(-3, 10, n), unit)
+    unit, _ = draw_target_units(n, rng, 20.0)
     poses = np.empty((n, 4, 4))
     signed = np.empty(n)
     sigmas = np.empty(n)
@@ -361,13 +359,13 @@ def run_scan(
         m.sphere_union_answer(d, q.poses, spacing / math.sqrt(2.0)) for d in draws
     ]
     if reconstruction_available():
+        answers["reconstruct"] = []
         for d in draws:
             scan_sigma = float(np.median(kinect_axial_sigma(d.room_points[:, 2])))
-            d._cache["meshes"] = (
-                gripper,
-                surface_shape(reconstruct(d.room_points, spacing, scan_sigma, frame.origin)),
+            scan = surface_shape(reconstruct(d.room_points, spacing, scan_sigma, frame.origin))
+            answers["reconstruct"].append(
+                m.reconstruct_answer(d, q.poses, spacing, scan_sigma, shapes=(gripper, scan))
             )
-        answers["reconstruct"] = [m.reconstruct_answer(d, q.poses, spacing, 0.0) for d in draws]
     tick("kinect: baselines", 1)
     unit_distance = q.signed_distance / q.sigma
     out = ScanResult({}, q, {}, {}, {}, {}, draws[0].room_points, g_pts)
