@@ -37,13 +37,14 @@ from cloudprox._native import (
     sample_box_surface,
     sample_sphere,
 )
-from cloudprox.exceptions import CloudproxError, InvalidInputError, SolverError
+from cloudprox.exceptions import CloudproxError, FormatError, InvalidInputError, SolverError
 
 __all__ = [
     "CloudproxError",
     "CollisionResult",
     "ContactRegion",
     "ExactShape",
+    "FormatError",
     "InvalidInputError",
     "Mesh",
     "PointCloud",

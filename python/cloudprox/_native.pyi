@@ -19,6 +19,7 @@ __all__ = [
     "CollisionResult",
     "ContactRegion",
     "ExactShape",
+    "FormatError",
     "InvalidInputError",
     "Mesh",
     "PointCloud",
@@ -54,6 +55,13 @@ class InvalidInputError(CloudproxError, ValueError):
     shape, negative sigmas, covariances that are not symmetric positive
     semi-definite, poses that are not rigid, thresholds out of order and unknown
     option names.
+    """
+
+class FormatError(CloudproxError, ValueError):
+    """A file's content is not valid in its format.
+
+    Raised for corrupt, truncated or unsupported files; the message names the
+    file and the problem. Missing files raise ``FileNotFoundError`` instead.
     """
 
 class SolverError(CloudproxError, RuntimeError):

@@ -6,6 +6,7 @@ re-exported here::
     Exception
     └── CloudproxError            base of everything cloudprox raises
         ├── InvalidInputError     also a ValueError: bad shapes, dtypes, values, options
+        ├── FormatError           also a ValueError: a corrupt, truncated or unsupported file
         └── SolverError           also a RuntimeError: reserved for solver failures
 
 A solve that does not converge is *not* an error: it falls back to a plane and is
@@ -14,6 +15,6 @@ reported as data (``ContactRegion.status == "fallback"`` and
 ``FileNotFoundError``.
 """
 
-from cloudprox._native import CloudproxError, InvalidInputError, SolverError
+from cloudprox._native import CloudproxError, FormatError, InvalidInputError, SolverError
 
-__all__ = ["CloudproxError", "InvalidInputError", "SolverError"]
+__all__ = ["CloudproxError", "FormatError", "InvalidInputError", "SolverError"]

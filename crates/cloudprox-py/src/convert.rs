@@ -140,7 +140,7 @@ fn pose_from_slice(py: Python<'_>, m: &[f64], what: &str) -> PyResult<Pose> {
             cloudprox::Error::InvalidInput(msg) => {
                 cloudprox::Error::InvalidInput(format!("{what}: {msg}"))
             }
-            shape @ cloudprox::Error::Shape { .. } => shape,
+            other => other,
         })
         .or_py(py)
 }

@@ -4,6 +4,7 @@
 //! Exception
 //! └── CloudproxError
 //!     ├── InvalidInputError  (also a ValueError)
+//!     ├── FormatError        (also a ValueError): a corrupt or unsupported file
 //!     └── SolverError        (also a RuntimeError)
 //! ```
 //!
@@ -29,6 +30,12 @@ pyo3::create_exception!(
 
 static INVALID_INPUT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static SOLVER_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static FORMAT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+const FORMAT_ERROR_DOC: &str = "A file's content is not valid in its format.\n\n\
+Raised for corrupt, truncated or unsupported files; the message names the file and the\n\
+problem. Missing files raise ``FileNotFoundError`` instead. Subclass of both\n\
+``CloudproxError`` and ``ValueError``.";
 
 const INVALID_INPUT_DOC: &str =
     "An input is out of its domain or has the wrong shape or dtype.\n\n\
@@ -85,6 +92,33 @@ pub fn solver_error_type(py: Python<'_>) -> PyResult<Bound<'_, PyType>> {
         .map(|t| t.bind(py).clone())
 }
 
+/// The `FormatError` type.
+pub fn format_error_type(py: Python<'_>) -> PyResult<Bound<'_, PyType>> {
+    FORMAT_ERROR
+        .get_or_try_init(py, || {
+            make_subclass(
+                py,
+                "FormatError",
+                FORMAT_ERROR_DOC,
+                py.get_type::<PyValueError>(),
+            )
+        })
+        .map(|t| t.bind(py).clone())
+}
+
+/// The builtin `OSError` subclass for an I/O error kind.
+fn os_error(kind: std::io::ErrorKind, msg: String) -> PyErr {
+    use pyo3::exceptions::{
+        PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError,
+    };
+    match kind {
+        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
+        std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(msg),
+        std::io::ErrorKind::IsADirectory => PyIsADirectoryError::new_err(msg),
+        _ => PyOSError::new_err(msg),
+    }
+}
+
 /// An `InvalidInputError` with `msg`.
 pub fn invalid_input(py: Python<'_>, msg: impl Into<String>) -> PyErr {
     match invalid_input_type(py) {
@@ -100,6 +134,15 @@ pub fn core_error(py: Python<'_>, err: cloudprox::Error) -> PyErr {
     match err {
         cloudprox::Error::InvalidInput(msg) => invalid_input(py, msg),
         e @ cloudprox::Error::Shape { .. } => invalid_input(py, e.to_string()),
+        e @ cloudprox::Error::Format { .. } => match format_error_type(py) {
+            Ok(ty) => PyErr::from_type(ty, e.to_string()),
+            Err(e) => e,
+        },
+        cloudprox::Error::Io {
+            path,
+            kind,
+            message,
+        } => os_error(kind, format!("{path}: {message}")),
     }
 }
 
@@ -163,5 +206,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CloudproxError", py.get_type::<CloudproxError>())?;
     m.add("InvalidInputError", invalid_input_type(py)?)?;
     m.add("SolverError", solver_error_type(py)?)?;
+    m.add("FormatError", format_error_type(py)?)?;
     Ok(())
 }

@@ -22,6 +22,8 @@
 //! | per-point and pair probability, thresholds, state | [`probability`] |
 //! | queries (`collide`, `collide_many`; exact mesh-vs-mesh ground truth) | [`query`] |
 //! | triangle meshes, primitives, surface sampling | [`shape`] |
+//! | sensor filters: self, shadow, crop box, voxel, outliers | [`filter`] |
+//! | files: PLY, PCD, XYZ/CSV, NPY, LAS/LAZ, STL, OBJ, OFF, PointCloud2 | [`io`] |
 //!
 //! [`sample`] makes synthetic shapes and seeded noise for tests, benchmarks and demos.
 //!
@@ -49,6 +51,8 @@ pub mod bvh;
 pub mod classify;
 pub mod cloud;
 pub mod error;
+pub mod filter;
+pub mod io;
 pub mod math;
 pub mod probability;
 pub mod query;

@@ -1,0 +1,145 @@
+//! What readers return: [`CloudData`] and [`MeshData`].
+
+use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::shape::Mesh;
+
+/// The layout of an organized cloud (a depth image): `width x height` pixels in
+/// row-major order, and the pixel of every point that was kept.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    /// Pixels per row.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// For each kept point, its pixel `row * width + column`.
+    pub pixels: Vec<u32>,
+}
+
+/// A point cloud as read from (or to be written to) a file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CloudData {
+    /// The points with finite coordinates, in file order (metres).
+    pub points: Vec<Point3>,
+    /// Per-point covariances when the file carries them (fields `cov_xx, cov_xy,
+    /// cov_xz, cov_yy, cov_yz, cov_zz`, as cloudprox writes them).
+    pub covariances: Option<Vec<Matrix3>>,
+    /// Per-point normals when the file carries them (`nx, ny, nz` or `normal_x, ...`).
+    pub normals: Option<Vec<Vector3>>,
+    /// The sensor's pose in the cloud's frame when the file records it (PCD
+    /// `VIEWPOINT`); its translation is the sensor origin of the noise models.
+    pub sensor: Option<Pose>,
+    /// The organized layout (PCD with `HEIGHT > 1`, organized PointCloud2).
+    pub grid: Option<Grid>,
+    /// The names of all per-point fields in the file, in file order.
+    pub fields: Vec<String>,
+    /// How many points were skipped because a coordinate was NaN or infinite.
+    pub skipped: usize,
+}
+
+impl CloudData {
+    /// Data holding just these points (no covariances, normals, sensor or grid).
+    pub fn from_points(points: Vec<Point3>) -> Self {
+        Self {
+            points,
+            fields: vec!["x".into(), "y".into(), "z".into()],
+            ..Self::default()
+        }
+    }
+}
+
+/// Collects points while a reader walks a file: skips (and counts) points with a
+/// non-finite coordinate, and records pixels for organized clouds.
+#[derive(Debug, Default)]
+pub struct CloudDataBuilder {
+    data: CloudData,
+    pixels: Vec<u32>,
+    organized: Option<(usize, usize)>,
+    with_normals: bool,
+    with_covariances: bool,
+}
+
+impl CloudDataBuilder {
+    /// A builder for a cloud with these field names; `organized` is `(width,
+    /// height)` of an organized cloud. `normals`/`covariances` say whether
+    /// [`CloudDataBuilder::push`] will be given them.
+    pub fn new(
+        fields: Vec<String>,
+        organized: Option<(usize, usize)>,
+        normals: bool,
+        covariances: bool,
+        capacity: usize,
+    ) -> Self {
+        let data = CloudData {
+            points: Vec::with_capacity(capacity),
+            normals: normals.then(|| Vec::with_capacity(capacity)),
+            covariances: covariances.then(|| Vec::with_capacity(capacity)),
+            fields,
+            ..CloudData::default()
+        };
+        Self {
+            data,
+            pixels: Vec::new(),
+            organized,
+            with_normals: normals,
+            with_covariances: covariances,
+        }
+    }
+
+    /// Adds the point read at position `index` of the file (its pixel, for an
+    /// organized cloud). A point with a non-finite coordinate is counted in
+    /// `skipped` and not kept. Normals and covariances must be given iff the
+    /// builder was made for them.
+    pub fn push(
+        &mut self,
+        index: usize,
+        point: Point3,
+        normal: Option<Vector3>,
+        covariance: Option<Matrix3>,
+    ) {
+        if !point.coords.iter().all(|c| c.is_finite()) {
+            self.data.skipped += 1;
+            return;
+        }
+        self.data.points.push(point);
+        if self.with_normals {
+            if let Some(n) = self.data.normals.as_mut() {
+                n.push(normal.unwrap_or_else(Vector3::zeros));
+            }
+        }
+        if self.with_covariances {
+            if let Some(c) = self.data.covariances.as_mut() {
+                c.push(covariance.unwrap_or_else(Matrix3::zeros));
+            }
+        }
+        if self.organized.is_some() {
+            self.pixels.push(index as u32);
+        }
+    }
+
+    /// Sets the sensor pose (PCD `VIEWPOINT`).
+    pub fn set_sensor(&mut self, sensor: Option<Pose>) {
+        self.data.sensor = sensor;
+    }
+
+    /// The finished data.
+    pub fn finish(mut self) -> CloudData {
+        if let Some((width, height)) = self.organized {
+            self.data.grid = Some(Grid {
+                width,
+                height,
+                pixels: self.pixels,
+            });
+        }
+        self.data
+    }
+}
+
+/// A triangle mesh as read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshData {
+    /// The mesh (polygons fan-triangulated, STL vertices welded).
+    pub mesh: Mesh,
+    /// Faces dropped because they repeat a vertex (zero area by construction),
+    /// after triangulation. Never dropped silently: reported here.
+    pub dropped_faces: usize,
+}

@@ -1,0 +1,22 @@
+//! OFF (to be written).
+
+#![allow(unused_variables)]
+
+use crate::error::{Error, Result};
+#[allow(unused_imports)]
+use crate::io::{CloudData, Encoding, MeshData};
+#[allow(unused_imports)]
+use crate::shape::Mesh;
+
+fn todo(name: &str) -> Error {
+    Error::format(name, "OFF", "reader not written yet")
+}
+
+/// Reads an OFF mesh.
+pub fn read_off_mesh(bytes: &[u8], name: &str) -> Result<MeshData> {
+    Err(todo(name))
+}
+/// Encodes a mesh as OFF.
+pub fn write_off_mesh(mesh: &Mesh) -> Result<Vec<u8>> {
+    Err(todo(""))
+}
