@@ -13,9 +13,14 @@ use crate::convert::{
     vec_to_py,
 };
 use crate::error::{invalid_input, run_detached};
+use crate::sensor::{sensor_model_from, viewpoint_from};
 
 /// The noise given to the constructor.
 enum Noise {
+    Sensor(
+        cloudprox::uncertainty::SensorModel,
+        cloudprox::uncertainty::Viewpoint,
+    ),
     Sigma(f64),
     Sigmas(Vec<f64>),
     Covariances(Vec<cloudprox::math::Matrix3>),
@@ -25,7 +30,29 @@ fn noise_from(
     py: Python<'_>,
     sigma: Option<&Bound<'_, PyAny>>,
     cov: Option<&Bound<'_, PyAny>>,
+    sensor: Option<&Bound<'_, PyAny>>,
+    origin: Option<&Bound<'_, PyAny>>,
+    sensor_pose: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Noise> {
+    if let Some(sensor) = sensor {
+        if sigma.is_some() || cov.is_some() {
+            return Err(invalid_input(
+                py,
+                "give one of sigma, cov or sensor (the sensor model gives the covariances)",
+            ));
+        }
+        let model = sensor_model_from(sensor)?;
+        return Ok(Noise::Sensor(
+            model,
+            viewpoint_from(py, origin, sensor_pose)?,
+        ));
+    }
+    if origin.is_some() || sensor_pose.is_some() {
+        return Err(invalid_input(
+            py,
+            "origin and sensor_pose are only used with a sensor model (sensor=...)",
+        ));
+    }
     match (sigma, cov) {
         (Some(_), Some(_)) => Err(invalid_input(
             py,
@@ -64,17 +91,23 @@ pub struct PyPointCloud {
 #[pymethods]
 impl PyPointCloud {
     #[new]
-    #[pyo3(signature = (points, sigma=None, cov=None, discretization=false, k=None))]
+    #[pyo3(signature = (
+        points, sigma=None, cov=None, *, sensor=None, origin=None, sensor_pose=None,
+        discretization=false, k=None
+    ))]
     fn new(
         py: Python<'_>,
         points: &Bound<'_, PyAny>,
         sigma: Option<&Bound<'_, PyAny>>,
         cov: Option<&Bound<'_, PyAny>>,
+        sensor: Option<&Bound<'_, PyAny>>,
+        origin: Option<&Bound<'_, PyAny>>,
+        sensor_pose: Option<&Bound<'_, PyAny>>,
         discretization: bool,
         k: Option<i64>,
     ) -> PyResult<Self> {
         let points = points_from(points, "points")?;
-        let noise = noise_from(py, sigma, cov)?;
+        let noise = noise_from(py, sigma, cov, sensor, origin, sensor_pose)?;
         let disc = if discretization {
             let mut settings = DiscretizationSettings::default();
             if let Some(k) = k {
@@ -93,6 +126,7 @@ impl PyPointCloud {
         };
         let cloud = run_detached(py, move || {
             let cloud = match noise {
+                Noise::Sensor(model, vp) => PointCloud::from_sensor(points, &model, &vp),
                 Noise::Sigma(s) => PointCloud::from_sigma(points, s),
                 Noise::Sigmas(s) => PointCloud::from_sigmas(points, s),
                 Noise::Covariances(c) => PointCloud::from_covariances(points, c),

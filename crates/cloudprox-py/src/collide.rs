@@ -1,17 +1,18 @@
 //! The `collide` and `collide_many` functions.
 
-use std::sync::Arc;
-
 use pyo3::prelude::*;
 
-use crate::cloud::PyPointCloud;
 use crate::convert::{pose_from, poses_from};
 use crate::error::run_detached;
 use crate::request::RequestOptions;
 use crate::result::PyCollisionResult;
+use crate::side::resolve_pair;
 
 /// The probabilistic collision query between cloud `a` at `pose_a` and cloud `b`
-/// at `pose_b` (`(4, 4)` transforms, `None` = identity). Options left at `None`
+/// at `pose_b` (`(4, 4)` transforms, `None` = identity). Either side may be a
+/// mesh instead (cloudprox `Mesh`, trimesh `Trimesh`, Open3D `TriangleMesh`): it
+/// is sampled at `mesh_spacing` (default: half the cloud's median spacing) into a
+/// cloud without sensor noise. Options left at `None`
 /// take the Rust defaults (see `default_options()`). The GIL is released during
 /// the query.
 #[pyfunction]
@@ -19,12 +20,12 @@ use crate::result::PyCollisionResult;
     a, b, pose_a=None, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
-    solver=None, use_hierarchy=None
+    solver=None, use_hierarchy=None, mesh_spacing=None
 ))]
 pub fn collide(
     py: Python<'_>,
-    a: &Bound<'_, PyPointCloud>,
-    b: &Bound<'_, PyPointCloud>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
     pose_a: Option<&Bound<'_, PyAny>>,
     pose_b: Option<&Bound<'_, PyAny>>,
     surface: Option<String>,
@@ -39,6 +40,7 @@ pub fn collide(
     robust_model: Option<String>,
     solver: Option<String>,
     use_hierarchy: Option<bool>,
+    mesh_spacing: Option<f64>,
 ) -> PyResult<PyCollisionResult> {
     let request = RequestOptions {
         surface,
@@ -57,7 +59,7 @@ pub fn collide(
     .build(py)?;
     let pose_a = pose_from(py, pose_a, "pose_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
     let result = run_detached(py, move || {
         cloudprox::query::collide(&pose_a, &ca, &pose_b, &cb, &request)
     })?;
@@ -72,12 +74,12 @@ pub fn collide(
     a, b, poses_a, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
-    solver=None, use_hierarchy=None
+    solver=None, use_hierarchy=None, mesh_spacing=None
 ))]
 pub fn collide_many(
     py: Python<'_>,
-    a: &Bound<'_, PyPointCloud>,
-    b: &Bound<'_, PyPointCloud>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
     poses_a: &Bound<'_, PyAny>,
     pose_b: Option<&Bound<'_, PyAny>>,
     surface: Option<String>,
@@ -92,6 +94,7 @@ pub fn collide_many(
     robust_model: Option<String>,
     solver: Option<String>,
     use_hierarchy: Option<bool>,
+    mesh_spacing: Option<f64>,
 ) -> PyResult<Vec<PyCollisionResult>> {
     let request = RequestOptions {
         surface,
@@ -110,7 +113,7 @@ pub fn collide_many(
     .build(py)?;
     let poses_a = poses_from(poses_a, "poses_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
     let results = run_detached(py, move || {
         cloudprox::query::collide_many(&poses_a, &ca, &pose_b, &cb, &request)
     })?;

@@ -107,9 +107,30 @@ fn data(arr: &Bound<'_, PyArrayDyn<f64>>, what: &str) -> PyResult<Vec<f64>> {
         .map_err(|_| invalid_input(arr.py(), format!("{what} is not contiguous")))
 }
 
-/// An `(n, 3)` array-like as points (any `n`, including 0).
+/// The points of a point-cloud object of another library, if `obj` is one:
+/// Open3D `PointCloud` (`.points`), trimesh `PointCloud` (`.vertices`), or
+/// anything else with one of these attributes that is not itself an array.
+fn foreign_points<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    if obj.is_instance(&np.getattr("ndarray")?)? {
+        return Ok(None);
+    }
+    for attr in ["points", "vertices"] {
+        if obj.hasattr(attr)? {
+            return Ok(Some(np.call_method1("asarray", (obj.getattr(attr)?,))?));
+        }
+    }
+    Ok(None)
+}
+
+/// An `(n, 3)` array-like as points (any `n`, including 0). Point-cloud objects
+/// of Open3D and trimesh are accepted too.
 pub fn points_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point3>> {
-    let arr = to_f64_array(obj, what)?;
+    let arr = match foreign_points(obj)? {
+        Some(inner) => to_f64_array(&inner, what)?,
+        None => to_f64_array(obj, what)?,
+    };
     check_shape(&arr, &[None, Some(3)], what, "(n, 3)")?;
     Ok(data(&arr, what)?
         .chunks_exact(3)

@@ -12,6 +12,8 @@
 //! | `result.rs` | `CollisionResult`, `ContactRegion` |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
 //! | `sample.rs` | seeded synthetic shapes |
+//! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
+//! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
 //!
 //! The Python package `cloudprox` re-exports everything; `_native.pyi` is the stub.
 #![deny(unused_qualifications)]
@@ -26,6 +28,8 @@ mod mesh;
 mod request;
 mod result;
 mod sample;
+mod sensor;
+mod side;
 
 /// The compiled part of cloudprox.
 #[pymodule]
@@ -40,6 +44,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
     m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
     m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<sensor::PyDepthCamera>()?;
+    m.add_class::<sensor::PyStereoCamera>()?;
+    m.add_class::<sensor::PyLidar>()?;
     m.add_class::<mesh::PyExactShape>()?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity_many_py, m)?)?;

@@ -1,6 +1,8 @@
 //! `Mesh`, `ExactShape` and the exact mesh-vs-mesh queries.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
+
+use cloudprox::cloud::PointCloud;
 
 use cloudprox::query::exact::{
     exact_intersects_many, exact_proximity as core_exact, exact_proximity_many, ExactProximity,
@@ -25,7 +27,7 @@ type SampleArrays<'py> = (
 );
 
 /// An `(m, 3)` integer array-like as triangle indices.
-fn faces_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+pub(crate) fn faces_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
     let py = obj.py();
     let np = py.import("numpy")?;
     let arr = np.call_method1("asarray", (obj,)).map_err(|e| {
@@ -76,13 +78,42 @@ fn faces_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
 #[pyclass(name = "Mesh", frozen, module = "cloudprox._native")]
 pub struct PyMesh {
     pub(crate) inner: Arc<Mesh>,
+    /// The clouds this mesh was sampled into for queries, by spacing (bits):
+    /// a mesh queried again at the same spacing is not sampled again.
+    samples: Mutex<Vec<(u64, Arc<PointCloud>)>>,
 }
 
+/// How many sampled clouds a mesh keeps.
+const SAMPLE_CACHE: usize = 4;
+
 impl PyMesh {
-    fn wrap(mesh: Mesh) -> Self {
+    pub(crate) fn wrap(mesh: Mesh) -> Self {
         Self {
             inner: Arc::new(mesh),
+            samples: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The mesh sampled at `spacing` for a query (cached; see
+    /// [`PointCloud::from_mesh`]). Runs without the GIL.
+    pub(crate) fn sampled(&self, py: Python<'_>, spacing: f64) -> PyResult<Arc<PointCloud>> {
+        let key = spacing.to_bits();
+        if let Ok(cache) = self.samples.lock() {
+            if let Some((_, c)) = cache.iter().find(|(k, _)| *k == key) {
+                return Ok(Arc::clone(c));
+            }
+        }
+        let mesh = Arc::clone(&self.inner);
+        let cloud = Arc::new(run_detached(py, move || {
+            PointCloud::from_mesh(&mesh, spacing, 0)
+        })?);
+        if let Ok(mut cache) = self.samples.lock() {
+            if cache.len() >= SAMPLE_CACHE {
+                cache.remove(0);
+            }
+            cache.push((key, Arc::clone(&cloud)));
+        }
+        Ok(cloud)
     }
 }
 

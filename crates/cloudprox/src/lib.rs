@@ -74,9 +74,12 @@ pub mod prelude {
     pub use crate::probability::{Aggregation, CollisionState, Thresholds};
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
-        collide, collide_many, CollisionRequest, CollisionRequestBuilder, CollisionResult,
-        ContactRegion, QueryStats,
+        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
+        CollisionResult, ContactRegion, MeshSampling, QueryStats,
     };
     pub use crate::shape::Mesh;
-    pub use crate::uncertainty::{DiscretizationSettings, RobustModel};
+    pub use crate::uncertainty::{
+        DepthCamera, DiscretizationSettings, Lidar, RobustModel, SensorModel, StereoCamera,
+        Viewpoint,
+    };
 }

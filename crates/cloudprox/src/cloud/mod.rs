@@ -1,5 +1,6 @@
 //! Point clouds with per-point uncertainty, and rigid poses.
 
+mod from_mesh;
 mod point_cloud;
 mod pose;
 

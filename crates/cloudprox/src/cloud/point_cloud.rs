@@ -110,6 +110,16 @@ impl PointCloud {
         Self::new(points, &NoiseModel::Full(covariances))
     }
 
+    /// A cloud seen by a range sensor: covariances anisotropic along each
+    /// point's viewing ray from `viewpoint` (see [`crate::uncertainty::sensor`]).
+    pub fn from_sensor(
+        points: Vec<Point3>,
+        model: &crate::uncertainty::SensorModel,
+        viewpoint: &crate::uncertainty::Viewpoint,
+    ) -> Result<Self> {
+        Self::new(points, &NoiseModel::Sensor(*model, *viewpoint))
+    }
+
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
         let sigma_max: Vec<Real> = covariances.iter().map(max_std).collect();
         let sensor_sigma_min = covariances.iter().map(min_std).collect();
@@ -135,6 +145,30 @@ impl PointCloud {
             self.bvh(),
             settings,
         )?;
+        if self.sensor.is_none() {
+            self.sensor = Some(self.covariances.clone());
+        }
+        for (c, d) in self.covariances.iter_mut().zip(disc) {
+            *c += d;
+        }
+        self.sigma_max = self.covariances.iter().map(max_std).collect();
+        Ok(self)
+    }
+
+    /// Adds a known discretization covariance to every point's covariance (as
+    /// [`PointCloud::with_discretization`] does with its estimate); for samples of
+    /// an exact surface whose patch per sample is known.
+    pub fn with_discretization_covariances(mut self, disc: Vec<Matrix3>) -> Result<Self> {
+        if disc.len() != self.points.len() {
+            return Err(Error::Shape {
+                what: "discretization covariances".into(),
+                expected: self.points.len(),
+                got: disc.len(),
+            });
+        }
+        for (i, d) in disc.iter().enumerate() {
+            crate::uncertainty::validate_covariance(d, &format!("discretization of point {i}"))?;
+        }
         if self.sensor.is_none() {
             self.sensor = Some(self.covariances.clone());
         }

@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3};
+use crate::uncertainty::sensor::{SensorModel, Viewpoint};
 use crate::uncertainty::validate_covariance;
 use crate::Real;
 
@@ -15,6 +16,9 @@ pub enum NoiseModel {
     PerPointSigma(Vec<Real>),
     /// A full 3x3 covariance per point (metres squared).
     Full(Vec<Matrix3>),
+    /// A range sensor's model seen from a viewpoint: anisotropic along each
+    /// point's viewing ray (see [`crate::uncertainty::sensor`]).
+    Sensor(SensorModel, Viewpoint),
 }
 
 impl NoiseModel {
@@ -68,6 +72,7 @@ impl NoiseModel {
                 }
                 Ok(covs.clone())
             }
+            NoiseModel::Sensor(model, viewpoint) => model.covariances(points, viewpoint),
         }
     }
 }

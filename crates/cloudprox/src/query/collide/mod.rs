@@ -11,11 +11,15 @@
 #[allow(clippy::module_inception)]
 mod collide;
 mod collide_many;
+mod collide_mesh_cloud;
 pub mod region;
 mod request;
 mod result;
 
 pub use collide::collide;
 pub use collide_many::collide_many;
+pub use collide_mesh_cloud::{
+    collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
+};
 pub use request::{CollisionRequest, CollisionRequestBuilder};
 pub use result::{CollisionResult, ContactRegion, QueryStats};
