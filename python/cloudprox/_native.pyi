@@ -8,7 +8,7 @@ arrays. Units are SI: metres, and metres squared for covariances. Poses map an
 object's own frame to the world; ``None`` means identity.
 """
 
-from typing import Final, Literal, TypedDict, final
+from typing import Any, Final, Literal, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -18,12 +18,15 @@ __all__ = [
     "CloudproxError",
     "CollisionResult",
     "ContactRegion",
+    "DepthCamera",
     "ExactShape",
     "FormatError",
     "InvalidInputError",
+    "Lidar",
     "Mesh",
     "PointCloud",
     "SolverError",
+    "StereoCamera",
     "__version__",
     "add_noise",
     "collide",
@@ -75,15 +78,16 @@ class SolverError(CloudproxError, RuntimeError):
 class PointCloud:
     """Points with a 3x3 covariance each, in the cloud's own frame.
 
-    The covariance of a point is its sensor covariance (from ``sigma`` or
-    ``cov``) plus, with ``discretization=True``, the k-nearest-neighbour
+    The covariance of a point is its sensor covariance (from ``sigma``, ``cov``
+    or a ``sensor`` model seen from ``origin`` / ``sensor_pose``) plus, with ``discretization=True``, the k-nearest-neighbour
     discretization covariance. The bounding volume hierarchy over the points is
     built on first use and shared by every query on this cloud.
 
     Parameters
     ----------
     points : array_like, shape (n, 3)
-        Point positions (metres); ``n >= 1``, all finite.
+        Point positions (metres); ``n >= 1``, all finite. An Open3D or trimesh
+        point cloud is accepted too.
     sigma : float or array_like of shape (n,), optional
         Isotropic standard deviation of the sensor noise, one for all points or
         one per point (metres, ``>= 0``).
@@ -91,6 +95,15 @@ class PointCloud:
         Full sensor covariance per point (metres squared), symmetric positive
         semi-definite. Exclusive with ``sigma``; with neither the sensor noise
         is zero.
+    sensor : DepthCamera or StereoCamera or Lidar, optional
+        A range sensor's noise model: covariances anisotropic along each point's
+        viewing ray. Exclusive with ``sigma`` and ``cov``; needs ``origin`` or
+        ``sensor_pose``.
+    origin : array_like, shape (3,), optional
+        The sensor's origin in the cloud's frame (depth is then taken as range).
+    sensor_pose : array_like, shape (4, 4), optional
+        The sensor's pose in the cloud's frame; its ``+z`` axis is the optical
+        axis (a PCD ``VIEWPOINT``, a ROS optical frame).
     discretization : bool, default False
         Add the discretization covariance estimated from each point's ``k``
         nearest neighbours (Gaussian weights of scale ``2 d_k``).
@@ -104,14 +117,19 @@ class PointCloud:
         On a wrong shape or dtype, an empty cloud, a NaN or infinite coordinate,
         a negative or non-finite sigma, a sigma array of the wrong length, a
         covariance that is not symmetric PSD, both ``sigma`` and ``cov``, or ``k``
-        without ``discretization``.
+        without ``discretization``; a sensor without a viewpoint, a point at the
+        sensor origin or behind the sensor.
     """
 
     def __new__(
         cls,
-        points: npt.ArrayLike,
+        points: npt.ArrayLike | Any,
         sigma: npt.ArrayLike | None = None,
         cov: npt.ArrayLike | None = None,
+        *,
+        sensor: DepthCamera | StereoCamera | Lidar | None = None,
+        origin: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
         discretization: bool = False,
         k: int | None = None,
     ) -> PointCloud: ...
@@ -391,8 +409,8 @@ def exact_proximity_many(
     """
 
 def collide(
-    a: PointCloud,
-    b: PointCloud,
+    a: PointCloud | Mesh | Any,
+    b: PointCloud | Mesh | Any,
     pose_a: npt.ArrayLike | None = None,
     pose_b: npt.ArrayLike | None = None,
     *,
@@ -408,16 +426,22 @@ def collide(
     robust_model: _RobustModelName | None = None,
     solver: _SolverName | None = None,
     use_hierarchy: bool | None = None,
+    mesh_spacing: float | None = None,
 ) -> CollisionResult:
     """Probabilistic collision query between two noisy point clouds.
 
     Every option left at ``None`` takes the Rust default (``CollisionRequest::default()``,
     listed by :func:`default_options`). The GIL is released during the query.
 
+    Either side may be a mesh (``Mesh``, a trimesh ``Trimesh`` or an Open3D
+    ``TriangleMesh``): an exact surface, sampled every ``mesh_spacing`` metres into
+    a cloud without sensor noise whose covariance is its own discretization
+    (``spacing^2 / 12`` across each sample's face, none along its normal).
+
     Parameters
     ----------
-    a, b : PointCloud
-        The two clouds.
+    a, b : PointCloud or mesh
+        The two clouds, or one cloud and one mesh.
     pose_a, pose_b : array_like, shape (4, 4), optional
         Rigid poses of the clouds (own frame to world); ``None`` is the identity.
     surface : {"quadric", "linear"}, optional
@@ -457,6 +481,10 @@ def collide(
     use_hierarchy : bool, optional
         ``False`` finds the near points by testing every point pair and classifies
         them in one region (the brute-force reference; default ``True``).
+    mesh_spacing : float, optional
+        Sampling spacing of a mesh side (metres; default: half the cloud's median
+        spacing, its distance to the 6th nearest neighbour). A ``Mesh`` keeps its
+        last samplings, so repeated queries do not sample it again.
 
     Returns
     -------
@@ -466,12 +494,13 @@ def collide(
     Raises
     ------
     InvalidInputError
-        On a bad pose, an unknown option name or an option out of its domain.
+        On a bad pose, an unknown option name or an option out of its domain, two
+        meshes, or a side that is neither a cloud nor a mesh.
     """
 
 def collide_many(
-    a: PointCloud,
-    b: PointCloud,
+    a: PointCloud | Mesh | Any,
+    b: PointCloud | Mesh | Any,
     poses_a: npt.ArrayLike,
     pose_b: npt.ArrayLike | None = None,
     *,
@@ -487,18 +516,19 @@ def collide_many(
     robust_model: _RobustModelName | None = None,
     solver: _SolverName | None = None,
     use_hierarchy: bool | None = None,
+    mesh_spacing: float | None = None,
 ) -> list[CollisionResult]:
     """Run :func:`collide` for many poses of ``a``, in parallel.
 
     Parameters
     ----------
-    a, b : PointCloud
-        The two clouds.
+    a, b : PointCloud or mesh
+        The two clouds, or one cloud and one mesh (see :func:`collide`).
     poses_a : array_like, shape (m, 4, 4)
         Poses of ``a``.
     pose_b : array_like, shape (4, 4), optional
         Pose of ``b``; ``None`` is the identity.
-    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy
+    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy, mesh_spacing
         As in :func:`collide`.
 
     Returns
@@ -584,3 +614,120 @@ def add_noise(points: npt.ArrayLike, sigma: float, seed: int = 0) -> _FloatArray
     ndarray, shape (n, 3)
         The noisy points.
     """
+
+@final
+class DepthCamera:
+    """Structured-light depth camera (Kinect v1-like) noise model.
+
+    Axial (depth) standard deviation ``axial_offset + axial_quadratic (z -
+    axial_depth0)^2``, stretched along the viewing ray by ``range / depth``;
+    lateral ``sigma_px z / focal_px``. The defaults are Khoshelham & Elberink
+    (Sensors 2012): ``sigma_z = 1.425e-3 z^2`` (1.4 mm at 1 m, 3.6 cm at 5 m),
+    focal length 580 px, lateral 0.8 px (Nguyen et al. 2012).
+
+    Parameters
+    ----------
+    axial_offset, axial_quadratic, axial_depth0 : float
+        Coefficients of the axial law (metres, 1/metre, metres; ``>= 0``).
+    focal_px : float
+        Focal length in pixels (``> 0``).
+    sigma_px : float
+        Lateral standard deviation in pixels (``>= 0``).
+    """
+
+    def __new__(
+        cls,
+        *,
+        axial_offset: float = 0.0,
+        axial_quadratic: float = 1.425e-3,
+        axial_depth0: float = 0.0,
+        focal_px: float = 580.0,
+        sigma_px: float = 0.8,
+    ) -> DepthCamera: ...
+    @staticmethod
+    def nguyen_2012() -> DepthCamera:
+        """Nguyen, Izadi & Lovell (2012): ``sigma_z = 0.0012 + 0.0019 (z - 0.4)^2``."""
+    @staticmethod
+    def khoshelham_2012() -> DepthCamera:
+        """Khoshelham & Elberink (2012): ``sigma_z = 1.425e-3 z^2`` (the default)."""
+    @property
+    def axial_offset(self) -> float: ...
+    @property
+    def axial_quadratic(self) -> float: ...
+    @property
+    def axial_depth0(self) -> float: ...
+    @property
+    def focal_px(self) -> float: ...
+    @property
+    def sigma_px(self) -> float: ...
+    def sigma_axial(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Axial (depth) standard deviation at each depth (metres), flattened."""
+    def sigma_lateral(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Lateral standard deviation at each depth (metres), flattened."""
+    def covariances(
+        self,
+        points: npt.ArrayLike,
+        origin: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
+    ) -> _FloatArray:
+        """Sensor covariances ``(n, 3, 3)`` of ``points`` seen from ``origin`` or ``sensor_pose``."""
+
+@final
+class StereoCamera:
+    """Stereo camera noise model.
+
+    Depth standard deviation ``z^2 sigma_disparity_px / (focal_px baseline)``
+    (first-order propagation of ``z = f B / d``), stretched along the ray;
+    lateral ``sigma_px z / focal_px``. Defaults: a RealSense D435-like camera
+    (430 px, 50 mm, 0.08 px subpixel disparity noise, 0.5 px lateral).
+    """
+
+    def __new__(
+        cls,
+        *,
+        focal_px: float = 430.0,
+        baseline: float = 0.05,
+        sigma_disparity_px: float = 0.08,
+        sigma_px: float = 0.5,
+    ) -> StereoCamera: ...
+    @property
+    def focal_px(self) -> float: ...
+    @property
+    def baseline(self) -> float: ...
+    @property
+    def sigma_disparity_px(self) -> float: ...
+    @property
+    def sigma_px(self) -> float: ...
+    def sigma_axial(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Depth standard deviation at each depth (metres), flattened."""
+    def sigma_lateral(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Lateral standard deviation at each depth (metres), flattened."""
+    def covariances(
+        self,
+        points: npt.ArrayLike,
+        origin: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
+    ) -> _FloatArray:
+        """Sensor covariances ``(n, 3, 3)`` of ``points`` seen from ``origin`` or ``sensor_pose``."""
+
+@final
+class Lidar:
+    """Laser range finder noise model.
+
+    ``sigma_range`` along the ray, ``range * sigma_angle`` across it. Defaults:
+    Hokuyo UTM-30LX (accuracy +-30 mm taken as 3 sigma: 10 mm; angular resolution
+    0.25 deg, quantization standard deviation 0.25 deg / sqrt(12)).
+    """
+
+    def __new__(cls, *, sigma_range: float = 0.01, sigma_angle: float | None = None) -> Lidar: ...
+    @property
+    def sigma_range(self) -> float: ...
+    @property
+    def sigma_angle(self) -> float: ...
+    def covariances(
+        self,
+        points: npt.ArrayLike,
+        origin: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
+    ) -> _FloatArray:
+        """Sensor covariances ``(n, 3, 3)`` of ``points`` seen from ``origin`` or ``sensor_pose``."""
