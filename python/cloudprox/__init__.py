@@ -19,6 +19,7 @@ Examples
 'free'
 """
 
+from cloudprox import io
 from cloudprox._native import (
     CollisionResult,
     ContactRegion,
@@ -40,12 +41,19 @@ from cloudprox._native import (
     sample_box_surface,
     sample_sphere,
 )
-from cloudprox.exceptions import CloudproxError, FormatError, InvalidInputError, SolverError
+from cloudprox.exceptions import (
+    CloudproxError,
+    DegenerateFacesWarning,
+    FormatError,
+    InvalidInputError,
+    SolverError,
+)
 
 __all__ = [
     "CloudproxError",
     "CollisionResult",
     "ContactRegion",
+    "DegenerateFacesWarning",
     "DepthCamera",
     "ExactShape",
     "FormatError",
@@ -63,6 +71,7 @@ __all__ = [
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
+    "io",
     "option_names",
     "sample_box_surface",
     "sample_sphere",

@@ -15,6 +15,7 @@ import numpy.typing as npt
 
 __version__: Final[str]
 __all__ = [
+    "CloudFile",
     "CloudproxError",
     "CollisionResult",
     "ContactRegion",
@@ -36,8 +37,12 @@ __all__ = [
     "exact_proximity",
     "exact_proximity_many",
     "option_names",
+    "read_mesh",
+    "read_point_cloud",
     "sample_box_surface",
     "sample_sphere",
+    "write_mesh",
+    "write_point_cloud",
 ]
 
 _FloatArray = npt.NDArray[np.float64]
@@ -731,3 +736,89 @@ class Lidar:
         sensor_pose: npt.ArrayLike | None = None,
     ) -> _FloatArray:
         """Sensor covariances ``(n, 3, 3)`` of ``points`` seen from ``origin`` or ``sensor_pose``."""
+
+@final
+class CloudFile:
+    """A point cloud as read from a file: points and whatever else the file holds.
+
+    Returned by :func:`cloudprox.io.read_point_cloud`.
+    """
+
+    @property
+    def points(self) -> _FloatArray:
+        """Points with finite coordinates, shape ``(n, 3)`` (metres)."""
+    @property
+    def normals(self) -> _FloatArray | None:
+        """Per-point normals ``(n, 3)``, or ``None`` when the file has none."""
+    @property
+    def covariances(self) -> _FloatArray | None:
+        """Per-point covariances ``(n, 3, 3)`` stored in the file, or ``None``."""
+    @property
+    def sensor_pose(self) -> _FloatArray | None:
+        """The sensor's pose ``(4, 4)`` recorded in the file (PCD ``VIEWPOINT``), or ``None``."""
+    @property
+    def grid_shape(self) -> tuple[int, int] | None:
+        """``(height, width)`` of an organized cloud, or ``None``."""
+    @property
+    def pixels(self) -> _IntArray | None:
+        """For an organized cloud, the pixel ``row * width + column`` of each point."""
+    @property
+    def fields(self) -> list[str]:
+        """Names of all per-point fields in the file, in file order."""
+    @property
+    def skipped(self) -> int:
+        """Points skipped because a coordinate was NaN or infinite."""
+    @property
+    def path(self) -> str:
+        """The file it was read from."""
+    def to_point_cloud(
+        self,
+        sigma: npt.ArrayLike | None = None,
+        cov: npt.ArrayLike | None = None,
+        *,
+        sensor: DepthCamera | StereoCamera | Lidar | None = None,
+        origin: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
+        discretization: bool = True,
+    ) -> PointCloud:
+        """Make a :class:`PointCloud` of the points.
+
+        The noise is ``sigma``, ``cov``, or a ``sensor`` model seen from
+        ``origin`` / ``sensor_pose`` (default: the file's ``sensor_pose``); with
+        none of them, the covariances stored in the file. ``discretization`` adds
+        the k-nearest-neighbour discretization part (default ``True``).
+
+        Raises
+        ------
+        InvalidInputError
+            If the noise is not given and the file stores none, or a sensor is
+            given and neither the call nor the file gives its viewpoint.
+        """
+    def __len__(self) -> int: ...
+
+def read_point_cloud(path: str, format: str = "auto") -> CloudFile:
+    """Read a point-cloud file (see :func:`cloudprox.io.read_point_cloud`)."""
+
+def write_point_cloud(
+    path: str,
+    cloud: object,
+    format: str = "auto",
+    *,
+    encoding: str | None = None,
+    write_ascii: bool = False,
+    compressed: bool = False,
+) -> None:
+    """Write a point cloud (see :func:`cloudprox.io.write_point_cloud`)."""
+
+def read_mesh(path: str, format: str = "auto") -> tuple[Mesh, int]:
+    """Read a mesh file; returns the mesh and the number of dropped degenerate faces."""
+
+def write_mesh(
+    path: str,
+    mesh: Mesh,
+    format: str = "auto",
+    *,
+    encoding: str | None = None,
+    write_ascii: bool = False,
+) -> None:
+    """Write a mesh file (see :func:`cloudprox.io.write_mesh`)."""

@@ -13,8 +13,21 @@ A solve that does not converge is *not* an error: it falls back to a plane and i
 reported as data (``ContactRegion.status == "fallback"`` and
 ``CollisionResult.stats["solver_fallbacks"]``). Missing files raise the builtin
 ``FileNotFoundError``.
+
+Warnings: :class:`DegenerateFacesWarning` when a mesh file's faces that repeat a
+vertex are dropped (their number is in the message).
 """
 
 from cloudprox._native import CloudproxError, FormatError, InvalidInputError, SolverError
 
-__all__ = ["CloudproxError", "FormatError", "InvalidInputError", "SolverError"]
+__all__ = [
+    "CloudproxError",
+    "DegenerateFacesWarning",
+    "FormatError",
+    "InvalidInputError",
+    "SolverError",
+]
+
+
+class DegenerateFacesWarning(UserWarning):
+    """Faces repeating a vertex were dropped while reading a mesh file."""

@@ -16,7 +16,7 @@ use crate::error::{invalid_input, run_detached};
 use crate::sensor::{sensor_model_from, viewpoint_from};
 
 /// The noise given to the constructor.
-enum Noise {
+pub(crate) enum Noise {
     Sensor(
         cloudprox::uncertainty::SensorModel,
         cloudprox::uncertainty::Viewpoint,
@@ -26,7 +26,7 @@ enum Noise {
     Covariances(Vec<cloudprox::math::Matrix3>),
 }
 
-fn noise_from(
+pub(crate) fn noise_from(
     py: Python<'_>,
     sigma: Option<&Bound<'_, PyAny>>,
     cov: Option<&Bound<'_, PyAny>>,
@@ -88,26 +88,16 @@ pub struct PyPointCloud {
     pub(crate) inner: Arc<PointCloud>,
 }
 
-#[pymethods]
 impl PyPointCloud {
-    #[new]
-    #[pyo3(signature = (
-        points, sigma=None, cov=None, *, sensor=None, origin=None, sensor_pose=None,
-        discretization=false, k=None
-    ))]
-    fn new(
+    /// A cloud from points and noise, with the discretization part if asked for
+    /// (`k` neighbours), built without the GIL.
+    pub(crate) fn build(
         py: Python<'_>,
-        points: &Bound<'_, PyAny>,
-        sigma: Option<&Bound<'_, PyAny>>,
-        cov: Option<&Bound<'_, PyAny>>,
-        sensor: Option<&Bound<'_, PyAny>>,
-        origin: Option<&Bound<'_, PyAny>>,
-        sensor_pose: Option<&Bound<'_, PyAny>>,
+        points: Vec<cloudprox::math::Point3>,
+        noise: Noise,
         discretization: bool,
         k: Option<i64>,
     ) -> PyResult<Self> {
-        let points = points_from(points, "points")?;
-        let noise = noise_from(py, sigma, cov, sensor, origin, sensor_pose)?;
         let disc = if discretization {
             let mut settings = DiscretizationSettings::default();
             if let Some(k) = k {
@@ -139,6 +129,30 @@ impl PyPointCloud {
         Ok(Self {
             inner: Arc::new(cloud),
         })
+    }
+}
+
+#[pymethods]
+impl PyPointCloud {
+    #[new]
+    #[pyo3(signature = (
+        points, sigma=None, cov=None, *, sensor=None, origin=None, sensor_pose=None,
+        discretization=false, k=None
+    ))]
+    fn new(
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        sigma: Option<&Bound<'_, PyAny>>,
+        cov: Option<&Bound<'_, PyAny>>,
+        sensor: Option<&Bound<'_, PyAny>>,
+        origin: Option<&Bound<'_, PyAny>>,
+        sensor_pose: Option<&Bound<'_, PyAny>>,
+        discretization: bool,
+        k: Option<i64>,
+    ) -> PyResult<Self> {
+        let points = points_from(points, "points")?;
+        let noise = noise_from(py, sigma, cov, sensor, origin, sensor_pose)?;
+        Self::build(py, points, noise, discretization, k)
     }
 
     /// Point positions, shape `(n, 3)`, float64 (metres).

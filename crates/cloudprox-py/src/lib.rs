@@ -10,6 +10,7 @@
 //! | `request.rs` | query options -> `CollisionRequest` |
 //! | `collide.rs` | `collide`, `collide_many` |
 //! | `result.rs` | `CollisionResult`, `ContactRegion` |
+//! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
 //! | `sample.rs` | seeded synthetic shapes |
 //! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
@@ -24,6 +25,7 @@ mod cloud;
 mod collide;
 mod convert;
 mod error;
+mod io;
 mod mesh;
 mod request;
 mod result;
@@ -44,6 +46,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
     m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
     m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<io::PyCloudFile>()?;
+    m.add_function(wrap_pyfunction!(io::read_point_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(io::write_point_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(io::read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(io::write_mesh, m)?)?;
     m.add_class::<sensor::PyDepthCamera>()?;
     m.add_class::<sensor::PyStereoCamera>()?;
     m.add_class::<sensor::PyLidar>()?;

@@ -62,6 +62,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cloudprox._native import Mesh
+from cloudprox.exceptions import DegenerateFacesWarning
 
 __all__ = [
     "PANDA_FINGER_MOUNT",
@@ -643,10 +644,6 @@ def load_kinect_frame(path: str | os.PathLike[str] | None = None) -> DepthFrame:
 
 
 # ------------------------------------------------------------------ Wavefront OBJ
-
-
-class DegenerateFacesWarning(UserWarning):
-    """Faces repeating a vertex were dropped while reading an OBJ file."""
 
 
 #: Statements that describe no geometry of a polygonal surface.

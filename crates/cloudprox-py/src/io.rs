@@ -1,0 +1,341 @@
+//! File reading and writing: `CloudFile`, `read_point_cloud`, `write_point_cloud`,
+//! `read_mesh`, `write_mesh`.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use cloudprox::cloud::{pose_to_matrix, PointCloud};
+use cloudprox::io::{self, CloudData, CloudFormat, Encoding, MeshFormat};
+use cloudprox::math::{Matrix3, Pose};
+use numpy::prelude::*;
+use numpy::{PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+
+use crate::cloud::{noise_from, PyPointCloud};
+use crate::convert::{matrices3_to_py, points_from, points_to_py, rows3_to_py};
+use crate::error::{invalid_input, run_detached};
+use crate::mesh::PyMesh;
+
+fn cloud_format(py: Python<'_>, format: &str) -> PyResult<Option<CloudFormat>> {
+    Ok(Some(match format.to_ascii_lowercase().as_str() {
+        "auto" => return Ok(None),
+        "ply" => CloudFormat::Ply,
+        "pcd" => CloudFormat::Pcd,
+        "xyz" | "txt" | "pts" => CloudFormat::Xyz,
+        "csv" => CloudFormat::Csv,
+        "npy" => CloudFormat::Npy,
+        "las" | "laz" => CloudFormat::Las,
+        other => {
+            return Err(invalid_input(
+                py,
+                format!(
+                    "unknown point cloud format {other:?}; known: auto, ply, pcd, xyz, csv, npy, \
+                     las, laz"
+                ),
+            ))
+        }
+    }))
+}
+
+fn mesh_format(py: Python<'_>, format: &str) -> PyResult<Option<MeshFormat>> {
+    Ok(Some(match format.to_ascii_lowercase().as_str() {
+        "auto" => return Ok(None),
+        "stl" => MeshFormat::Stl,
+        "obj" => MeshFormat::Obj,
+        "ply" => MeshFormat::Ply,
+        "off" => MeshFormat::Off,
+        other => {
+            return Err(invalid_input(
+                py,
+                format!("unknown mesh format {other:?}; known: auto, stl, obj, ply, off"),
+            ))
+        }
+    }))
+}
+
+fn encoding_from(
+    py: Python<'_>,
+    encoding: Option<&str>,
+    write_ascii: bool,
+    compressed: bool,
+) -> PyResult<Encoding> {
+    let named = match encoding {
+        None => None,
+        Some(e) => Some(match e.to_ascii_lowercase().as_str() {
+            "ascii" => Encoding::Ascii,
+            "binary" | "binary_little_endian" => Encoding::BinaryLittleEndian,
+            "binary_big_endian" => Encoding::BinaryBigEndian,
+            "binary_compressed" => Encoding::BinaryCompressed,
+            other => {
+                return Err(invalid_input(
+                    py,
+                    format!(
+                        "unknown encoding {other:?}; known: ascii, binary, binary_big_endian, \
+                         binary_compressed"
+                    ),
+                ))
+            }
+        }),
+    };
+    match (named, write_ascii, compressed) {
+        (Some(_), true, _) | (Some(_), _, true) => Err(invalid_input(
+            py,
+            "give encoding, or write_ascii / compressed, not both",
+        )),
+        (Some(e), false, false) => Ok(e),
+        (None, true, true) => Err(invalid_input(
+            py,
+            "write_ascii and compressed exclude each other",
+        )),
+        (None, true, false) => Ok(Encoding::Ascii),
+        (None, false, true) => Ok(Encoding::BinaryCompressed),
+        (None, false, false) => Ok(Encoding::BinaryLittleEndian),
+    }
+}
+
+/// A point cloud as read from a file: points and whatever else the file holds.
+#[pyclass(name = "CloudFile", frozen, module = "cloudprox._native")]
+pub struct PyCloudFile {
+    pub(crate) data: Arc<CloudData>,
+    path: String,
+}
+
+impl PyCloudFile {
+    pub(crate) fn new(data: CloudData, path: String) -> Self {
+        Self {
+            data: Arc::new(data),
+            path,
+        }
+    }
+}
+
+#[pymethods]
+impl PyCloudFile {
+    /// Points with finite coordinates, shape `(n, 3)` (metres).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points_to_py(py, &self.data.points)
+    }
+
+    /// Per-point normals `(n, 3)`, or `None`.
+    #[getter]
+    fn normals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.data
+            .normals
+            .as_ref()
+            .map(|n| rows3_to_py(py, n.iter().copied()))
+            .transpose()
+    }
+
+    /// Per-point covariances `(n, 3, 3)` stored in the file, or `None`.
+    #[getter]
+    fn covariances<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray3<f64>>>> {
+        self.data
+            .covariances
+            .as_ref()
+            .map(|c| matrices3_to_py(py, c))
+            .transpose()
+    }
+
+    /// The sensor's pose `(4, 4)` recorded in the file (PCD `VIEWPOINT`), or `None`.
+    #[getter]
+    fn sensor_pose<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.data
+            .sensor
+            .as_ref()
+            .map(|p| pose_py(py, p))
+            .transpose()
+    }
+
+    /// `(height, width)` of an organized cloud, or `None`.
+    #[getter]
+    fn grid_shape(&self) -> Option<(usize, usize)> {
+        self.data.grid.as_ref().map(|g| (g.height, g.width))
+    }
+
+    /// For an organized cloud, the pixel `row * width + column` of every point, or `None`.
+    #[getter]
+    fn pixels<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i64>>> {
+        self.data
+            .grid
+            .as_ref()
+            .map(|g| PyArray1::from_vec(py, g.pixels.iter().map(|&p| i64::from(p)).collect()))
+    }
+
+    /// Names of all per-point fields in the file, in file order.
+    #[getter]
+    fn fields(&self) -> Vec<String> {
+        self.data.fields.clone()
+    }
+
+    /// Points skipped because a coordinate was NaN or infinite.
+    #[getter]
+    fn skipped(&self) -> usize {
+        self.data.skipped
+    }
+
+    /// The file it was read from.
+    #[getter]
+    fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// The points as a `PointCloud` with noise: `sigma`, `cov`, or a `sensor`
+    /// model seen from `origin` / `sensor_pose` (default: the file's
+    /// `sensor_pose`). With none of them, the file's covariances are used if it
+    /// has them. `discretization` adds the k-nearest-neighbour discretization part.
+    #[pyo3(signature = (
+        sigma=None, cov=None, *, sensor=None, origin=None, sensor_pose=None,
+        discretization=true
+    ))]
+    fn to_point_cloud(
+        &self,
+        py: Python<'_>,
+        sigma: Option<&Bound<'_, PyAny>>,
+        cov: Option<&Bound<'_, PyAny>>,
+        sensor: Option<&Bound<'_, PyAny>>,
+        origin: Option<&Bound<'_, PyAny>>,
+        sensor_pose: Option<&Bound<'_, PyAny>>,
+        discretization: bool,
+    ) -> PyResult<PyPointCloud> {
+        let file_pose = if sensor.is_some() && origin.is_none() && sensor_pose.is_none() {
+            match self.data.sensor.as_ref() {
+                Some(p) => Some(pose_py(py, p)?.into_any()),
+                None => {
+                    return Err(invalid_input(
+                        py,
+                        format!(
+                            "{} records no sensor viewpoint: give origin= or sensor_pose=",
+                            self.path
+                        ),
+                    ))
+                }
+            }
+        } else {
+            None
+        };
+        let sensor_pose = sensor_pose.or(file_pose.as_ref());
+        let noise = if sigma.is_none() && cov.is_none() && sensor.is_none() {
+            match self.data.covariances.as_ref() {
+                Some(c) => crate::cloud::Noise::Covariances(c.clone()),
+                None => {
+                    return Err(invalid_input(
+                        py,
+                        format!(
+                            "{} stores no covariances: give sigma=, cov= or sensor= to say how \
+                             noisy the points are",
+                            self.path
+                        ),
+                    ))
+                }
+            }
+        } else {
+            noise_from(py, sigma, cov, sensor, origin, sensor_pose)?
+        };
+        PyPointCloud::build(py, self.data.points.clone(), noise, discretization, None)
+    }
+
+    fn __len__(&self) -> usize {
+        self.data.points.len()
+    }
+
+    fn __repr__(&self) -> String {
+        let grid = self.data.grid.as_ref().map_or(String::new(), |g| {
+            format!(", organized {}x{}", g.width, g.height)
+        });
+        format!(
+            "CloudFile({:?}: {} points{grid}, {} skipped, fields {:?})",
+            self.path,
+            self.data.points.len(),
+            self.data.skipped,
+            self.data.fields
+        )
+    }
+}
+
+fn pose_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = pose_to_matrix(pose);
+    let flat: Vec<f64> = (0..4)
+        .flat_map(|r| (0..4).map(move |c| m[(r, c)]))
+        .collect();
+    PyArray1::from_vec(py, flat).reshape([4, 4])
+}
+
+/// Reads a point-cloud file (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ; the format from the
+/// extension unless given). The GIL is released while reading.
+#[pyfunction]
+#[pyo3(signature = (path, format="auto"))]
+pub fn read_point_cloud(py: Python<'_>, path: PathBuf, format: &str) -> PyResult<PyCloudFile> {
+    let format = cloud_format(py, format)?;
+    let name = path.display().to_string();
+    let data = run_detached(py, move || io::read_point_cloud(&path, format))?;
+    Ok(PyCloudFile::new(data, name))
+}
+
+/// What `write_point_cloud` accepts: a `CloudFile`, a `PointCloud` (its points and
+/// sensor covariances) or an `(n, 3)` array-like.
+fn cloud_data_from(obj: &Bound<'_, PyAny>) -> PyResult<CloudData> {
+    if let Ok(f) = obj.cast::<PyCloudFile>() {
+        return Ok((*f.get().data).clone());
+    }
+    if let Ok(c) = obj.cast::<PyPointCloud>() {
+        let inner: &PointCloud = &c.get().inner;
+        let mut data = CloudData::from_points(inner.points().to_vec());
+        let sensor = inner.sensor_covariances();
+        if sensor.iter().any(|m| *m != Matrix3::zeros()) {
+            data.covariances = Some(sensor.to_vec());
+            data.fields.extend(
+                ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"].map(String::from),
+            );
+        }
+        return Ok(data);
+    }
+    Ok(CloudData::from_points(points_from(obj, "cloud")?))
+}
+
+/// Writes a point cloud (`CloudFile`, `PointCloud` or `(n, 3)` array-like).
+#[pyfunction]
+#[pyo3(signature = (path, cloud, format="auto", *, encoding=None, write_ascii=false, compressed=false))]
+pub fn write_point_cloud(
+    py: Python<'_>,
+    path: PathBuf,
+    cloud: &Bound<'_, PyAny>,
+    format: &str,
+    encoding: Option<&str>,
+    write_ascii: bool,
+    compressed: bool,
+) -> PyResult<()> {
+    let format = cloud_format(py, format)?;
+    let encoding = encoding_from(py, encoding, write_ascii, compressed)?;
+    let data = cloud_data_from(cloud)?;
+    run_detached(py, move || {
+        io::write_point_cloud(&path, &data, format, encoding)
+    })
+}
+
+/// Reads a mesh file (STL, OBJ, PLY, OFF); returns the mesh and the number of
+/// faces dropped because they repeat a vertex.
+#[pyfunction]
+#[pyo3(signature = (path, format="auto"))]
+pub fn read_mesh(py: Python<'_>, path: PathBuf, format: &str) -> PyResult<(PyMesh, usize)> {
+    let format = mesh_format(py, format)?;
+    let data = run_detached(py, move || io::read_mesh(&path, format))?;
+    Ok((PyMesh::wrap(data.mesh), data.dropped_faces))
+}
+
+/// Writes a mesh (STL ascii/binary, OBJ, PLY ascii/binary, OFF).
+#[pyfunction]
+#[pyo3(signature = (path, mesh, format="auto", *, encoding=None, write_ascii=false))]
+pub fn write_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    mesh: &Bound<'_, PyMesh>,
+    format: &str,
+    encoding: Option<&str>,
+    write_ascii: bool,
+) -> PyResult<()> {
+    let format = mesh_format(py, format)?;
+    let encoding = encoding_from(py, encoding, write_ascii, false)?;
+    let mesh = Arc::clone(&mesh.get().inner);
+    run_detached(py, move || io::write_mesh(&path, &mesh, format, encoding))
+}

@@ -1,0 +1,154 @@
+"""Reading and writing point clouds and meshes.
+
+Point clouds: PLY (ascii, binary little/big endian), PCD (ascii, binary,
+binary_compressed; organized or not), XYZ/CSV, NPY, and LAS/LAZ (read only).
+Meshes: STL (ascii, binary), OBJ, PLY, OFF. ROS ``sensor_msgs/PointCloud2``
+messages are read from their raw bytes and field layout, no ROS needed.
+
+The parsers are the Rust core's (``cloudprox::io``); they release the GIL. A
+missing file raises ``FileNotFoundError``; a corrupt, truncated or unsupported
+file raises :class:`cloudprox.FormatError` naming the file and the problem.
+Points with a NaN or infinite coordinate (the holes of an organized depth image)
+are skipped and counted in :attr:`CloudFile.skipped`, never dropped silently.
+
+Examples
+--------
+>>> import cloudprox as cp
+>>> scan = cp.io.read_point_cloud("scan.pcd")  # doctest: +SKIP
+>>> cloud = scan.to_point_cloud(sensor=cp.DepthCamera())  # noise seen from the file's VIEWPOINT
+>>> gripper = cp.io.read_mesh("gripper.stl")  # doctest: +SKIP
+>>> cp.collide(gripper, cloud, pose_a=grasp).probability  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from typing import Literal
+
+from cloudprox._native import CloudFile, Mesh
+from cloudprox._native import read_mesh as _read_mesh
+from cloudprox._native import read_point_cloud as _read_point_cloud
+from cloudprox._native import write_mesh as _write_mesh
+from cloudprox._native import write_point_cloud as _write_point_cloud
+from cloudprox.exceptions import DegenerateFacesWarning
+
+__all__ = [
+    "CloudFile",
+    "DegenerateFacesWarning",
+    "read_mesh",
+    "read_point_cloud",
+    "write_mesh",
+    "write_point_cloud",
+]
+
+CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
+MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
+EncodingName = Literal["ascii", "binary", "binary_big_endian", "binary_compressed"]
+PathLike = str | os.PathLike[str]
+
+
+def read_point_cloud(path: PathLike, format: CloudFormatName = "auto") -> CloudFile:
+    """Read a point-cloud file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    format : str, default "auto"
+        ``"auto"`` picks the format from the extension (``.ply .pcd .xyz .txt
+        .pts .csv .npy .las .laz``).
+
+    Returns
+    -------
+    CloudFile
+        Points ``(n, 3)`` with finite coordinates, and what else the file holds:
+        normals, covariances, the sensor pose (PCD ``VIEWPOINT``), the organized
+        layout, the field names and the number of skipped non-finite points.
+        ``CloudFile.to_point_cloud(...)`` makes a :class:`cloudprox.PointCloud`.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    cloudprox.FormatError
+        If its content is corrupt, truncated or unsupported (the message names
+        the file and the problem).
+    cloudprox.InvalidInputError
+        If the format cannot be told from the extension or is unknown.
+    """
+    return _read_point_cloud(os.fspath(path), format)
+
+
+def write_point_cloud(
+    path: PathLike,
+    cloud: object,
+    format: CloudFormatName = "auto",
+    *,
+    encoding: EncodingName | None = None,
+    write_ascii: bool = False,
+    compressed: bool = False,
+) -> None:
+    """Write a point cloud.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file; its extension gives the format unless ``format`` does.
+    cloud : CloudFile, PointCloud or array_like of shape (n, 3)
+        What to write. A ``PointCloud`` writes its points and its sensor
+        covariances (as ``cov_xx ... cov_zz`` fields in PLY and PCD) when they are
+        not zero; a ``CloudFile`` writes everything it holds.
+    format : str, default "auto"
+        As in :func:`read_point_cloud`; LAS/LAZ cannot be written.
+    encoding : {"ascii", "binary", "binary_big_endian", "binary_compressed"}, optional
+        PLY: ascii, binary (little endian) or binary_big_endian. PCD: ascii,
+        binary or binary_compressed. Default binary.
+    write_ascii, compressed : bool
+        Open3D's spelling of ``encoding="ascii"`` and
+        ``encoding="binary_compressed"``.
+    """
+    _write_point_cloud(
+        os.fspath(path),
+        cloud,
+        format,
+        encoding=encoding,
+        write_ascii=write_ascii,
+        compressed=compressed,
+    )
+
+
+def read_mesh(path: PathLike, format: MeshFormatName = "auto") -> Mesh:
+    """Read a triangle mesh (STL ascii/binary, OBJ, PLY, OFF).
+
+    Polygons are split into fans of triangles and STL vertices are welded.
+    Triangles that repeat a vertex are dropped with a
+    :class:`DegenerateFacesWarning` giving their number.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    cloudprox.FormatError
+        If its content is corrupt, truncated or unsupported.
+    """
+    mesh, dropped = _read_mesh(os.fspath(path), format)
+    if dropped:
+        warnings.warn(
+            f"{os.fspath(path)}: dropped {dropped} degenerate face(s) that repeat a vertex",
+            DegenerateFacesWarning,
+            stacklevel=2,
+        )
+    return mesh
+
+
+def write_mesh(
+    path: PathLike,
+    mesh: Mesh,
+    format: MeshFormatName = "auto",
+    *,
+    encoding: EncodingName | None = None,
+    write_ascii: bool = False,
+) -> None:
+    """Write a triangle mesh (STL and PLY: binary unless ascii is asked for)."""
+    _write_mesh(os.fspath(path), mesh, format, encoding=encoding, write_ascii=write_ascii)
