@@ -147,6 +147,12 @@ class PointCloud:
     @property
     def sigma_max(self) -> _FloatArray:
         """Per-point largest standard deviation over all directions, shape ``(n,)``."""
+    @property
+    def spacing(self) -> _FloatArray:
+        """Per-point sampling spacing ``(n,)``: the distance to the 6th nearest neighbour."""
+    @property
+    def sensor_covariances(self) -> _FloatArray:
+        """Per-point sensor covariances (without the discretization part), ``(n, 3, 3)``."""
     def transformed(self, transform: npt.ArrayLike) -> PointCloud:
         """Return a copy moved by a rigid transform.
 

@@ -3,8 +3,11 @@
 ``cloudprox demo``
     A piano lowered over a table in a room, at several exact gaps: a table of
     ``P`` and states, and a figure.
-``cloudprox collide A.npy B.npy --sigma S``
-    One query between two ``(n, 3)`` arrays saved with ``numpy.save``.
+``cloudprox collide A B [--sigma S | --sensor ...] [--pose-a P] [--filter STEP]``
+    One query between two files: point clouds (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ)
+    or meshes (STL, OBJ, OFF, PLY with faces).
+``cloudprox info FILE``
+    A summary of a point-cloud or mesh file.
 ``cloudprox bench``
     cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
 ``cloudprox reproduce [--quick] [--out DIR]``
@@ -176,53 +179,77 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------ collide
 
 
-def _load_array(path: str, what: str) -> np.ndarray:
-    p = Path(path)
-    if not p.exists():
-        raise CliError(f"{what}: no such file: {path}")
-    if p.is_dir():
-        raise CliError(f"{what}: {path} is a directory, expected a .npy file")
-    try:
-        with p.open("rb") as f:
-            magic = f.read(6)
-        if magic[:4] == b"PK\x03\x04":
-            raise CliError(f"{what}: {path} is an .npz archive, expected a single .npy array")
-        if magic != b"\x93NUMPY":
-            raise CliError(f"{what}: {path} is not a .npy file (no NumPy header)")
-        data = np.load(p, allow_pickle=False)
-    except (ValueError, OSError, EOFError) as e:
-        raise CliError(f"{what}: {path} is not a readable .npy file ({e})") from None
-    if not isinstance(data, np.ndarray):
-        raise CliError(f"{what}: {path} does not hold an array")
-    return data
+def _sensor_spec(args: argparse.Namespace) -> Any:
+    from cloudprox.pipeline import sensor_spec
+
+    params = {
+        k: getattr(args, k)
+        for k in (
+            "axial_offset",
+            "axial_quadratic",
+            "axial_depth0",
+            "focal_px",
+            "sigma_px",
+            "baseline",
+            "sigma_disparity_px",
+            "sigma_range",
+            "sigma_angle",
+        )
+    }
+    return sensor_spec(
+        args.sensor,
+        sigma=args.sigma,
+        params=params,
+        preset=args.preset,
+        origin=args.origin,
+        sensor_pose=args.sensor_pose,
+    )
 
 
 def _cmd_collide(args: argparse.Namespace) -> int:
-    clouds = []
-    for path, sigma, what in ((args.a, args.sigma, "A"), (args.b, args.sigma_b, "B")):
-        points = _load_array(path, what)
-        try:
-            clouds.append(PointCloud(points, sigma=args.sigma if sigma is None else sigma))
-        except CloudproxError as e:
-            raise CliError(f"{what} ({path}): {e}") from None
-    poses = []
-    for path, what in ((args.pose_a, "pose A"), (args.pose_b, "pose B")):
-        poses.append(None if path is None else _load_array(path, what))
-    options = {
+    from cloudprox.pipeline import PipelineError, load_side, parse_filter, parse_pose
+
+    try:
+        sensor = _sensor_spec(args)
+        steps = [parse_filter(f) for f in args.filter]
+        sides = [
+            load_side(args.a, sensor, steps),
+            load_side(args.b, sensor, steps, sigma_override=args.sigma_b),
+        ]
+        poses = [
+            None if text is None else parse_pose(text, what)
+            for text, what in ((args.pose_a, "--pose-a"), (args.pose_b, "--pose-b"))
+        ]
+    except (PipelineError, FileNotFoundError) as e:
+        raise CliError(str(e)) from None
+    options: dict[str, Any] = {
         k: getattr(args, k)
-        for k in ("surface", "aggregation", "solver")
+        for k in ("surface", "aggregation", "solver", "mesh_spacing")
         if getattr(args, k) is not None
     }
-    try:
-        result = collide(clouds[0], clouds[1], poses[0], poses[1], **options)
-    except CloudproxError as e:
-        raise CliError(str(e)) from None
+    result = collide(sides[0].obj, sides[1].obj, poses[0], poses[1], **options)
     if args.json:
-        print(json.dumps(result_to_dict(result), indent=2))
+        doc = result_to_dict(result) | {"a": sides[0].summary(), "b": sides[1].summary()}
+        print(json.dumps(doc, indent=2))
         return 0
     console = _console()
     style = {"free": "green", "contact": "yellow", "collision": "red"}[result.state]
-    console.print(f"A: {args.a} ({len(clouds[0])} points)   B: {args.b} ({len(clouds[1])} points)")
+    for name, side in zip("AB", sides, strict=True):
+        if side.mesh is not None:
+            console.print(
+                f"{name}: {side.path} (mesh: {len(side.mesh.vertices)} vertices, "
+                f"{len(side.mesh.faces)} faces)"
+            )
+        else:
+            assert side.cloud is not None
+            steps_text = "".join(
+                f", {f['filter']} -> {f['after']}" for f in side.filters
+            )
+            skipped = f", {side.skipped} non-finite skipped" if side.skipped else ""
+            console.print(
+                f"{name}: {side.path} ({side.read_points} points{skipped}{steps_text}; "
+                f"{len(side.cloud)} queried)"
+            )
     console.print(
         f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
         f"regions: {len(result.regions)}   time: {1e3 * result.stats['time_seconds']:.2f} ms"
@@ -239,6 +266,98 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
     )
     console.print(f"stats: {stats}")
+    return 0
+
+
+# --------------------------------------------------------------------------- info
+
+
+def file_info(path: str) -> dict[str, Any]:
+    """A plain-JSON summary of a point-cloud or mesh file.
+
+    Point clouds: format, points, non-finite points skipped, organized layout,
+    fields, bounds, sensor pose and the estimated sampling spacing (median and
+    5th/95th percentiles of each point's distance to its 6th nearest neighbour).
+    Meshes: vertices, faces (dropped degenerate ones), bounds, area, volume,
+    whether closed.
+    """
+    import warnings
+
+    from cloudprox import io
+    from cloudprox.pipeline import _is_mesh_file
+
+    p = Path(path)
+    if not p.exists():
+        raise CliError(f"{path}: no such file")
+    if p.is_dir():
+        raise CliError(f"{path} is a directory, expected a point-cloud or mesh file")
+    info: dict[str, Any] = {"path": path, "format": p.suffix.lower().lstrip(".")}
+    if _is_mesh_file(path):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            mesh = io.read_mesh(path)
+        lo, hi = mesh.bounds()
+        info |= {
+            "kind": "mesh",
+            "vertices": len(mesh.vertices),
+            "faces": len(mesh.faces),
+            "warnings": [str(w.message) for w in caught],
+            "bounds": [lo.tolist(), hi.tolist()],
+            "area_m2": mesh.area,
+            "closed": mesh.is_closed,
+            "volume_m3": mesh.volume if mesh.is_closed else None,
+        }
+        return info
+    scan = io.read_point_cloud(path)
+    pts = np.asarray(scan.points)
+    info |= {
+        "kind": "point cloud",
+        "points": len(pts),
+        "skipped_non_finite": scan.skipped,
+        "organized": None if scan.grid_shape is None else list(scan.grid_shape),
+        "fields": scan.fields,
+        "has_normals": scan.normals is not None,
+        "has_covariances": scan.covariances is not None,
+        "sensor_pose": None if scan.sensor_pose is None else np.asarray(scan.sensor_pose).tolist(),
+    }
+    if len(pts):
+        info["bounds"] = [pts.min(axis=0).tolist(), pts.max(axis=0).tolist()]
+    if len(pts) >= 7:
+        spacing = np.asarray(PointCloud(pts, sigma=0.0).spacing)
+        q05, q50, q95 = np.percentile(spacing, [5, 50, 95])
+        info["spacing_m"] = {"median": q50, "p05": q05, "p95": q95}
+    return info
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    info = file_info(args.file)
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    console = _console()
+    console.print(f"[bold]{info['path']}[/bold]: {info['kind']} ({info['format'].upper()})")
+    for key, value in info.items():
+        if key in ("path", "kind", "format"):
+            continue
+        if key == "bounds":
+            lo, hi = value
+            value = (
+                "["
+                + ", ".join(f"{x:.4g}" for x in lo)
+                + "] .. ["
+                + ", ".join(f"{x:.4g}" for x in hi)
+                + "]"
+            )
+        elif key == "spacing_m":
+            value = (
+                f"median {1e3 * value['median']:.3g} mm "
+                f"(5%: {1e3 * value['p05']:.3g}, 95%: {1e3 * value['p95']:.3g})"
+            )
+        elif key == "sensor_pose" and value is not None:
+            value = "origin (" + ", ".join(f"{row[3]:.4g}" for row in value[:3]) + ")"
+        elif key == "fields":
+            value = " ".join(value)
+        console.print(f"  {key.replace('_', ' ')}: {value}")
     return 0
 
 
@@ -415,18 +534,71 @@ def _parser() -> argparse.ArgumentParser:
     )
     demo.set_defaults(func=_cmd_demo)
 
-    col = sub.add_parser("collide", help="one query between two .npy point arrays")
-    col.add_argument("a", metavar="A.npy", help="(n, 3) array of cloud A's points (metres)")
-    col.add_argument("b", metavar="B.npy", help="(m, 3) array of cloud B's points (metres)")
-    col.add_argument(
-        "--sigma",
-        type=float,
-        required=True,
-        help="noise standard deviation of A (and of B unless --sigma-b) in metres",
+    col = sub.add_parser(
+        "collide",
+        help="one query between two files (point clouds or meshes)",
+        description=(
+            "One query between A and B. Each is a point-cloud file (PLY, PCD, XYZ/CSV, NPY, "
+            "LAS/LAZ) or a mesh file (STL, OBJ, OFF, PLY with faces). Cloud sides get their "
+            "noise from --sigma, --sensor, or the covariances stored in the file, then go "
+            "through the --filter steps in order."
+        ),
     )
-    col.add_argument("--sigma-b", type=float, default=None, help="noise standard deviation of B")
-    col.add_argument("--pose-a", default=None, metavar="FILE.npy", help="(4, 4) pose of A")
-    col.add_argument("--pose-b", default=None, metavar="FILE.npy", help="(4, 4) pose of B")
+    col.add_argument("a", metavar="A", help="point-cloud or mesh file of side A")
+    col.add_argument("b", metavar="B", help="point-cloud or mesh file of side B")
+    col.add_argument(
+        "--sigma", type=float, default=None, help="isotropic noise standard deviation (metres)"
+    )
+    col.add_argument(
+        "--sigma-b", type=float, default=None, help="isotropic noise of B (overrides for B)"
+    )
+    sensor = col.add_argument_group("sensor model (per-point noise along the viewing rays)")
+    sensor.add_argument("--sensor", choices=["isotropic", "depth-camera", "stereo", "lidar"])
+    sensor.add_argument(
+        "--preset",
+        choices=["khoshelham-2012", "nguyen-2012"],
+        help="depth camera: published fit (default khoshelham-2012: 1.425e-3 z^2)",
+    )
+    sensor.add_argument("--origin", metavar="X,Y,Z", help="sensor origin in the cloud's frame")
+    sensor.add_argument(
+        "--sensor-pose",
+        metavar="POSE",
+        help="sensor pose (optical axis +z); default: the file's VIEWPOINT",
+    )
+    for flag, text in (
+        ("--axial-offset", "depth camera: constant axial std (m)"),
+        ("--axial-quadratic", "depth camera: quadratic axial coefficient (1/m)"),
+        ("--axial-depth0", "depth camera: depth where the quadratic term vanishes (m)"),
+        ("--focal-px", "depth/stereo camera: focal length (px)"),
+        ("--sigma-px", "depth/stereo camera: lateral std (px)"),
+        ("--baseline", "stereo: baseline (m)"),
+        ("--sigma-disparity-px", "stereo: disparity std (px)"),
+        ("--sigma-range", "lidar: range std (m)"),
+        ("--sigma-angle", "lidar: angular std (rad)"),
+    ):
+        sensor.add_argument(flag, type=float, default=None, help=text)
+    col.add_argument(
+        "--pose-a",
+        default=None,
+        metavar="POSE",
+        help="pose of A: a .npy (4, 4) or text file, or x,y,z or x,y,z,qw,qx,qy,qz",
+    )
+    col.add_argument("--pose-b", default=None, metavar="POSE", help="pose of B (as --pose-a)")
+    col.add_argument(
+        "--filter",
+        action="append",
+        default=[],
+        metavar="STEP",
+        help="filter step for point-cloud sides, in order (repeatable): "
+        "crop:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX | voxel:SIZE | outliers[:K[:STD]] | "
+        "shadow[:MIN_ANGLE_DEG] | self:MESH[:PADDING[:POSE]]",
+    )
+    col.add_argument(
+        "--mesh-spacing",
+        type=float,
+        default=None,
+        help="sampling spacing of a mesh side (m; default half the cloud's spacing)",
+    )
     col.add_argument(
         "--surface",
         choices=names["surface"],
@@ -447,6 +619,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     col.add_argument("--json", action="store_true", help="print the result as JSON")
     col.set_defaults(func=_cmd_collide)
+
+    info = sub.add_parser(
+        "info", help="summarize a point-cloud or mesh file (points, bounds, fields, spacing)"
+    )
+    info.add_argument("file", metavar="FILE", help="point-cloud or mesh file")
+    info.add_argument("--json", action="store_true", help="print the summary as JSON")
+    info.set_defaults(func=_cmd_info)
 
     bench = sub.add_parser("bench", help="cloudprox against comparison engines")
     bench.add_argument(
@@ -508,7 +687,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_usage(sys.stderr)
         print(
-            "cloudprox: error: a command is required (demo, collide, bench or reproduce)",
+            "cloudprox: error: a command is required (demo, collide, info, bench or reproduce)",
             file=sys.stderr,
         )
         return 2

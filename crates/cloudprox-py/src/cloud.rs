@@ -173,6 +173,22 @@ impl PyPointCloud {
         vec_to_py(py, self.inner.sigma_max())
     }
 
+    /// Per-point sampling spacing, shape `(n,)`: the distance to the 6th nearest
+    /// neighbour (computed on first use, without the GIL).
+    #[getter]
+    fn spacing<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let inner = Arc::clone(&self.inner);
+        let s = run_detached(py, move || Ok(inner.spacing().to_vec()))?;
+        Ok(PyArray1::from_vec(py, s))
+    }
+
+    /// Per-point sensor covariances (without the discretization part), shape
+    /// `(n, 3, 3)`.
+    #[getter]
+    fn sensor_covariances<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        matrices3_to_py(py, self.inner.sensor_covariances())
+    }
+
     /// A new cloud moved by the `(4, 4)` rigid transform `transform`.
     fn transformed(&self, py: Python<'_>, transform: &Bound<'_, PyAny>) -> PyResult<Self> {
         let pose = pose_from(py, Some(transform), "transform")?;

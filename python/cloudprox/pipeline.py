@@ -1,0 +1,411 @@
+"""From files to query sides: parse poses, sensors and filter steps; load a side.
+
+This is the glue of ``cloudprox collide A B``: a side is a mesh file (STL, OBJ,
+OFF, or a PLY with faces) or a point-cloud file (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ).
+A cloud side goes through
+
+1. reading (:func:`cloudprox.io.read_point_cloud`; non-finite points skipped and
+   counted);
+2. the sensor covariances of every point (a sensor model seen from the file's
+   ``VIEWPOINT`` or the given origin / sensor pose, an isotropic sigma, or the
+   covariances stored in the file);
+3. the filter steps, in order (each one subsets the points, their covariances
+   and pixels; voxel downsampling merges covariances);
+4. a :class:`cloudprox.PointCloud` with the discretization part added.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from cloudprox import filters, io
+from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera
+
+__all__ = [
+    "MESH_EXTENSIONS",
+    "PipelineError",
+    "FilterStep",
+    "LoadedSide",
+    "SensorSpec",
+    "load_side",
+    "parse_filter",
+    "parse_pose",
+    "parse_vector",
+    "sensor_spec",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Extensions always read as meshes (``.ply`` is a mesh when it has faces).
+MESH_EXTENSIONS = frozenset({".stl", ".obj", ".off"})
+
+SENSORS = ("isotropic", "depth-camera", "stereo", "lidar")
+FILTERS = ("crop", "voxel", "outliers", "shadow", "self")
+
+
+class PipelineError(ValueError):
+    """A user error in a pose, a sensor or a filter step (the message says which)."""
+
+
+def parse_vector(text: str, n: int, what: str) -> FloatArray:
+    """``n`` numbers separated by commas or spaces."""
+    parts = [p for p in text.replace(",", " ").split() if p]
+    try:
+        values = np.array([float(p) for p in parts], dtype=np.float64)
+    except ValueError:
+        raise PipelineError(f"{what}: expected {n} numbers, got {text!r}") from None
+    if len(values) != n or not np.all(np.isfinite(values)):
+        raise PipelineError(f"{what}: expected {n} finite numbers, got {text!r}")
+    return values
+
+
+def _quaternion_matrix(w: float, x: float, y: float, z: float, what: str) -> FloatArray:
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
+    if not norm > 0.0:
+        raise PipelineError(f"{what}: the quaternion (w x y z) is zero")
+    w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def parse_pose(text: str, what: str) -> FloatArray:
+    """A ``(4, 4)`` pose from a file or inline numbers.
+
+    Accepted: a ``.npy`` file holding a ``(4, 4)`` array; a text file of 16
+    numbers (row-major); inline ``"x,y,z"`` (a translation), ``"x,y,z,qw,qx,qy,qz"``
+    (translation and unit quaternion) or 16 numbers (row-major matrix).
+    """
+    path = Path(text)
+    if path.suffix.lower() == ".npy" or path.is_file():
+        if not path.is_file():
+            raise PipelineError(f"{what}: no such file: {text}")
+        if path.suffix.lower() == ".npy":
+            try:
+                m = np.load(path, allow_pickle=False)
+            except (ValueError, OSError) as e:
+                raise PipelineError(f"{what}: {text} is not a readable .npy file ({e})") from None
+        else:
+            try:
+                m = np.loadtxt(path, dtype=np.float64, ndmin=1)
+            except ValueError as e:
+                raise PipelineError(f"{what}: {text} is not a text file of numbers ({e})") from None
+        m = np.asarray(m, dtype=np.float64)
+        if m.size != 16:
+            raise PipelineError(f"{what}: {text} must hold a (4, 4) matrix, got shape {m.shape}")
+        return m.reshape(4, 4)
+    parts = [p for p in text.replace(",", " ").split() if p]
+    values = parse_vector(text, len(parts), what) if parts else np.zeros(0)
+    pose = np.eye(4)
+    if len(values) == 3:
+        pose[:3, 3] = values
+    elif len(values) == 7:
+        pose[:3, 3] = values[:3]
+        pose[:3, :3] = _quaternion_matrix(*values[3:], what=what)
+    elif len(values) == 16:
+        pose = values.reshape(4, 4)
+    else:
+        raise PipelineError(
+            f"{what}: expected a pose file, or 3 (x,y,z), 7 (x,y,z,qw,qx,qy,qz) or 16 numbers, "
+            f"got {text!r}"
+        )
+    return pose
+
+
+@dataclass(frozen=True)
+class SensorSpec:
+    """How noisy a cloud side is: a sensor model and where it sits, or a sigma."""
+
+    kind: str = "isotropic"
+    sigma: float | None = None
+    model: DepthCamera | StereoCamera | Lidar | None = None
+    origin: FloatArray | None = None
+    sensor_pose: FloatArray | None = None
+
+    def covariances(self, scan: io.CloudFile, points: FloatArray) -> FloatArray | None:
+        """Sensor covariances ``(n, 3, 3)`` of ``points`` read from ``scan``, or ``None``
+        when the noise is an isotropic sigma (applied later)."""
+        if self.model is None:
+            if self.sigma is None:
+                if scan.covariances is None:
+                    raise PipelineError(
+                        f"{scan.path}: no noise given and the file stores no covariances: "
+                        "give --sigma or --sensor"
+                    )
+                return np.asarray(scan.covariances)
+            return None
+        if self.origin is not None:
+            return self.model.covariances(points, origin=self.origin)
+        pose = self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
+        if pose is None:
+            raise PipelineError(
+                f"{scan.path} records no sensor viewpoint: give --origin or --sensor-pose "
+                f"for --sensor {self.kind}"
+            )
+        return self.model.covariances(points, sensor_pose=pose)
+
+    def sensor_origin(self, scan: io.CloudFile) -> FloatArray | None:
+        """Where the sensor sits (for the shadow filter), if known."""
+        if self.origin is not None:
+            return self.origin
+        pose = self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
+        return None if pose is None else np.asarray(pose)[:3, 3]
+
+
+@dataclass(frozen=True)
+class FilterStep:
+    """One ``--filter`` step: its name and arguments."""
+
+    name: str
+    args: tuple[str, ...] = ()
+
+    def describe(self) -> str:
+        return self.name + "".join(f":{a}" for a in self.args)
+
+
+def parse_filter(text: str) -> FilterStep:
+    """A filter step ``NAME[:ARG[:ARG...]]``.
+
+    ``crop:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX``, ``voxel:SIZE``, ``outliers[:K[:STD]]``,
+    ``shadow[:MIN_ANGLE_DEG]``, ``self:MESH_FILE[:PADDING[:POSE]]``.
+    """
+    name, *args = text.split(":", 2) if text.startswith("self:") else text.split(":")
+    if name not in FILTERS:
+        raise PipelineError(f"unknown filter {name!r} in {text!r}; known: {', '.join(FILTERS)}")
+    step = FilterStep(name, tuple(args))
+    if name == "crop" and len(args) != 1:
+        raise PipelineError(f"crop needs 6 numbers: crop:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX ({text!r})")
+    if name == "voxel" and len(args) != 1:
+        raise PipelineError(f"voxel needs a size in metres: voxel:SIZE ({text!r})")
+    if name == "outliers" and len(args) > 2:
+        raise PipelineError(f"outliers takes at most K and STD: outliers:K:STD ({text!r})")
+    if name == "shadow" and len(args) > 1:
+        raise PipelineError(f"shadow takes at most an angle: shadow:MIN_ANGLE_DEG ({text!r})")
+    if name == "self" and not args:
+        raise PipelineError(f"self needs a mesh file: self:MESH[:PADDING[:POSE]] ({text!r})")
+    if name == "self" and len(args) == 2 and ":" in args[1]:
+        padding, pose = args[1].split(":", 1)
+        step = FilterStep(name, (args[0], padding, pose))
+    return step
+
+
+def _float(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise PipelineError(f"{what}: expected a number, got {text!r}") from None
+    return value
+
+
+def _int(text: str, what: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise PipelineError(f"{what}: expected an integer, got {text!r}") from None
+
+
+@dataclass
+class LoadedSide:
+    """A query side read from a file: a cloud or a mesh, and what happened to it."""
+
+    path: str
+    kind: str  # "cloud" or "mesh"
+    cloud: PointCloud | None = None
+    mesh: Mesh | None = None
+    read_points: int = 0
+    skipped: int = 0
+    filters: list[dict[str, Any]] = field(default_factory=list)
+    fields: list[str] = field(default_factory=list)
+
+    @property
+    def obj(self) -> PointCloud | Mesh:
+        """What goes into ``collide``."""
+        obj = self.cloud if self.cloud is not None else self.mesh
+        assert obj is not None
+        return obj
+
+    def summary(self) -> dict[str, Any]:
+        """Plain-JSON description."""
+        out: dict[str, Any] = {"path": self.path, "kind": self.kind}
+        if self.mesh is not None:
+            out |= {"vertices": len(self.mesh.vertices), "faces": len(self.mesh.faces)}
+        if self.cloud is not None:
+            out |= {
+                "points_read": self.read_points,
+                "skipped_non_finite": self.skipped,
+                "filters": self.filters,
+                "points": len(self.cloud),
+                "fields": self.fields,
+            }
+        return out
+
+
+def _is_mesh_file(path: str) -> bool:
+    suffix = Path(path).suffix.lower()
+    if suffix in MESH_EXTENSIONS:
+        return True
+    if suffix != ".ply":
+        return False
+    with open(path, "rb") as f:
+        head = f.read(4096)
+    return b"\nelement face " in head.split(b"end_header", 1)[0]
+
+
+def _read_mesh_quietly(path: str) -> tuple[Mesh, int]:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mesh = io.read_mesh(path)
+    dropped = sum(1 for w in caught if issubclass(w.category, io.DegenerateFacesWarning))
+    return mesh, dropped
+
+
+def _apply_filter(
+    step: FilterStep,
+    points: FloatArray,
+    covs: FloatArray | None,
+    pixels: npt.NDArray[np.int64] | None,
+    scan: io.CloudFile,
+    sensor: SensorSpec,
+) -> tuple[FloatArray, FloatArray | None, npt.NDArray[np.int64] | None]:
+    """One filter step on the side's points (and their covariances and pixels)."""
+    keep: npt.NDArray[np.int64]
+    if step.name == "crop":
+        box = parse_vector(step.args[0], 6, "crop")
+        keep = filters.crop_box(points, box[:3], box[3:])
+    elif step.name == "voxel":
+        size = _float(step.args[0], "voxel size")
+        new_points, new_covs, _ = filters.voxel_downsample(points, size, covariances=covs)
+        return new_points, new_covs, None
+    elif step.name == "outliers":
+        k = _int(step.args[0], "outliers K") if step.args else filters.SOR_DEFAULT_K
+        std = _float(step.args[1], "outliers STD") if len(step.args) > 1 else None
+        keep = filters.statistical_outlier_removal(
+            points, k=k, std_ratio=filters.SOR_DEFAULT_STD_RATIO if std is None else std
+        )
+    elif step.name == "shadow":
+        origin = sensor.sensor_origin(scan)
+        if origin is None:
+            raise PipelineError(
+                f"shadow filter on {scan.path}: the sensor origin is unknown (the file has no "
+                "VIEWPOINT): give --origin or --sensor-pose"
+            )
+        angle = _float(step.args[0], "shadow angle") if step.args else 10.0
+        grid = scan.grid_shape if pixels is not None else None
+        keep = filters.shadow_filter(
+            points, origin, pixels=pixels, grid_shape=grid, min_angle_deg=angle
+        )
+    else:  # self
+        mesh, _ = _read_mesh_quietly(step.args[0])
+        padding = _float(step.args[1], "self padding") if len(step.args) > 1 else 0.01
+        pose = parse_pose(step.args[2], "self pose") if len(step.args) > 2 else np.eye(4)
+        keep = filters.SelfFilter([(mesh, pose)], padding).apply(points)
+    return (
+        points[keep],
+        None if covs is None else covs[keep],
+        None if pixels is None else pixels[keep],
+    )
+
+
+def load_side(
+    path: str,
+    sensor: SensorSpec,
+    steps: list[FilterStep],
+    *,
+    sigma_override: float | None = None,
+) -> LoadedSide:
+    """Read one side of a query from ``path`` (see the module docs)."""
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise PipelineError(f"{path} is a directory, expected a point-cloud or mesh file")
+    if _is_mesh_file(path):
+        mesh, _ = _read_mesh_quietly(path)
+        return LoadedSide(path, "mesh", mesh=mesh)
+    scan = io.read_point_cloud(path)
+    side = LoadedSide(path, "cloud", read_points=len(scan) + scan.skipped, skipped=scan.skipped)
+    side.fields = scan.fields
+    points = np.asarray(scan.points)
+    if len(points) == 0:
+        raise PipelineError(f"{path}: no point with finite coordinates ({scan.skipped} skipped)")
+    spec = sensor if sigma_override is None else SensorSpec(sigma=sigma_override)
+    covs = spec.covariances(scan, points)
+    pixels = None if scan.pixels is None else np.asarray(scan.pixels)
+    for step in steps:
+        before = len(points)
+        points, covs, pixels = _apply_filter(step, points, covs, pixels, scan, spec)
+        side.filters.append({"filter": step.describe(), "before": before, "after": len(points)})
+        if len(points) == 0:
+            raise PipelineError(f"{path}: filter {step.describe()} removed every point")
+    if covs is not None:
+        side.cloud = PointCloud(points, cov=covs, discretization=True)
+    else:
+        side.cloud = PointCloud(points, sigma=spec.sigma, discretization=True)
+    return side
+
+
+def sensor_spec(
+    kind: str | None,
+    *,
+    sigma: float | None,
+    params: dict[str, float | None],
+    preset: str | None,
+    origin: str | None,
+    sensor_pose: str | None,
+) -> SensorSpec:
+    """The noise of the cloud sides from the CLI's options."""
+    o = None if origin is None else parse_vector(origin, 3, "--origin")
+    sp = None if sensor_pose is None else parse_pose(sensor_pose, "--sensor-pose")
+    if kind is None:
+        kind = "isotropic"
+    if kind == "isotropic":
+        if preset is not None or any(v is not None for v in params.values()):
+            raise PipelineError("sensor parameters need --sensor depth-camera, stereo or lidar")
+        return SensorSpec(kind, sigma=sigma, origin=o, sensor_pose=sp)
+    if sigma is not None:
+        raise PipelineError(f"--sigma is for --sensor isotropic, not {kind}")
+    given = {k: v for k, v in params.items() if v is not None}
+    allowed: dict[str, tuple[str, ...]] = {
+        "depth-camera": (
+            "axial_offset",
+            "axial_quadratic",
+            "axial_depth0",
+            "focal_px",
+            "sigma_px",
+        ),
+        "stereo": ("focal_px", "baseline", "sigma_disparity_px", "sigma_px"),
+        "lidar": ("sigma_range", "sigma_angle"),
+    }
+    extra = sorted(set(given) - set(allowed[kind]))
+    if extra:
+        flags = ", ".join("--" + e.replace("_", "-") for e in extra)
+        raise PipelineError(f"{flags} do not apply to --sensor {kind}")
+    model: DepthCamera | StereoCamera | Lidar
+    if kind == "depth-camera":
+        base = DepthCamera.nguyen_2012() if preset == "nguyen-2012" else DepthCamera()
+        values = {
+            "axial_offset": base.axial_offset,
+            "axial_quadratic": base.axial_quadratic,
+            "axial_depth0": base.axial_depth0,
+            "focal_px": base.focal_px,
+            "sigma_px": base.sigma_px,
+        } | given
+        model = DepthCamera(**values)
+    elif preset is not None:
+        raise PipelineError("--preset applies to --sensor depth-camera only")
+    elif kind == "stereo":
+        model = StereoCamera(**given)
+    else:
+        model = Lidar(**given)
+    return SensorSpec(kind, model=model, origin=o, sensor_pose=sp)
