@@ -2,6 +2,9 @@
 //! line), with `DATA ascii`, `binary` and `binary_compressed` (LZF, the
 //! uncompressed data stored field by field).
 //!
+//! Values are read as their declared type: an `F4` field is an `f32` in ascii
+//! data too (`0.1` reads as `0.1f32`).
+//!
 //! Reading: `x y z` are required (types `F4`, `F8` or any integer type);
 //! `normal_x normal_y normal_z` (or `nx ny nz`) become normals and `cov_xx
 //! cov_xy cov_xz cov_yy cov_yz cov_zz` covariances. Fields with `COUNT > 1`
@@ -14,8 +17,11 @@
 //! is not the identity `0 0 0 1 0 0 0` (PCL writes the identity when it knows no
 //! viewpoint, so the identity means "unknown").
 //!
-//! Writing: every field as `F8` (values round-trip exactly; note that PCL's
-//! typed conversions expect `F4` coordinates), `VIEWPOINT` from
+//! Writing: `x y z` and normals as `F4`, the type PCL's point types, Open3D
+//! and RViz read (Open3D reads `F8` binary values as 0), so coordinates
+//! round-trip within `f32` rounding (use PLY for exact `f64`); covariances as
+//! `F8` (exact; they are cloudprox's own fields, other readers skip them);
+//! `VIEWPOINT` from
 //! [`CloudData::sensor`] (identity when none), `WIDTH`/`HEIGHT` from
 //! [`CloudData::grid`] when it is present and every pixel holds a point (else
 //! `WIDTH n HEIGHT 1`).
@@ -26,7 +32,7 @@ use nalgebra::{Quaternion, Translation3, UnitQuaternion};
 
 use crate::error::{Error, Result};
 use crate::io::lzf;
-use crate::io::text::{parse_f64, show};
+use crate::io::text::{parse_f32, parse_f64, show};
 use crate::io::{ByteCursor, CloudData, CloudDataBuilder, Encoding};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 
@@ -520,6 +526,12 @@ fn read_ascii(
             Some(at)
         })
         .collect();
+    // Whether each column is an F4 field: those values are f32, as in binary data.
+    let single: Vec<bool> = h
+        .fields
+        .iter()
+        .flat_map(|f| std::iter::repeat(f.kind == b'F' && f.size == 4).take(f.count))
+        .collect();
     let mut cur = ByteCursor::new(body, name, FORMAT);
     let mut line_no = h.first_line - 1;
     let mut values = vec![0.0f64; columns];
@@ -541,7 +553,12 @@ fn read_ascii(
             .filter(|t| !t.is_empty())
         {
             if n < columns {
-                values[n] = parse_f64(tok).ok_or_else(|| {
+                let v = if single[n] {
+                    parse_f32(tok).map(f64::from)
+                } else {
+                    parse_f64(tok)
+                };
+                values[n] = v.ok_or_else(|| {
                     err(
                         name,
                         format!("line {line_no}: value '{}' is not a number", show(tok)),
@@ -565,9 +582,19 @@ fn read_ascii(
     Ok(())
 }
 
+/// Appends `v` as a little-endian float of `size` bytes (4 or 8).
+fn put(out: &mut Vec<u8>, v: f64, size: usize) {
+    if size == 4 {
+        out.extend_from_slice(&(v as f32).to_le_bytes());
+    } else {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
 /// Encodes a point cloud as PCD v0.7 (`Ascii` → `DATA ascii`,
 /// `BinaryLittleEndian` → `DATA binary`, `BinaryCompressed` →
-/// `DATA binary_compressed`); every field is `F8`.
+/// `DATA binary_compressed`): `x y z` and normals as `F4`, covariances as
+/// `F8` (see the module documentation).
 ///
 /// # Errors
 /// [`Error::InvalidInput`] for [`Encoding::BinaryBigEndian`] or when the
@@ -603,6 +630,12 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         names.extend_from_slice(&COV);
     }
     let k = names.len();
+    // Bytes per field: F4 for coordinates and normals, F8 for covariances.
+    let sizes: Vec<usize> = names
+        .iter()
+        .map(|n| if n.starts_with("cov_") { 8 } else { 4 })
+        .collect();
+    let step: usize = sizes.iter().sum();
     let (width, height) = match &cloud.grid {
         Some(g)
             if g.width.checked_mul(g.height) == Some(n)
@@ -620,7 +653,11 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         "# .PCD v0.7 - Point Cloud Data file format (written by cloudprox)\nVERSION 0.7\n",
     );
     let _ = writeln!(head, "FIELDS {}", names.join(" "));
-    let _ = writeln!(head, "SIZE{}", " 8".repeat(k));
+    head.push_str("SIZE");
+    for s in &sizes {
+        let _ = write!(head, " {s}");
+    }
+    head.push('\n');
     let _ = writeln!(head, "TYPE{}", " F".repeat(k));
     let _ = writeln!(head, "COUNT{}", " 1".repeat(k));
     let _ = writeln!(head, "WIDTH {width}\nHEIGHT {height}");
@@ -651,25 +688,36 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
     let mut out = head.into_bytes();
     match encoding {
         Encoding::Ascii => {
+            // Shortest forms that read back as the same f32 / f64.
             let mut text = String::new();
             for i in 0..n {
-                crate::io::text::push_row(&mut text, &row(i), ' ');
+                for (f, (v, &size)) in row(i).into_iter().zip(&sizes).enumerate() {
+                    let sep = if f == 0 { "" } else { " " };
+                    let _ = if size == 4 {
+                        write!(text, "{sep}{:?}", v as f32)
+                    } else {
+                        write!(text, "{sep}{v:?}")
+                    };
+                }
+                text.push('\n');
             }
             out.extend_from_slice(text.as_bytes());
         }
         Encoding::BinaryLittleEndian => {
+            out.reserve(n * step);
             for i in 0..n {
-                for v in row(i) {
-                    out.extend_from_slice(&v.to_le_bytes());
+                for (v, &size) in row(i).into_iter().zip(&sizes) {
+                    put(&mut out, v, size);
                 }
             }
         }
         _ => {
-            let mut raw = vec![0u8; n * k * 8];
-            for i in 0..n {
-                for (f, v) in row(i).into_iter().enumerate() {
-                    let at = (f * n + i) * 8;
-                    raw[at..at + 8].copy_from_slice(&v.to_le_bytes());
+            // Field by field: all values of field 0, then of field 1, ...
+            let mut raw = Vec::with_capacity(n * step);
+            let rows: Vec<Vec<f64>> = (0..n).map(row).collect();
+            for (f, &size) in sizes.iter().enumerate() {
+                for r in &rows {
+                    put(&mut raw, r[f], size);
                 }
             }
             let packed = lzf::compress(&raw);

@@ -71,6 +71,11 @@ pub(crate) fn parse_f64(token: &[u8]) -> Option<f64> {
     std::str::from_utf8(token).ok()?.trim().parse().ok()
 }
 
+/// Parses a float token as `f32` (the nearest `f32` to the decimal value).
+pub(crate) fn parse_f32(token: &[u8]) -> Option<f32> {
+    std::str::from_utf8(token).ok()?.trim().parse().ok()
+}
+
 /// Parses an integer token.
 pub(crate) fn parse_i64(token: &[u8]) -> Option<i64> {
     std::str::from_utf8(token).ok()?.trim().parse().ok()
