@@ -28,6 +28,7 @@ mod cloud_data;
 mod cursor;
 mod format;
 pub mod las;
+mod lzf;
 pub mod npy;
 pub mod obj;
 pub mod off;
@@ -35,6 +36,7 @@ pub mod pcd;
 pub mod ply;
 pub mod pointcloud2;
 pub mod stl;
+mod text;
 pub mod xyz;
 
 pub use cloud_data::{CloudData, CloudDataBuilder, Grid, MeshData};

@@ -1,22 +1,737 @@
-//! PCD (to be written).
+//! Point Cloud Library PCD, v0.7 (and v0.6, whose header has no `VERSION`
+//! line), with `DATA ascii`, `binary` and `binary_compressed` (LZF, the
+//! uncompressed data stored field by field).
+//!
+//! Values are read as their declared type: an `F4` field is an `f32` in ascii
+//! data too (`0.1` reads as `0.1f32`).
+//!
+//! Reading: `x y z` are required (types `F4`, `F8` or any integer type);
+//! `normal_x normal_y normal_z` (or `nx ny nz`) become normals and `cov_xx
+//! cov_xy cov_xz cov_yy cov_yz cov_zz` covariances. Fields with `COUNT > 1`
+//! (descriptors) and packed `rgb` are skipped but named in
+//! [`CloudData::fields`]. A cloud with `HEIGHT > 1` is organized: the pixel of
+//! each kept point is in [`CloudData::grid`], and NaN points (the holes of a
+//! depth image) are counted in [`CloudData::skipped`].
+//!
+//! `VIEWPOINT tx ty tz qw qx qy qz` becomes [`CloudData::sensor`] only when it
+//! is not the identity `0 0 0 1 0 0 0` (PCL writes the identity when it knows no
+//! viewpoint, so the identity means "unknown").
+//!
+//! Writing: `x y z` and normals as `F4`, the type PCL's point types, Open3D
+//! and RViz read (Open3D reads `F8` binary values as 0), so coordinates
+//! round-trip within `f32` rounding (use PLY for exact `f64`); covariances as
+//! `F8` (exact; they are cloudprox's own fields, other readers skip them);
+//! `VIEWPOINT` from
+//! [`CloudData::sensor`] (identity when none), `WIDTH`/`HEIGHT` from
+//! [`CloudData::grid`] when it is present and every pixel holds a point (else
+//! `WIDTH n HEIGHT 1`).
 
-#![allow(unused_variables)]
+use std::fmt::Write as _;
+
+use nalgebra::{Quaternion, Translation3, UnitQuaternion};
 
 use crate::error::{Error, Result};
-#[allow(unused_imports)]
-use crate::io::{CloudData, Encoding, MeshData};
-#[allow(unused_imports)]
-use crate::shape::Mesh;
+use crate::io::lzf;
+use crate::io::text::{parse_f32, parse_f64, show};
+use crate::io::{ByteCursor, CloudData, CloudDataBuilder, Encoding};
+use crate::math::{Matrix3, Point3, Pose, Vector3};
 
-fn todo(name: &str) -> Error {
-    Error::format(name, "PCD", "reader not written yet")
+const FORMAT: &str = "PCD";
+
+const COV: [&str; 6] = ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"];
+
+fn err(name: &str, problem: impl Into<String>) -> Error {
+    Error::format(name, FORMAT, problem)
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Data {
+    Ascii,
+    Binary,
+    Compressed,
+}
+
+#[derive(Debug, Clone)]
+struct Field {
+    name: String,
+    size: usize,
+    kind: u8,
+    count: usize,
+}
+
+#[derive(Debug)]
+struct Header {
+    fields: Vec<Field>,
+    width: usize,
+    height: usize,
+    points: usize,
+    viewpoint: Option<[f64; 7]>,
+    data: Data,
+    start: usize,
+    first_line: usize,
+}
+
+fn parse_usize(name: &str, line_no: usize, key: &str, w: &str) -> Result<usize> {
+    w.parse::<usize>().map_err(|_| {
+        err(
+            name,
+            format!(
+                "header line {line_no}: {key} must be a non-negative integer, found '{}'",
+                show(w.as_bytes())
+            ),
+        )
+    })
+}
+
+#[allow(clippy::too_many_lines)]
+fn parse_header(bytes: &[u8], name: &str) -> Result<Header> {
+    let mut cur = ByteCursor::new(bytes, name, FORMAT);
+    let mut names: Option<Vec<String>> = None;
+    let mut sizes: Option<Vec<usize>> = None;
+    let mut types: Option<Vec<u8>> = None;
+    let mut counts: Option<Vec<usize>> = None;
+    let mut width = None;
+    let mut height = None;
+    let mut points = None;
+    let mut viewpoint = None;
+    let mut line_no = 0;
+    let mut seen_keyword = false;
+    let data = loop {
+        line_no += 1;
+        let Some(raw) = cur.line() else {
+            return Err(err(
+                name,
+                if seen_keyword {
+                    "truncated header: no DATA line".to_string()
+                } else {
+                    "empty file (no PCD header)".to_string()
+                },
+            ));
+        };
+        let line = std::str::from_utf8(raw).map_err(|_| {
+            err(
+                name,
+                format!(
+                    "wrong magic or corrupt header: line {line_no} is not text ('{}')",
+                    show(raw)
+                ),
+            )
+        })?;
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some(&key) = words.first() else { continue };
+        if key.starts_with('#') {
+            continue;
+        }
+        let args = &words[1..];
+        let expect_n = |n: usize| -> Result<()> {
+            if args.len() == n {
+                Ok(())
+            } else {
+                Err(err(
+                    name,
+                    format!(
+                        "header line {line_no}: {key} needs {n} value(s), found {}: '{line}'",
+                        args.len()
+                    ),
+                ))
+            }
+        };
+        match key {
+            "VERSION" => {}
+            "FIELDS" | "COLUMNS" => {
+                if args.is_empty() {
+                    return Err(err(name, format!("header line {line_no}: FIELDS is empty")));
+                }
+                names = Some(args.iter().map(|s| (*s).to_string()).collect());
+            }
+            "SIZE" => {
+                sizes = Some(
+                    args.iter()
+                        .map(|w| parse_usize(name, line_no, "SIZE", w))
+                        .collect::<Result<_>>()?,
+                );
+            }
+            "TYPE" => {
+                types = Some(
+                    args.iter()
+                        .map(|w| match *w {
+                            "F" | "I" | "U" => Ok(w.as_bytes()[0]),
+                            _ => Err(err(
+                                name,
+                                format!(
+                                    "header line {line_no}: TYPE must be F, I or U, found '{}'",
+                                    show(w.as_bytes())
+                                ),
+                            )),
+                        })
+                        .collect::<Result<_>>()?,
+                );
+            }
+            "COUNT" => {
+                counts = Some(
+                    args.iter()
+                        .map(|w| parse_usize(name, line_no, "COUNT", w))
+                        .collect::<Result<_>>()?,
+                );
+            }
+            "WIDTH" => {
+                expect_n(1)?;
+                width = Some(parse_usize(name, line_no, "WIDTH", args[0])?);
+            }
+            "HEIGHT" => {
+                expect_n(1)?;
+                height = Some(parse_usize(name, line_no, "HEIGHT", args[0])?);
+            }
+            "POINTS" => {
+                expect_n(1)?;
+                points = Some(parse_usize(name, line_no, "POINTS", args[0])?);
+            }
+            "VIEWPOINT" => {
+                expect_n(7)?;
+                let mut v = [0.0; 7];
+                for (slot, w) in v.iter_mut().zip(args) {
+                    *slot = parse_f64(w.as_bytes())
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| {
+                            err(
+                                name,
+                                format!("header line {line_no}: VIEWPOINT value '{}' is not a finite number", show(w.as_bytes())),
+                            )
+                        })?;
+                }
+                viewpoint = Some(v);
+            }
+            "DATA" => {
+                expect_n(1)?;
+                break match args[0] {
+                    "ascii" => Data::Ascii,
+                    "binary" => Data::Binary,
+                    "binary_compressed" => Data::Compressed,
+                    other => {
+                        return Err(err(
+                            name,
+                            format!("header line {line_no}: unknown DATA '{}' (expected ascii, binary or binary_compressed)", show(other.as_bytes())),
+                        ))
+                    }
+                };
+            }
+            other => {
+                return Err(err(
+                    name,
+                    if seen_keyword {
+                        format!(
+                            "header line {line_no}: unknown keyword '{}'",
+                            show(other.as_bytes())
+                        )
+                    } else {
+                        format!("wrong magic: line {line_no} starts with '{}', not a PCD header keyword (VERSION, FIELDS, ...)", show(other.as_bytes()))
+                    },
+                ))
+            }
+        }
+        seen_keyword = true;
+    };
+    let names = names.ok_or_else(|| err(name, "header has no FIELDS line"))?;
+    let n = names.len();
+    let sizes = sizes.ok_or_else(|| err(name, "header has no SIZE line"))?;
+    let types = types.ok_or_else(|| err(name, "header has no TYPE line"))?;
+    let counts = counts.unwrap_or_else(|| vec![1; n]);
+    for (key, len) in [
+        ("SIZE", sizes.len()),
+        ("TYPE", types.len()),
+        ("COUNT", counts.len()),
+    ] {
+        if len != n {
+            return Err(err(
+                name,
+                format!("{key} has {len} values but FIELDS names {n} fields"),
+            ));
+        }
+    }
+    let mut fields = Vec::with_capacity(n);
+    for i in 0..n {
+        let (size, kind, count) = (sizes[i], types[i], counts[i]);
+        let ok = match kind {
+            b'F' => matches!(size, 4 | 8),
+            _ => matches!(size, 1 | 2 | 4 | 8),
+        };
+        if !ok {
+            return Err(err(
+                name,
+                format!(
+                    "field '{}' has TYPE {} with SIZE {size} (F needs 4 or 8, I and U need 1, 2, 4 or 8)",
+                    names[i], kind as char
+                ),
+            ));
+        }
+        if count == 0 {
+            return Err(err(name, format!("field '{}' has COUNT 0", names[i])));
+        }
+        fields.push(Field {
+            name: names[i].clone(),
+            size,
+            kind,
+            count,
+        });
+    }
+    let (width, height, points) = match (width, height, points) {
+        (Some(w), h, p) => {
+            let h = h.unwrap_or(1);
+            let wh = w
+                .checked_mul(h)
+                .ok_or_else(|| err(name, format!("WIDTH {w} x HEIGHT {h} overflows")))?;
+            let p = p.unwrap_or(wh);
+            if p != wh {
+                return Err(err(
+                    name,
+                    format!("POINTS {p} is not WIDTH {w} x HEIGHT {h} = {wh}"),
+                ));
+            }
+            (w, h, p)
+        }
+        (None, None, Some(p)) => (p, 1, p),
+        (None, Some(_), _) => return Err(err(name, "header has HEIGHT but no WIDTH line")),
+        (None, None, None) => return Err(err(name, "header has neither WIDTH nor POINTS")),
+    };
+    Ok(Header {
+        fields,
+        width,
+        height,
+        points,
+        viewpoint,
+        data,
+        start: cur.position(),
+        first_line: line_no + 1,
+    })
+}
+
+/// Reads one binary value as f64.
+fn value(b: &[u8], kind: u8) -> f64 {
+    let a = |n: usize| -> [u8; 8] {
+        let mut x = [0u8; 8];
+        x[..n].copy_from_slice(&b[..n]);
+        x
+    };
+    match (kind, b.len()) {
+        (b'F', 4) => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        (b'F', _) => f64::from_le_bytes(a(8)),
+        (b'I', 1) => f64::from(i8::from_le_bytes([b[0]])),
+        (b'I', 2) => f64::from(i16::from_le_bytes([b[0], b[1]])),
+        (b'I', 4) => f64::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        (b'I', _) => i64::from_le_bytes(a(8)) as f64,
+        (_, 1) => f64::from(b[0]),
+        (_, 2) => f64::from(u16::from_le_bytes([b[0], b[1]])),
+        (_, 4) => f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        _ => u64::from_le_bytes(a(8)) as f64,
+    }
+}
+
+/// Indices of the fields cloudprox reads: x y z, normals, covariances.
+struct Layout {
+    xyz: [usize; 3],
+    normals: Option<[usize; 3]>,
+    covs: Option<[usize; 6]>,
+}
+
+fn layout(h: &Header, name: &str) -> Result<Layout> {
+    let find = |n: &str| h.fields.iter().position(|f| f.name == n);
+    let names = || {
+        h.fields
+            .iter()
+            .map(|f| f.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut xyz = [0; 3];
+    for (slot, axis) in xyz.iter_mut().zip(["x", "y", "z"]) {
+        *slot = find(axis)
+            .ok_or_else(|| err(name, format!("no field '{axis}' (FIELDS {})", names())))?;
+        if h.fields[*slot].count != 1 {
+            return Err(err(
+                name,
+                format!(
+                    "field '{axis}' has COUNT {}, expected 1",
+                    h.fields[*slot].count
+                ),
+            ));
+        }
+    }
+    let group = |names: &[&str]| -> Option<Vec<usize>> {
+        names
+            .iter()
+            .map(|n| find(n).filter(|&i| h.fields[i].count == 1))
+            .collect()
+    };
+    let normals = group(&["normal_x", "normal_y", "normal_z"])
+        .or_else(|| group(&["nx", "ny", "nz"]))
+        .map(|v| [v[0], v[1], v[2]]);
+    let covs = group(&COV).map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]]);
+    Ok(Layout { xyz, normals, covs })
+}
+
+fn push_point(b: &mut CloudDataBuilder, l: &Layout, index: usize, v: &dyn Fn(usize) -> f64) {
+    let p = Point3::new(v(l.xyz[0]), v(l.xyz[1]), v(l.xyz[2]));
+    let n = l.normals.map(|n| Vector3::new(v(n[0]), v(n[1]), v(n[2])));
+    let c = l.covs.map(|c| {
+        let [xx, xy, xz, yy, yz, zz] = c.map(v);
+        Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+    });
+    b.push(index, p, n, c);
+}
+
+fn sensor(v: Option<[f64; 7]>, name: &str) -> Result<Option<Pose>> {
+    let Some(v) = v else { return Ok(None) };
+    if v == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0] {
+        return Ok(None);
+    }
+    let q = UnitQuaternion::try_new(Quaternion::new(v[3], v[4], v[5], v[6]), 1e-12)
+        .ok_or_else(|| err(name, "VIEWPOINT quaternion qw qx qy qz is zero"))?;
+    Ok(Some(Pose::from_parts(
+        Translation3::new(v[0], v[1], v[2]),
+        q,
+    )))
 }
 
 /// Reads a PCD file.
+///
+/// # Errors
+/// [`Error::Format`] naming the problem: not a PCD header, a missing or
+/// inconsistent header line (POINTS not WIDTH x HEIGHT, a bad SIZE/TYPE pair),
+/// no `x`/`y`/`z`, data shorter than the header says, a corrupt LZF stream or a
+/// decompressed size that differs from the header's, a non-numeric value.
 pub fn read_pcd(bytes: &[u8], name: &str) -> Result<CloudData> {
-    Err(todo(name))
+    let h = parse_header(bytes, name)?;
+    let l = layout(&h, name)?;
+    let body = &bytes[h.start..];
+    let fields = h.fields.iter().map(|f| f.name.clone()).collect();
+    let organized = (h.height > 1).then_some((h.width, h.height));
+    let cap = h.points.min(body.len() / 3);
+    let mut b = CloudDataBuilder::new(
+        fields,
+        organized,
+        l.normals.is_some(),
+        l.covs.is_some(),
+        cap,
+    );
+    b.set_sensor(sensor(h.viewpoint, name)?);
+    let step = h
+        .fields
+        .iter()
+        .try_fold(0usize, |s, f| s.checked_add(f.size.checked_mul(f.count)?))
+        .ok_or_else(|| err(name, "point size overflows"))?;
+    // Byte offset of each field inside a point record.
+    let offsets: Vec<usize> = h
+        .fields
+        .iter()
+        .scan(0, |o, f| {
+            let at = *o;
+            *o += f.size * f.count;
+            Some(at)
+        })
+        .collect();
+    let total = || {
+        h.points.checked_mul(step).ok_or_else(|| {
+            err(
+                name,
+                format!("POINTS {} x {step} bytes per point overflows", h.points),
+            )
+        })
+    };
+    match h.data {
+        Data::Ascii => read_ascii(body, &h, &l, name, &mut b)?,
+        Data::Binary => {
+            let need = total()?;
+            if body.len() < need {
+                return Err(err(
+                    name,
+                    format!(
+                        "truncated: {} points of {step} bytes need {need} bytes of binary data, found {}",
+                        h.points,
+                        body.len()
+                    ),
+                ));
+            }
+            for i in 0..h.points {
+                let rec = &body[i * step..(i + 1) * step];
+                push_point(&mut b, &l, i, &|f| {
+                    let o = offsets[f];
+                    value(&rec[o..o + h.fields[f].size], h.fields[f].kind)
+                });
+            }
+        }
+        Data::Compressed => {
+            let need = total()?;
+            let mut cur = ByteCursor::new(body, name, FORMAT);
+            let sizes = cur.u32_le().and_then(|c| Ok((c, cur.u32_le()?)));
+            let (csize, usize_) = sizes.map_err(|_| {
+                err(
+                    name,
+                    format!("truncated: binary_compressed data needs an 8-byte size header, found {} bytes", body.len()),
+                )
+            })?;
+            let (csize, usize_) = (csize as usize, usize_ as usize);
+            if usize_ != need {
+                return Err(err(
+                    name,
+                    format!(
+                        "binary_compressed uncompressed size {usize_} differs from POINTS {} x {step} bytes = {need}",
+                        h.points
+                    ),
+                ));
+            }
+            if csize > cur.remaining() {
+                return Err(err(
+                    name,
+                    format!(
+                        "truncated: compressed size is {csize} bytes, only {} left",
+                        cur.remaining()
+                    ),
+                ));
+            }
+            let data = if need == 0 && csize == 0 {
+                Vec::new()
+            } else {
+                lzf::decompress(cur.take(csize)?, need)
+                    .map_err(|e| err(name, format!("binary_compressed: {e}")))?
+            };
+            // Field by field: field f's block starts at points * (sum of previous record sizes).
+            let starts: Vec<usize> = offsets.iter().map(|o| o * h.points).collect();
+            for i in 0..h.points {
+                push_point(&mut b, &l, i, &|f| {
+                    let s = h.fields[f].size;
+                    let at = starts[f] + i * s * h.fields[f].count;
+                    value(&data[at..at + s], h.fields[f].kind)
+                });
+            }
+        }
+    }
+    Ok(b.finish())
 }
-/// Encodes a point cloud as PCD.
+
+fn read_ascii(
+    body: &[u8],
+    h: &Header,
+    l: &Layout,
+    name: &str,
+    b: &mut CloudDataBuilder,
+) -> Result<()> {
+    let columns: usize = h.fields.iter().map(|f| f.count).sum();
+    // Column of each field's first value.
+    let first: Vec<usize> = h
+        .fields
+        .iter()
+        .scan(0, |o, f| {
+            let at = *o;
+            *o += f.count;
+            Some(at)
+        })
+        .collect();
+    // Whether each column is an F4 field: those values are f32, as in binary data.
+    let single: Vec<bool> = h
+        .fields
+        .iter()
+        .flat_map(|f| std::iter::repeat(f.kind == b'F' && f.size == 4).take(f.count))
+        .collect();
+    let mut cur = ByteCursor::new(body, name, FORMAT);
+    let mut line_no = h.first_line - 1;
+    let mut values = vec![0.0f64; columns];
+    let mut i = 0;
+    while i < h.points {
+        line_no += 1;
+        let Some(line) = cur.line() else {
+            return Err(err(
+                name,
+                format!(
+                    "truncated: POINTS is {} but the data ends after {i} points (line {line_no})",
+                    h.points
+                ),
+            ));
+        };
+        let mut n = 0;
+        for tok in line
+            .split(u8::is_ascii_whitespace)
+            .filter(|t| !t.is_empty())
+        {
+            if n < columns {
+                let v = if single[n] {
+                    parse_f32(tok).map(f64::from)
+                } else {
+                    parse_f64(tok)
+                };
+                values[n] = v.ok_or_else(|| {
+                    err(
+                        name,
+                        format!("line {line_no}: value '{}' is not a number", show(tok)),
+                    )
+                })?;
+            }
+            n += 1;
+        }
+        if n == 0 {
+            continue;
+        }
+        if n != columns {
+            return Err(err(
+                name,
+                format!("line {line_no}: {n} values, expected {columns} (one per field and COUNT)"),
+            ));
+        }
+        push_point(b, l, i, &|f| values[first[f]]);
+        i += 1;
+    }
+    Ok(())
+}
+
+/// Appends `v` as a little-endian float of `size` bytes (4 or 8).
+fn put(out: &mut Vec<u8>, v: f64, size: usize) {
+    if size == 4 {
+        out.extend_from_slice(&(v as f32).to_le_bytes());
+    } else {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// Encodes a point cloud as PCD v0.7 (`Ascii` → `DATA ascii`,
+/// `BinaryLittleEndian` → `DATA binary`, `BinaryCompressed` →
+/// `DATA binary_compressed`): `x y z` and normals as `F4`, covariances as
+/// `F8` (see the module documentation).
+///
+/// # Errors
+/// [`Error::InvalidInput`] for [`Encoding::BinaryBigEndian`] or when the
+/// normals/covariances do not have one entry per point.
 pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
-    Err(todo(""))
+    let data =
+        match encoding {
+            Encoding::Ascii => "ascii",
+            Encoding::BinaryLittleEndian => "binary",
+            Encoding::BinaryCompressed => "binary_compressed",
+            Encoding::BinaryBigEndian => return Err(Error::invalid(
+                "PCD has no big-endian encoding; use Ascii, BinaryLittleEndian or BinaryCompressed",
+            )),
+        };
+    let n = cloud.points.len();
+    for (what, len) in [
+        ("normals", cloud.normals.as_ref().map(Vec::len)),
+        ("covariances", cloud.covariances.as_ref().map(Vec::len)),
+    ] {
+        if let Some(len) = len {
+            if len != n {
+                return Err(Error::invalid(format!(
+                    "cloud has {n} points but {len} {what}"
+                )));
+            }
+        }
+    }
+    let mut names = vec!["x", "y", "z"];
+    if cloud.normals.is_some() {
+        names.extend_from_slice(&["normal_x", "normal_y", "normal_z"]);
+    }
+    if cloud.covariances.is_some() {
+        names.extend_from_slice(&COV);
+    }
+    let k = names.len();
+    // Bytes per field: F4 for coordinates and normals, F8 for covariances.
+    let sizes: Vec<usize> = names
+        .iter()
+        .map(|n| if n.starts_with("cov_") { 8 } else { 4 })
+        .collect();
+    let step: usize = sizes.iter().sum();
+    let (width, height) = match &cloud.grid {
+        Some(g)
+            if g.width.checked_mul(g.height) == Some(n)
+                && g.pixels.len() == n
+                && g.pixels.iter().enumerate().all(|(i, &p)| p as usize == i) =>
+        {
+            (g.width, g.height)
+        }
+        _ => (n, 1),
+    };
+    let pose = cloud.sensor.unwrap_or_else(Pose::identity);
+    let t = pose.translation.vector;
+    let q = pose.rotation.quaternion();
+    let mut head = String::from(
+        "# .PCD v0.7 - Point Cloud Data file format (written by cloudprox)\nVERSION 0.7\n",
+    );
+    let _ = writeln!(head, "FIELDS {}", names.join(" "));
+    head.push_str("SIZE");
+    for s in &sizes {
+        let _ = write!(head, " {s}");
+    }
+    head.push('\n');
+    let _ = writeln!(head, "TYPE{}", " F".repeat(k));
+    let _ = writeln!(head, "COUNT{}", " 1".repeat(k));
+    let _ = writeln!(head, "WIDTH {width}\nHEIGHT {height}");
+    let _ = writeln!(
+        head,
+        "VIEWPOINT {} {} {} {} {} {} {}",
+        t.x, t.y, t.z, q.w, q.i, q.j, q.k
+    );
+    let _ = writeln!(head, "POINTS {n}\nDATA {data}");
+    let row = |i: usize| -> Vec<f64> {
+        let mut r: Vec<f64> = cloud.points[i].coords.iter().copied().collect();
+        if let Some(normals) = &cloud.normals {
+            r.extend(normals[i].iter());
+        }
+        if let Some(covs) = &cloud.covariances {
+            let c = &covs[i];
+            r.extend([
+                c[(0, 0)],
+                c[(0, 1)],
+                c[(0, 2)],
+                c[(1, 1)],
+                c[(1, 2)],
+                c[(2, 2)],
+            ]);
+        }
+        r
+    };
+    let mut out = head.into_bytes();
+    match encoding {
+        Encoding::Ascii => {
+            // Shortest forms that read back as the same f32 / f64.
+            let mut text = String::new();
+            for i in 0..n {
+                for (f, (v, &size)) in row(i).into_iter().zip(&sizes).enumerate() {
+                    let sep = if f == 0 { "" } else { " " };
+                    let _ = if size == 4 {
+                        write!(text, "{sep}{:?}", v as f32)
+                    } else {
+                        write!(text, "{sep}{v:?}")
+                    };
+                }
+                text.push('\n');
+            }
+            out.extend_from_slice(text.as_bytes());
+        }
+        Encoding::BinaryLittleEndian => {
+            out.reserve(n * step);
+            for i in 0..n {
+                for (v, &size) in row(i).into_iter().zip(&sizes) {
+                    put(&mut out, v, size);
+                }
+            }
+        }
+        _ => {
+            // Field by field: all values of field 0, then of field 1, ...
+            let mut raw = Vec::with_capacity(n * step);
+            let rows: Vec<Vec<f64>> = (0..n).map(row).collect();
+            for (f, &size) in sizes.iter().enumerate() {
+                for r in &rows {
+                    put(&mut raw, r[f], size);
+                }
+            }
+            let packed = lzf::compress(&raw);
+            let sizes = |x: usize| {
+                u32::try_from(x).map_err(|_| {
+                    Error::invalid(format!(
+                        "cloud too large for PCD binary_compressed ({x} bytes; the format stores sizes in 32 bits)"
+                    ))
+                })
+            };
+            out.extend_from_slice(&sizes(packed.len())?.to_le_bytes());
+            out.extend_from_slice(&sizes(raw.len())?.to_le_bytes());
+            out.extend_from_slice(&packed);
+        }
+    }
+    Ok(out)
 }
