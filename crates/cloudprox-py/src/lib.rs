@@ -10,6 +10,7 @@
 //! | `request.rs` | query options -> `CollisionRequest` |
 //! | `collide.rs` | `collide`, `collide_many` |
 //! | `result.rs` | `CollisionResult`, `ContactRegion` |
+//! | `filter.rs` | sensor-cloud filters: crop box, voxel, outliers, shadow, self |
 //! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
 //! | `sample.rs` | seeded synthetic shapes |
@@ -25,6 +26,7 @@ mod cloud;
 mod collide;
 mod convert;
 mod error;
+mod filter;
 mod io;
 mod mesh;
 mod request;
@@ -46,6 +48,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
     m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
     m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<filter::PySelfFilter>()?;
+    m.add_function(wrap_pyfunction!(filter::crop_box, m)?)?;
+    m.add_function(wrap_pyfunction!(filter::voxel_downsample, m)?)?;
+    m.add_function(wrap_pyfunction!(filter::statistical_outlier_removal, m)?)?;
+    m.add_function(wrap_pyfunction!(filter::shadow_filter, m)?)?;
     m.add_class::<io::PyCloudFile>()?;
     m.add_function(wrap_pyfunction!(io::read_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_point_cloud, m)?)?;
