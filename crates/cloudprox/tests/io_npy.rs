@@ -194,6 +194,13 @@ fn corrupt_inputs_are_format_errors() {
         ),
         "integer too large",
     );
+    format_err(
+        read_npy(
+            &d("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 4000000000)}"),
+            "t.npy",
+        ),
+        "more than 65536 columns",
+    );
     let good = write_npy(&sample_cloud()).unwrap();
     for cut in [5, 9, 20, 127, 128, 140, good.len() - 1] {
         assert!(

@@ -464,6 +464,14 @@ fn corrupt_inputs_are_format_errors() {
         "differs from POINTS 4000000000",
     );
     format_err(read_pcd(&huge("ascii"), "h.pcd"), "value");
+    let wide = ok.replace("COUNT 1 1 1 2 1", "COUNT 1 1 1 4000000000 1") + "1 2 3\n";
+    format_err(
+        read_pcd(wide.as_bytes(), "w.pcd"),
+        "a line needs 4000000004 values",
+    );
+    // Lowercase TYPE letters are accepted (Open3D does too).
+    let lower = ok.replace("TYPE F F F F U", "TYPE f f f f u") + "1 2 3 4 5 6\n1 2 3 4 5 6\n";
+    assert_eq!(read_pcd(lower.as_bytes(), "l.pcd").unwrap().points.len(), 2);
     // Truncated files written by the writer, cut at several points.
     for enc in [Encoding::BinaryLittleEndian, Encoding::BinaryCompressed] {
         let good = write_pcd(&sample_cloud(), enc).unwrap();

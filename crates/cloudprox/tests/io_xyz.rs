@@ -7,9 +7,15 @@ use cloudprox::prelude::*;
 fn format_err<T: std::fmt::Debug>(r: Result<T>, needle: &str) {
     match r {
         Err(Error::Format {
-            problem, format, ..
+            problem,
+            format,
+            path,
         }) => {
-            assert_eq!(format, "XYZ");
+            let csv = std::path::Path::new(&path)
+                .extension()
+                .is_some_and(|e| e == "csv");
+            let expected = if csv { "CSV" } else { "XYZ" };
+            assert_eq!(format, expected);
             assert!(
                 problem.contains(needle),
                 "problem {problem:?} does not mention {needle:?}"

@@ -10,7 +10,7 @@
 //! | STL (ascii, binary) | yes | yes | [`stl`] |
 //! | OBJ | yes | yes | [`obj`] |
 //! | OFF | yes | yes | [`off`] |
-//! | ROS `sensor_msgs/PointCloud2` (raw bytes + field layout) | yes | no | [`pointcloud2`] |
+//! | ROS `sensor_msgs/PointCloud2` (raw bytes + field layout) | yes | encode to bytes | [`pointcloud2`] |
 //!
 //! Readers parse bytes already in memory (`read_*(bytes, name)`; `name` is the
 //! file name used in errors) and return plain data: [`CloudData`] for point

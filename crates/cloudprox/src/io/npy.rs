@@ -2,7 +2,8 @@
 //!
 //! Reading: versions 1.0, 2.0 and 3.0; dtypes `<f8 >f8 <f4 >f4`; C or Fortran
 //! order. Columns 0, 1, 2 are `x y z`; further columns are ignored but named
-//! `col3`, `col4`, ... in [`CloudData::fields`]. Structured dtypes are refused.
+//! `col3`, `col4`, ... in [`CloudData::fields`]. Structured dtypes and arrays
+//! of more than 65536 columns are refused.
 //!
 //! Writing ([`write_npy`]): version 1.0, `<f8`, shape `(n, 3)`, C order, the
 //! header padded so the data starts at a multiple of 64 bytes.
@@ -14,6 +15,8 @@ use crate::math::Point3;
 
 const FORMAT: &str = "NPY";
 const MAGIC: &[u8] = b"\x93NUMPY";
+/// More columns than this is not a point array (and each would get a name).
+const MAX_COLUMNS: u64 = 1 << 16;
 
 fn err(name: &str, problem: impl Into<String>) -> Error {
     Error::format(name, FORMAT, problem)
@@ -246,6 +249,12 @@ pub fn read_npy(bytes: &[u8], name: &str) -> Result<CloudData> {
             format!("shape {shape:?} is not 2-D; expected (n, 3) or (n, k) with k >= 3"),
         ));
     };
+    if k > MAX_COLUMNS {
+        return Err(err(
+            name,
+            format!("shape ({n}, {k}) has more than {MAX_COLUMNS} columns; not a point array"),
+        ));
+    }
     if k < 3 {
         return Err(err(
             name,

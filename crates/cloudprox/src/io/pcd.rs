@@ -155,7 +155,9 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header> {
                 types = Some(
                     args.iter()
                         .map(|w| match *w {
-                            "F" | "I" | "U" => Ok(w.as_bytes()[0]),
+                            "F" | "I" | "U" | "f" | "i" | "u" => {
+                                Ok(w.as_bytes()[0].to_ascii_uppercase())
+                            }
                             _ => Err(err(
                                 name,
                                 format!(
@@ -515,7 +517,20 @@ fn read_ascii(
     name: &str,
     b: &mut CloudDataBuilder,
 ) -> Result<()> {
+    if h.points == 0 {
+        return Ok(());
+    }
     let columns: usize = h.fields.iter().map(|f| f.count).sum();
+    // Each value takes at least one byte: bounds the buffers below.
+    if columns > body.len() {
+        return Err(err(
+            name,
+            format!(
+                "truncated: a line needs {columns} values (one per field and COUNT), but only {} bytes of data follow the header",
+                body.len()
+            ),
+        ));
+    }
     // Column of each field's first value.
     let first: Vec<usize> = h
         .fields

@@ -9,6 +9,7 @@
 //! cov_xy cov_xz cov_yy cov_yz cov_zz` covariances. Without a header, columns
 //! 0, 1, 2 are `x y z` and the rest are named `col3`, `col4`, ... Every row
 //! must have the same number of columns and every value must be a number.
+//! Errors name the format `CSV` when the file name ends in `.csv`, else `XYZ`.
 //!
 //! Writing ([`write_xyz`]): with `,` or `;` a header line `x,y,z` (plus
 //! `,nx,ny,nz` and `,cov_xx,...` when present); with ` ` or `\t` no header and
@@ -21,10 +22,12 @@ use crate::io::text::{parse_f64, push_row, show};
 use crate::io::{CloudData, CloudDataBuilder};
 use crate::math::{Matrix3, Point3, Vector3};
 
-const FORMAT: &str = "XYZ";
-
+/// The format named in errors: `CSV` for a `.csv` file, else `XYZ`.
 fn err(name: &str, problem: impl Into<String>) -> Error {
-    Error::format(name, FORMAT, problem)
+    let csv = std::path::Path::new(name)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    Error::format(name, if csv { "CSV" } else { "XYZ" }, problem)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
