@@ -28,6 +28,7 @@ mod cloud_data;
 mod cursor;
 mod format;
 pub mod las;
+mod mesh_text;
 pub mod npy;
 pub mod obj;
 pub mod off;
