@@ -350,8 +350,12 @@ fn read_points(
 ) -> Result<CloudData> {
     let crate_err =
         |what: &str, e: &las::Error| Error::format(name, format, format!("{what}: {e}"));
-    let mut reader = las::Reader::new(Cursor::new(bytes.to_vec()))
-        .map_err(|e| crate_err("cannot read the header", &e))?;
+    let mut reader = las::Reader::new(Cursor::new(bytes.to_vec())).map_err(|e| {
+        crate_err(
+            "cannot read the header, its records or the LAZ chunk table",
+            &e,
+        )
+    })?;
     let header = reader.header();
     if header.point_format().is_compressed != facts.compressed {
         return Err(Error::format(
@@ -385,8 +389,9 @@ fn read_points(
                 format,
                 format!(
                     "truncated or corrupt point data: the header promises {count} points from \
-                     offset {}, reading point {done} failed: {e}",
-                    facts.offset_to_points
+                     offset {}, reading points {done} to {} failed: {e}",
+                    facts.offset_to_points,
+                    done + want - 1
                 ),
             )
         })?;

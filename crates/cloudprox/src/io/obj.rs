@@ -19,6 +19,7 @@
 //! Errors name the line: a malformed number or index, index 0, an index out of
 //! range, a face with fewer than 3 vertices, a non-finite coordinate, no face.
 
+use std::borrow::Cow;
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
@@ -31,7 +32,7 @@ const FORMAT: &str = "OBJ";
 
 /// The statements of an OBJ file, comments removed and continuation lines joined,
 /// with the number of their first line.
-fn statements(bytes: &[u8]) -> Vec<(usize, Vec<u8>)> {
+fn statements(bytes: &[u8]) -> Vec<(usize, Cow<'_, [u8]>)> {
     let mut out = Vec::new();
     let mut pending: Option<(usize, Vec<u8>)> = None;
     for (number, raw) in lines(bytes) {
@@ -44,16 +45,21 @@ fn statements(bytes: &[u8]) -> Vec<(usize, Vec<u8>)> {
             Some(head) => (head, true),
             None => (line, false),
         };
-        let entry = pending.get_or_insert_with(|| (number, Vec::new()));
-        entry.1.extend_from_slice(text);
-        entry.1.push(b' ');
+        match (pending.as_mut(), continues) {
+            (None, false) => out.push((number, Cow::Borrowed(text))),
+            (None, true) => pending = Some((number, [text, b" "].concat())),
+            (Some(p), _) => {
+                p.1.extend_from_slice(text);
+                p.1.push(b' ');
+            }
+        }
         if !continues {
-            if let Some(done) = pending.take() {
-                out.push(done);
+            if let Some((n, joined)) = pending.take() {
+                out.push((n, Cow::Owned(joined)));
             }
         }
     }
-    out.extend(pending);
+    out.extend(pending.map(|(n, joined)| (n, Cow::Owned(joined))));
     out
 }
 
