@@ -7,7 +7,7 @@ use cloudprox::io::las::read_las;
 use cloudprox::io::{read_point_cloud_bytes, CloudData, CloudFormat};
 use cloudprox::Error;
 use las::point::Format;
-use las::{Builder, Color, Point, Transform, Vector, Writer};
+use las::{Builder, Color, Point, Transform, Vector, Vlr, Writer};
 
 const OFFSET: [f64; 3] = [500_000.0, 4_500_000.0, 100.0];
 const SCALE: f64 = 0.001;
@@ -27,7 +27,25 @@ fn expected(raw: [i32; 3]) -> [f64; 3] {
 
 /// A LAS (or LAZ when `compressed`) file of the test points in `format`.
 fn write_file(version: (u8, u8), format: u8, compressed: bool) -> Vec<u8> {
+    write_file_with(version, format, compressed, None)
+}
+
+/// Like [`write_file`], with an extended record holding `evlr` (LAS 1.4).
+fn write_file_with(
+    version: (u8, u8),
+    format: u8,
+    compressed: bool,
+    evlr: Option<Vec<u8>>,
+) -> Vec<u8> {
     let mut builder = Builder::from(version);
+    if let Some(data) = evlr {
+        builder.evlrs.push(Vlr {
+            user_id: "cloudprox".into(),
+            record_id: 7,
+            description: "test record".into(),
+            data,
+        });
+    }
     let mut point_format = Format::new(format).unwrap();
     point_format.is_compressed = compressed;
     builder.point_format = point_format;
@@ -231,4 +249,26 @@ fn no_prefix_or_bit_flip_panics() {
             }
         }
     }
+}
+
+#[test]
+fn extended_records_are_checked() {
+    let bytes = write_file_with((1, 4), 6, false, Some(vec![9u8; 100]));
+    check(&read_las(&bytes, "t.las").unwrap());
+    // The extended record's length field (at its offset + 20) promises more than the file holds.
+    let start = u64::from_le_bytes(bytes[235..243].try_into().unwrap()) as usize;
+    assert_eq!(u32::from_le_bytes(bytes[243..247].try_into().unwrap()), 1);
+    let mut long = bytes.clone();
+    long[start + 20..start + 28].copy_from_slice(&u64::MAX.to_le_bytes());
+    let p = problem(read_las(&long, "t.las"), "LAS");
+    assert!(
+        p.contains(&format!("extended record at offset {start}")),
+        "{p}"
+    );
+    let p = problem(read_las(&bytes[..bytes.len() - 1], "t.las"), "LAS");
+    assert!(p.contains("extended record"), "{p}");
+    let mut far = bytes.clone();
+    far[235..243].copy_from_slice(&(1u64 << 40).to_le_bytes());
+    let p = problem(read_las(&far, "t.las"), "LAS");
+    assert!(p.contains("1 extended records from offset"), "{p}");
 }
