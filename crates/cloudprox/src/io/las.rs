@@ -1,18 +1,415 @@
-//! LAS (to be written).
+//! LAS and LAZ (ASPRS lidar point clouds): read only, through the `las` crate.
+//!
+//! The points' `x, y, z` are returned in the file's units (metres for projected
+//! coordinate systems such as UTM) as `raw * scale + offset`, computed in `f64`:
+//! large offsets keep the full precision the file stores. [`CloudData::fields`]
+//! lists the attributes the file's point format carries (`x, y, z, intensity,
+//! return_number, ..., gps_time, red, green, blue, nir, ...`); only the
+//! coordinates are read into the cloud.
+//!
+//! Before the file is handed to the `las` crate its header is checked here: the
+//! signature, finite and non-zero scales, finite offsets, a point count that the
+//! data can hold (an uncompressed file must contain every point record its
+//! header promises; a compressed one must not end early), and the extended
+//! records and LAZ chunk table that the crate would otherwise size its buffers
+//! from. Points are then read in batches, so a hostile count never allocates
+//! more than the file can hold. Every error of the crate becomes an
+//! [`Error::Format`] naming the file, with the format `LAS` or `LAZ` (compressed).
 
-#![allow(unused_variables)]
+use std::io::Cursor;
+use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use crate::error::{Error, Result};
-#[allow(unused_imports)]
-use crate::io::{CloudData, Encoding, MeshData};
-#[allow(unused_imports)]
-use crate::shape::Mesh;
+use crate::io::{ByteCursor, CloudData, CloudDataBuilder};
+use crate::math::Point3;
 
-fn todo(name: &str) -> Error {
-    Error::format(name, "LAS", "reader not written yet")
+/// Points read per batch.
+const BATCH: u64 = 1 << 16;
+/// The size of the LAS 1.0-1.2 public header block.
+const MIN_HEADER: usize = 227;
+
+/// What the header says, as far as the checks here need it.
+struct HeaderFacts {
+    compressed: bool,
+    format_id: u8,
+    count: u64,
+    offset_to_points: u64,
 }
 
-/// Reads a LAS or LAZ file.
+/// `"LAZ"` when the point format's compression bit is set, or (when the header
+/// cannot be read) when the name ends in `.laz`; `"LAS"` otherwise.
+fn format_name(bytes: &[u8], name: &str) -> &'static str {
+    let compressed = match bytes.get(104) {
+        Some(&id) if bytes.starts_with(b"LASF") => id & 0x80 != 0,
+        _ => name.to_ascii_lowercase().ends_with(".laz"),
+    };
+    if compressed {
+        "LAZ"
+    } else {
+        "LAS"
+    }
+}
+
+fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<HeaderFacts> {
+    let err = |problem: String| Error::format(name, format, problem);
+    if !bytes.starts_with(b"LASF") {
+        let shown: Vec<u8> = bytes.iter().take(4).copied().collect();
+        return Err(err(format!(
+            "the file does not start with the signature \"LASF\" (found {:?})",
+            String::from_utf8_lossy(&shown)
+        )));
+    }
+    if bytes.len() < MIN_HEADER {
+        return Err(err(format!(
+            "truncated: the public header block needs at least {MIN_HEADER} bytes, the file \
+             has {}",
+            bytes.len()
+        )));
+    }
+    let mut cur = ByteCursor::new(bytes, name, format);
+    cur.seek(24)?;
+    let version = (cur.u8()?, cur.u8()?);
+    cur.seek(94)?;
+    let header_size = cur.u16_le()?;
+    let offset_to_points = u64::from(cur.u32_le()?);
+    let vlrs = cur.u32_le()?;
+    let format_id = cur.u8()?;
+    let record_len = u64::from(cur.u16_le()?);
+    let legacy_count = u64::from(cur.u32_le()?);
+    cur.seek(131)?;
+    let mut scale = [0.0; 3];
+    let mut offset = [0.0; 3];
+    for s in &mut scale {
+        *s = cur.f64_le()?;
+    }
+    for o in &mut offset {
+        *o = cur.f64_le()?;
+    }
+    for (axis, (s, o)) in ["x", "y", "z"].iter().zip(scale.iter().zip(offset.iter())) {
+        if !s.is_finite() || *s == 0.0 {
+            return Err(err(format!(
+                "the {axis} scale factor is {s}: it must be finite and non-zero"
+            )));
+        }
+        if !o.is_finite() {
+            return Err(err(format!("the {axis} offset is {o}: it must be finite")));
+        }
+    }
+    let mut count = legacy_count;
+    let mut evlrs: Option<(u64, u32)> = None;
+    if version >= (1, 4) {
+        let needed = 375;
+        if bytes.len() < needed {
+            return Err(err(format!(
+                "truncated: a LAS {}.{} header needs {needed} bytes, the file has {}",
+                version.0,
+                version.1,
+                bytes.len()
+            )));
+        }
+        cur.seek(235)?;
+        let start = cur.u64_le()?;
+        let n = cur.u32_le()?;
+        let count64 = cur.u64_le()?;
+        if legacy_count == 0 {
+            count = count64;
+        }
+        if n > 0 {
+            evlrs = Some((start, n));
+        }
+    }
+    let len = bytes.len() as u64;
+    if u64::from(header_size) > len {
+        return Err(err(format!(
+            "truncated: the header size is {header_size} bytes, the file has {len}"
+        )));
+    }
+    if offset_to_points > len {
+        return Err(err(format!(
+            "truncated: the point data starts at offset {offset_to_points}, the file has \
+             {len} bytes"
+        )));
+    }
+    let Some(data_len) = count.checked_mul(record_len) else {
+        return Err(err(format!(
+            "the header promises {count} points of {record_len} bytes: more than any file holds"
+        )));
+    };
+    let compressed = format_id & 0x80 != 0;
+    if !compressed
+        && offset_to_points
+            .checked_add(data_len)
+            .map_or(true, |end| end > len)
+    {
+        return Err(err(format!(
+            "truncated: the header promises {count} points of {record_len} bytes ({data_len} \
+             bytes from offset {offset_to_points}), but the file has {len} bytes"
+        )));
+    }
+    if let Some((start, n)) = evlrs {
+        // The crate reads the first extended record and sizes its buffer from it.
+        let header_end = start.checked_add(60).filter(|&e| e <= len).ok_or_else(|| {
+            err(format!(
+                "truncated: the header promises {n} extended records from offset {start}, the \
+                 file has {len} bytes"
+            ))
+        })?;
+        cur.seek(start as usize + 20)?;
+        let record = cur.u64_le()?;
+        if header_end.checked_add(record).map_or(true, |e| e > len) {
+            return Err(err(format!(
+                "truncated: the extended record at offset {start} promises {record} bytes, the \
+                 file has {len}"
+            )));
+        }
+    }
+    if compressed {
+        check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
+        check_chunk_table(bytes, &mut cur, offset_to_points)?;
+    }
+    Ok(HeaderFacts {
+        compressed,
+        format_id,
+        count,
+        offset_to_points,
+    })
+}
+
+/// The LAZ items (in the `laszip encoded` record) must add up to the point
+/// record length, or the decoder writes past its buffer.
+fn check_laszip_items(
+    cur: &mut ByteCursor,
+    header_size: u16,
+    vlrs: u32,
+    record_len: u64,
+) -> Result<()> {
+    cur.seek(usize::from(header_size))?;
+    // Variable length records: a 54-byte header, then `length` bytes.
+    for _ in 0..vlrs {
+        if cur.remaining() < 54 {
+            break;
+        }
+        let start = cur.position();
+        let _reserved = cur.u16_le()?;
+        let user_id = cur.take(16)?;
+        let record_id = cur.u16_le()?;
+        let length = usize::from(cur.u16_le()?);
+        let _description = cur.take(32)?;
+        if user_id.starts_with(b"laszip encoded") && record_id == 22204 {
+            let data = cur.take(length)?;
+            let mut items = ByteCursor::new(data, "", "LAZ");
+            items
+                .seek(32)
+                .map_err(|_| cur.error("the laszip record is too short"))?;
+            let n = items
+                .u16_le()
+                .map_err(|_| cur.error("the laszip record is too short"))?;
+            let mut total = 0u64;
+            for _ in 0..n {
+                let _kind = items.u16_le();
+                let size = items.u16_le().map_err(|_| {
+                    cur.error(format!(
+                        "the laszip record at offset {start} lists {n} items but is only {length} bytes"
+                    ))
+                })?;
+                let _version = items.u16_le();
+                total += u64::from(size);
+            }
+            if total != record_len {
+                return Err(cur.error(format!(
+                    "the laszip items add up to {total} bytes per point but the header's point \
+                     records are {record_len} bytes"
+                )));
+            }
+            return Ok(());
+        }
+        if cur.take(length).is_err() {
+            break;
+        }
+    }
+    // No laszip record: the las crate reports it.
+    Ok(())
+}
+
+/// The LAZ chunk table: the crate sizes a buffer from its chunk count.
+fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Result<()> {
+    let len = bytes.len() as u64;
+    let data_start = usize::try_from(data_start).map_err(|_| cur.error("offset too large"))?;
+    cur.seek(data_start)?;
+    let table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
+    let table_data = data_start as u64 + 8;
+    if table == -1 {
+        return Ok(()); // written by a streaming writer: the table is found at the end
+    }
+    if u64::try_from(table).map_or(true, |t| t <= table_data) {
+        return Ok(()); // no chunk table: the crate reads the points sequentially
+    }
+    let table = table.unsigned_abs();
+    if table.checked_add(8).map_or(true, |e| e > len) {
+        return Err(cur.error(format!(
+            "truncated: the chunk table is at offset {table}, the file has {len} bytes"
+        )));
+    }
+    cur.seek(table as usize + 4)?;
+    let chunks = u64::from(cur.u32_le()?);
+    // Every chunk holds at least one byte of compressed points before the table.
+    if chunks > table - table_data {
+        return Err(cur.error(format!(
+            "the chunk table lists {chunks} chunks but there are only {} bytes of point data",
+            table - table_data
+        )));
+    }
+    Ok(())
+}
+
+/// The names of the attributes of a LAS point format.
+fn field_names(format: las::point::Format) -> Vec<String> {
+    let mut f: Vec<&str> = vec![
+        "x",
+        "y",
+        "z",
+        "intensity",
+        "return_number",
+        "number_of_returns",
+    ];
+    if format.is_extended {
+        f.push("scanner_channel");
+    }
+    f.extend([
+        "scan_direction_flag",
+        "edge_of_flight_line",
+        "classification",
+    ]);
+    f.extend(["synthetic", "key_point", "withheld"]);
+    if format.is_extended {
+        f.push("overlap");
+    }
+    f.extend(["scan_angle", "user_data", "point_source_id"]);
+    if format.has_gps_time {
+        f.push("gps_time");
+    }
+    if format.has_color {
+        f.extend(["red", "green", "blue"]);
+    }
+    if format.has_nir {
+        f.push("nir");
+    }
+    if format.has_waveform {
+        f.extend([
+            "wave_packet_descriptor_index",
+            "byte_offset_to_waveform_data",
+            "waveform_packet_size",
+            "return_point_waveform_location",
+            "x_t",
+            "y_t",
+            "z_t",
+        ]);
+    }
+    let mut names: Vec<String> = f.into_iter().map(String::from).collect();
+    if format.extra_bytes > 0 {
+        names.push(format!("extra_bytes_{}", format.extra_bytes));
+    }
+    names
+}
+
+/// Reads a LAS or LAZ file from its bytes; `name` is used in errors.
+///
+/// # Errors
+/// [`Error::Format`] (format `LAS` or `LAZ`) naming the problem: a bad signature
+/// or header field, a truncated file (with the count the header promises and
+/// the bytes there are), or what the `las` crate reported.
 pub fn read_las(bytes: &[u8], name: &str) -> Result<CloudData> {
-    Err(todo(name))
+    let format = format_name(bytes, name);
+    let facts = check_header(bytes, name, format)?;
+    // The crate is not ours: a panic inside it on a corrupt file still becomes
+    // a format error rather than unwinding into the caller.
+    match catch_unwind(AssertUnwindSafe(|| {
+        read_points(bytes, name, format, &facts)
+    })) {
+        Ok(result) => result,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(Error::format(
+                name,
+                format,
+                format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
+            ))
+        }
+    }
+}
+
+fn read_points(
+    bytes: &[u8],
+    name: &str,
+    format: &'static str,
+    facts: &HeaderFacts,
+) -> Result<CloudData> {
+    let crate_err =
+        |what: &str, e: &las::Error| Error::format(name, format, format!("{what}: {e}"));
+    let mut reader = las::Reader::new(Cursor::new(bytes.to_vec())).map_err(|e| {
+        crate_err(
+            "cannot read the header, its records or the LAZ chunk table",
+            &e,
+        )
+    })?;
+    let header = reader.header();
+    if header.point_format().is_compressed != facts.compressed {
+        return Err(Error::format(
+            name,
+            format,
+            format!("point format id {} is inconsistent", facts.format_id),
+        ));
+    }
+    let count = header.number_of_points();
+    if count != facts.count {
+        return Err(Error::format(
+            name,
+            format,
+            format!(
+                "the header's point counts disagree ({count} and {})",
+                facts.count
+            ),
+        ));
+    }
+    let fields = field_names(*header.point_format());
+    let capacity = usize::try_from(count)
+        .unwrap_or(usize::MAX)
+        .min(bytes.len() / 20);
+    let mut builder = CloudDataBuilder::new(fields, None, false, false, capacity);
+    let mut done: u64 = 0;
+    while done < count {
+        let want = (count - done).min(BATCH);
+        let batch = reader.read_points(want).map_err(|e| {
+            Error::format(
+                name,
+                format,
+                format!(
+                    "truncated or corrupt point data: the header promises {count} points from \
+                     offset {}, reading points {done} to {} failed: {e}",
+                    facts.offset_to_points,
+                    done + want - 1
+                ),
+            )
+        })?;
+        let got = batch.len() as u64;
+        if got != want {
+            return Err(Error::format(
+                name,
+                format,
+                format!(
+                    "truncated: the header promises {count} points, the file holds {}",
+                    done + got
+                ),
+            ));
+        }
+        for (k, ((x, y), z)) in batch.x().zip(batch.y()).zip(batch.z()).enumerate() {
+            builder.push(done as usize + k, Point3::new(x, y, z), None, None);
+        }
+        done += got;
+    }
+    Ok(builder.finish())
 }

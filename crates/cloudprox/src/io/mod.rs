@@ -29,6 +29,7 @@ mod cursor;
 mod format;
 pub mod las;
 mod lzf;
+mod mesh_text;
 pub mod npy;
 pub mod obj;
 pub mod off;

@@ -1,22 +1,267 @@
-//! OFF (to be written).
+//! OFF (Object File Format): read and write triangle meshes.
+//!
+//! Read: a header line `OFF` (also `COFF`, `NOFF`, `CNOFF`, `STOFF`, ... : any
+//! of the `ST`, `C`, `N` prefixes), optionally followed on the same line by the
+//! counts; then `nv nf [ne]`; then `nv` vertex lines `x y z ...` (values after
+//! `z`, such as colours and normals of the C/N variants, are ignored); then `nf`
+//! face lines `k i1 ... ik [colour]` with 0-based indices, split into a fan of
+//! triangles. `#` starts a comment; blank lines are skipped. The 4D (`4OFF`),
+//! n-dimensional (`nOFF`) and binary (`OFF BINARY`) variants are rejected.
+//! Anything but blank lines or comments after the last face is an error.
+//! Triangles that repeat a vertex are dropped and counted in
+//! [`MeshData::dropped_faces`].
 
-#![allow(unused_variables)]
+use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
-#[allow(unused_imports)]
-use crate::io::{CloudData, Encoding, MeshData};
-#[allow(unused_imports)]
+use crate::io::mesh_text::{
+    finish_mesh, lines, parse_f64, parse_i64, push_real, quote, strip_comment, tokens,
+};
+use crate::io::MeshData;
+use crate::math::Point3;
 use crate::shape::Mesh;
 
-fn todo(name: &str) -> Error {
-    Error::format(name, "OFF", "reader not written yet")
+const FORMAT: &str = "OFF";
+
+/// Whether `keyword` is an OFF header this reader reads.
+fn is_off_keyword(keyword: &[u8]) -> bool {
+    let Some(prefix) = keyword.strip_suffix(b"OFF") else {
+        return false;
+    };
+    let prefix = prefix.strip_prefix(b"ST").unwrap_or(prefix);
+    let prefix = prefix.strip_prefix(b"C").unwrap_or(prefix);
+    let prefix = prefix.strip_prefix(b"N").unwrap_or(prefix);
+    prefix.is_empty()
 }
 
-/// Reads an OFF mesh.
+/// Reads an OFF mesh (see the module docs for what is read).
+///
+/// # Errors
+/// [`Error::Format`] naming the line and the problem.
 pub fn read_off_mesh(bytes: &[u8], name: &str) -> Result<MeshData> {
-    Err(todo(name))
+    let err = |line: usize, problem: String| {
+        Error::format(name, FORMAT, format!("line {line}: {problem}"))
+    };
+    // Non-blank lines, comments removed, as token lists.
+    let mut rows = lines(bytes).filter_map(|(n, l)| {
+        let t: Vec<&[u8]> = tokens(strip_comment(l)).collect();
+        (!t.is_empty()).then_some((n, t))
+    });
+    let last_line = lines(bytes).last().map_or(1, |(n, _)| n);
+
+    let Some((line, header)) = rows.next() else {
+        return Err(Error::format(
+            name,
+            FORMAT,
+            "empty file: expected the header \"OFF\"",
+        ));
+    };
+    let keyword = header[0];
+    if !is_off_keyword(keyword) {
+        let problem = if keyword.ends_with(b"OFF") {
+            format!(
+                "unsupported OFF variant {} (only OFF, COFF, NOFF, CNOFF, STOFF ... in 3D)",
+                quote(keyword)
+            )
+        } else {
+            format!("expected the header \"OFF\", found {}", quote(keyword))
+        };
+        return Err(err(line, problem));
+    }
+    let mut counts_tokens: Vec<&[u8]> = header[1..].to_vec();
+    let mut counts_line = line;
+    if counts_tokens
+        .first()
+        .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
+    {
+        return Err(err(line, "binary OFF is not supported".into()));
+    }
+    if counts_tokens.is_empty() {
+        let Some((l, t)) = rows.next() else {
+            return Err(err(
+                last_line,
+                "expected the counts \"nv nf ne\" after the header, found the end of the file"
+                    .into(),
+            ));
+        };
+        counts_tokens = t;
+        counts_line = l;
+    }
+    if !(2..=3).contains(&counts_tokens.len()) {
+        return Err(err(
+            counts_line,
+            format!(
+                "expected the counts \"nv nf ne\" (2 or 3 integers), found {} values",
+                counts_tokens.len()
+            ),
+        ));
+    }
+    let mut counts = [0usize; 3];
+    for (k, t) in counts_tokens.iter().enumerate() {
+        counts[k] = parse_i64(t)
+            .and_then(|v| usize::try_from(v).ok())
+            .ok_or_else(|| {
+                err(
+                    counts_line,
+                    format!(
+                        "bad count {}: expected a non-negative integer for {}",
+                        quote(t),
+                        [
+                            "the number of vertices",
+                            "the number of faces",
+                            "the number of edges"
+                        ][k]
+                    ),
+                )
+            })?;
+    }
+    let [nv, nf, _ne] = counts;
+    if nv > u32::MAX as usize {
+        return Err(err(
+            counts_line,
+            format!("{nv} vertices: more than 2^32 - 1"),
+        ));
+    }
+    // A vertex line is at least 6 bytes ("0 0 0\n"): never trust the count further.
+    let mut vertices = Vec::with_capacity(nv.min(bytes.len() / 6));
+    for i in 0..nv {
+        let Some((line, t)) = rows.next() else {
+            return Err(err(
+                last_line,
+                format!(
+                    "the header promises {nv} vertices and {nf} faces, but the file ends after \
+                     {i} vertices"
+                ),
+            ));
+        };
+        if t.len() < 3 {
+            return Err(err(
+                line,
+                format!("vertex {i} needs 3 coordinates, found {} values", t.len()),
+            ));
+        }
+        let mut xyz = [0.0; 3];
+        for k in 0..3 {
+            xyz[k] = match parse_f64(t[k]) {
+                Some(x) if x.is_finite() => x,
+                Some(_) => {
+                    return Err(err(
+                        line,
+                        format!("vertex {i} has a non-finite coordinate {}", quote(t[k])),
+                    ))
+                }
+                None => {
+                    return Err(err(
+                        line,
+                        format!("vertex {i}: malformed number {}", quote(t[k])),
+                    ))
+                }
+            };
+        }
+        vertices.push(Point3::new(xyz[0], xyz[1], xyz[2]));
+    }
+    let mut triangles = Vec::with_capacity(nf.min(bytes.len() / 8));
+    for f in 0..nf {
+        let Some((line, t)) = rows.next() else {
+            return Err(err(
+                last_line,
+                format!("the header promises {nf} faces, but the file ends after {f} faces"),
+            ));
+        };
+        let k = parse_i64(t[0])
+            .and_then(|v| usize::try_from(v).ok())
+            .ok_or_else(|| {
+                err(
+                    line,
+                    format!(
+                        "face {f}: bad vertex count {}: expected a non-negative integer",
+                        quote(t[0])
+                    ),
+                )
+            })?;
+        if k < 3 {
+            return Err(err(
+                line,
+                format!("face {f} has {k} vertices; a face needs at least 3"),
+            ));
+        }
+        if t.len() - 1 < k {
+            return Err(err(
+                line,
+                format!(
+                    "face {f} announces {k} vertices but the line has only {} indices",
+                    t.len() - 1
+                ),
+            ));
+        }
+        let mut corners = Vec::with_capacity(k);
+        for tok in &t[1..=k] {
+            let index = parse_i64(tok).ok_or_else(|| {
+                err(
+                    line,
+                    format!("face {f}: malformed vertex index {}", quote(tok)),
+                )
+            })?;
+            match u32::try_from(index) {
+                Ok(i) if (i as usize) < nv => corners.push(i),
+                _ => {
+                    return Err(err(
+                        line,
+                        format!(
+                            "face {f}: vertex index {index} out of range ({})",
+                            if nv == 0 {
+                                "the file has no vertices".to_string()
+                            } else {
+                                format!("0 to {}", nv - 1)
+                            }
+                        ),
+                    ))
+                }
+            }
+        }
+        for i in 1..k - 1 {
+            triangles.push([corners[0], corners[i], corners[i + 1]]);
+        }
+    }
+    if let Some((line, t)) = rows.next() {
+        return Err(err(
+            line,
+            format!(
+                "unexpected {} after the {nf} faces the header promises",
+                quote(t[0])
+            ),
+        ));
+    }
+    if triangles.is_empty() {
+        return Err(Error::format(
+            name,
+            FORMAT,
+            "no faces (the header says 0 faces)",
+        ));
+    }
+    finish_mesh(name, FORMAT, vertices, triangles)
 }
-/// Encodes a mesh as OFF.
+
+/// Encodes a mesh as OFF: vertex coordinates written so they read back to
+/// exactly the same `f64`, faces as `3 a b c`.
+///
+/// # Errors
+/// Never fails; the `Result` matches the other writers.
 pub fn write_off_mesh(mesh: &Mesh) -> Result<Vec<u8>> {
-    Err(todo(""))
+    let mut out = format!("OFF\n{} {} 0\n", mesh.vertices().len(), mesh.faces().len());
+    for v in mesh.vertices() {
+        let mut first = true;
+        for &c in v.coords.iter() {
+            if !first {
+                out.push(' ');
+            }
+            first = false;
+            push_real(&mut out, c);
+        }
+        out.push('\n');
+    }
+    for f in mesh.faces() {
+        let _ = writeln!(out, "3 {} {} {}", f[0], f[1], f[2]);
+    }
+    Ok(out.into_bytes())
 }
