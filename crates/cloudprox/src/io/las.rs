@@ -139,7 +139,7 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
     if !compressed
         && offset_to_points
             .checked_add(data_len)
-            .map_or(true, |end| end > len)
+            .is_none_or(|end| end > len)
     {
         return Err(err(format!(
             "truncated: the header promises {count} points of {record_len} bytes ({data_len} \
@@ -156,7 +156,7 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
         })?;
         cur.seek(start as usize + 20)?;
         let record = cur.u64_le()?;
-        if header_end.checked_add(record).map_or(true, |e| e > len) {
+        if header_end.checked_add(record).is_none_or(|e| e > len) {
             return Err(err(format!(
                 "truncated: the extended record at offset {start} promises {record} bytes, the \
                  file has {len}"
@@ -245,7 +245,7 @@ fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Res
         return Ok(()); // no chunk table: the crate reads the points sequentially
     }
     let table = table.unsigned_abs();
-    if table.checked_add(8).map_or(true, |e| e > len) {
+    if table.checked_add(8).is_none_or(|e| e > len) {
         return Err(cur.error(format!(
             "truncated: the chunk table is at offset {table}, the file has {len} bytes"
         )));

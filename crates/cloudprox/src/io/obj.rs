@@ -178,7 +178,7 @@ fn corner_index(
     if rest.len() > 2
         || rest
             .iter()
-            .any(|p| !p.is_empty() && parse_i64(p).map_or(true, |v| v == 0))
+            .any(|p| !p.is_empty() && parse_i64(p).is_none_or(|v| v == 0))
     {
         return Err(malformed());
     }

@@ -545,7 +545,7 @@ fn read_ascii(
     let single: Vec<bool> = h
         .fields
         .iter()
-        .flat_map(|f| std::iter::repeat(f.kind == b'F' && f.size == 4).take(f.count))
+        .flat_map(|f| std::iter::repeat_n(f.kind == b'F' && f.size == 4, f.count))
         .collect();
     let mut cur = ByteCursor::new(body, name, FORMAT);
     let mut line_no = h.first_line - 1;

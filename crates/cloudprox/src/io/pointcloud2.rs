@@ -148,7 +148,7 @@ pub fn read_pointcloud2(layout: &PointCloud2Layout, data: &[u8]) -> Result<Cloud
         .collect();
     let (width, height) = (layout.width as usize, layout.height as usize);
     let row = layout.row_step as usize;
-    if step.checked_mul(width).map_or(true, |w| w > row) {
+    if step.checked_mul(width).is_none_or(|w| w > row) {
         return Err(err(format!(
             "point_step {step} x width {width} is more than row_step {row}"
         )));
