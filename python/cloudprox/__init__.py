@@ -19,7 +19,7 @@ Examples
 'free'
 """
 
-from cloudprox import io
+from cloudprox import filters, io
 from cloudprox._native import (
     CollisionResult,
     ContactRegion,
@@ -71,6 +71,7 @@ __all__ = [
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
+    "filters",
     "io",
     "option_names",
     "sample_box_surface",

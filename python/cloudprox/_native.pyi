@@ -26,12 +26,14 @@ __all__ = [
     "Lidar",
     "Mesh",
     "PointCloud",
+    "SelfFilter",
     "SolverError",
     "StereoCamera",
     "__version__",
     "add_noise",
     "collide",
     "collide_many",
+    "crop_box",
     "default_options",
     "exact_intersects_many",
     "exact_proximity",
@@ -39,10 +41,15 @@ __all__ = [
     "option_names",
     "read_mesh",
     "read_point_cloud",
+    "read_pointcloud2",
     "sample_box_surface",
     "sample_sphere",
+    "shadow_filter",
+    "statistical_outlier_removal",
+    "voxel_downsample",
     "write_mesh",
     "write_point_cloud",
+    "write_pointcloud2",
 ]
 
 _FloatArray = npt.NDArray[np.float64]
@@ -828,3 +835,65 @@ def write_mesh(
     write_ascii: bool = False,
 ) -> None:
     """Write a mesh file (see :func:`cloudprox.io.write_mesh`)."""
+
+def read_pointcloud2(
+    data: object,
+    fields: object,
+    *,
+    height: int,
+    width: int,
+    point_step: int,
+    row_step: int,
+    is_bigendian: bool = False,
+) -> CloudFile:
+    """Read a ROS PointCloud2 from raw bytes (see :func:`cloudprox.io.read_pointcloud2`)."""
+
+def write_pointcloud2(cloud: object) -> tuple[dict[str, Any], bytes]:
+    """Encode a cloud as a PointCloud2 (see :func:`cloudprox.io.write_pointcloud2`)."""
+
+def crop_box(
+    points: npt.ArrayLike,
+    min: npt.ArrayLike,
+    max: npt.ArrayLike,
+    pose: npt.ArrayLike | None = None,
+    invert: bool = False,
+) -> _IntArray:
+    """Return the indices (ascending) of the points inside the box (see :mod:`cloudprox.filters`)."""
+
+def voxel_downsample(
+    points: npt.ArrayLike,
+    voxel_size: float,
+    covariances: npt.ArrayLike | None = None,
+    merge: str = "mean",
+) -> tuple[_FloatArray, _FloatArray | None, _IntArray]:
+    """One point per occupied voxel (see :mod:`cloudprox.filters`)."""
+
+def statistical_outlier_removal(
+    points: npt.ArrayLike, k: int = ..., std_ratio: float = ...
+) -> _IntArray:
+    """Return the indices (ascending) of the points kept (see :mod:`cloudprox.filters`)."""
+
+def shadow_filter(
+    points: npt.ArrayLike,
+    origin: npt.ArrayLike,
+    *,
+    pixels: npt.ArrayLike | None = None,
+    grid_shape: tuple[int, int] | None = None,
+    min_angle_deg: float = 10.0,
+    window: int = 1,
+    k: int = 8,
+) -> _IntArray:
+    """Return the indices of the points kept by the veil filter (see :mod:`cloudprox.filters`)."""
+
+@final
+class SelfFilter:
+    """Removes the points on the robot (see :mod:`cloudprox.filters`)."""
+
+    def __new__(cls, links: object, padding: float = 0.01) -> SelfFilter: ...
+    def set_poses(self, poses: npt.ArrayLike) -> None:
+        """Move the links: ``(m, 4, 4)``, one pose per link."""
+    @property
+    def padding(self) -> float:
+        """The padding (metres)."""
+    def apply(self, points: npt.ArrayLike) -> _IntArray:
+        """Return the indices (ascending) of the points not on the robot."""

@@ -242,9 +242,7 @@ def _cmd_collide(args: argparse.Namespace) -> int:
             )
         else:
             assert side.cloud is not None
-            steps_text = "".join(
-                f", {f['filter']} -> {f['after']}" for f in side.filters
-            )
+            steps_text = "".join(f", {f['filter']} -> {f['after']}" for f in side.filters)
             skipped = f", {side.skipped} non-finite skipped" if side.skipped else ""
             console.print(
                 f"{name}: {side.path} ({side.read_points} points{skipped}{steps_text}; "
@@ -273,7 +271,7 @@ def _cmd_collide(args: argparse.Namespace) -> int:
 
 
 def file_info(path: str) -> dict[str, Any]:
-    """A plain-JSON summary of a point-cloud or mesh file.
+    """Summarize a point-cloud or mesh file as plain JSON.
 
     Point clouds: format, points, non-finite points skipped, organized layout,
     fields, bounds, sensor pose and the estimated sampling spacing (median and

@@ -24,22 +24,28 @@ from __future__ import annotations
 
 import os
 import warnings
-from typing import Literal
+from collections.abc import Sequence
+from typing import Any, Literal
 
 from cloudprox._native import CloudFile, Mesh
 from cloudprox._native import read_mesh as _read_mesh
 from cloudprox._native import read_point_cloud as _read_point_cloud
+from cloudprox._native import read_pointcloud2 as _read_pointcloud2
 from cloudprox._native import write_mesh as _write_mesh
 from cloudprox._native import write_point_cloud as _write_point_cloud
+from cloudprox._native import write_pointcloud2 as _write_pointcloud2
 from cloudprox.exceptions import DegenerateFacesWarning
 
 __all__ = [
     "CloudFile",
     "DegenerateFacesWarning",
+    "from_ros_message",
     "read_mesh",
     "read_point_cloud",
+    "read_pointcloud2",
     "write_mesh",
     "write_point_cloud",
+    "write_pointcloud2",
 ]
 
 CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
@@ -152,3 +158,90 @@ def write_mesh(
 ) -> None:
     """Write a triangle mesh (STL and PLY: binary unless ascii is asked for)."""
     _write_mesh(os.fspath(path), mesh, format, encoding=encoding, write_ascii=write_ascii)
+
+
+def read_pointcloud2(
+    data: bytes | bytearray | memoryview,
+    fields: Sequence[tuple[str, int, int, int]] | Sequence[Any],
+    *,
+    height: int,
+    width: int,
+    point_step: int,
+    row_step: int,
+    is_bigendian: bool = False,
+) -> CloudFile:
+    """Read a ROS ``sensor_msgs/PointCloud2`` from its raw bytes and field layout.
+
+    No ROS installation is needed: give the message's ``data`` and layout.
+
+    Parameters
+    ----------
+    data : bytes-like
+        The message's ``data`` (``row_step * height`` bytes at least).
+    fields : sequence
+        ``(name, offset, datatype, count)`` tuples, or ROS ``PointField`` objects;
+        datatypes 1-8 are INT8, UINT8, INT16, UINT16, INT32, UINT32, FLOAT32,
+        FLOAT64. ``x``, ``y`` and ``z`` are required; ``normal_x/y/z`` are read as
+        normals.
+    height, width, point_step, row_step, is_bigendian
+        As in the message. ``height > 1`` is an organized cloud.
+
+    Returns
+    -------
+    CloudFile
+        Points with finite coordinates; NaN points (the holes of an organized
+        cloud) are skipped and counted in ``skipped``, and ``pixels`` gives each
+        kept point's pixel.
+
+    Raises
+    ------
+    cloudprox.FormatError
+        If the layout does not fit the data (a field past ``point_step``, data
+        shorter than ``row_step * height``, an unknown datatype, no ``x``).
+    """
+    return _read_pointcloud2(
+        data,
+        fields,
+        height=height,
+        width=width,
+        point_step=point_step,
+        row_step=row_step,
+        is_bigendian=is_bigendian,
+    )
+
+
+def from_ros_message(msg: Any) -> CloudFile:
+    """Read a ROS 1 or ROS 2 ``sensor_msgs/PointCloud2`` message object.
+
+    Any object with the message's attributes works (``data``, ``fields`` with
+    ``name``/``offset``/``datatype``/``count``, ``height``, ``width``,
+    ``point_step``, ``row_step``, ``is_bigendian``); see :func:`read_pointcloud2`.
+    """
+    return read_pointcloud2(
+        bytes(msg.data),
+        list(msg.fields),
+        height=int(msg.height),
+        width=int(msg.width),
+        point_step=int(msg.point_step),
+        row_step=int(msg.row_step),
+        is_bigendian=bool(msg.is_bigendian),
+    )
+
+
+def write_pointcloud2(cloud: object) -> tuple[dict[str, Any], bytes]:
+    """Encode a cloud as a dense ``PointCloud2`` (float32 x, y, z; little endian).
+
+    Parameters
+    ----------
+    cloud : CloudFile, PointCloud or array_like of shape (n, 3)
+        The points (and normals of a ``CloudFile`` that has them).
+
+    Returns
+    -------
+    layout : dict
+        ``height`` (1), ``width``, ``fields`` as ``(name, offset, datatype,
+        count)`` tuples, ``is_bigendian``, ``point_step``, ``row_step``.
+    data : bytes
+        The message's ``data``.
+    """
+    return _write_pointcloud2(cloud)

@@ -31,9 +31,9 @@ from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera
 
 __all__ = [
     "MESH_EXTENSIONS",
-    "PipelineError",
     "FilterStep",
     "LoadedSide",
+    "PipelineError",
     "SensorSpec",
     "load_side",
     "parse_filter",
@@ -56,7 +56,7 @@ class PipelineError(ValueError):
 
 
 def parse_vector(text: str, n: int, what: str) -> FloatArray:
-    """``n`` numbers separated by commas or spaces."""
+    """Parse ``n`` numbers separated by commas or spaces."""
     parts = [p for p in text.replace(",", " ").split() if p]
     try:
         values = np.array([float(p) for p in parts], dtype=np.float64)
@@ -82,7 +82,7 @@ def _quaternion_matrix(w: float, x: float, y: float, z: float, what: str) -> Flo
 
 
 def parse_pose(text: str, what: str) -> FloatArray:
-    """A ``(4, 4)`` pose from a file or inline numbers.
+    """Parse a ``(4, 4)`` pose from a file or inline numbers.
 
     Accepted: a ``.npy`` file holding a ``(4, 4)`` array; a text file of 16
     numbers (row-major); inline ``"x,y,z"`` (a translation), ``"x,y,z,qw,qx,qy,qz"``
@@ -135,8 +135,10 @@ class SensorSpec:
     sensor_pose: FloatArray | None = None
 
     def covariances(self, scan: io.CloudFile, points: FloatArray) -> FloatArray | None:
-        """Sensor covariances ``(n, 3, 3)`` of ``points`` read from ``scan``, or ``None``
-        when the noise is an isotropic sigma (applied later)."""
+        """Return the sensor covariances ``(n, 3, 3)`` of ``points`` read from ``scan``.
+
+        ``None`` when the noise is an isotropic sigma (applied later).
+        """
         if self.model is None:
             if self.sigma is None:
                 if scan.covariances is None:
@@ -157,7 +159,7 @@ class SensorSpec:
         return self.model.covariances(points, sensor_pose=pose)
 
     def sensor_origin(self, scan: io.CloudFile) -> FloatArray | None:
-        """Where the sensor sits (for the shadow filter), if known."""
+        """Return where the sensor sits (for the shadow filter), if known."""
         if self.origin is not None:
             return self.origin
         pose = self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
@@ -172,11 +174,12 @@ class FilterStep:
     args: tuple[str, ...] = ()
 
     def describe(self) -> str:
+        """Return the step as written on the command line."""
         return self.name + "".join(f":{a}" for a in self.args)
 
 
 def parse_filter(text: str) -> FilterStep:
-    """A filter step ``NAME[:ARG[:ARG...]]``.
+    """Parse a filter step ``NAME[:ARG[:ARG...]]``.
 
     ``crop:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX``, ``voxel:SIZE``, ``outliers[:K[:STD]]``,
     ``shadow[:MIN_ANGLE_DEG]``, ``self:MESH_FILE[:PADDING[:POSE]]``.
@@ -364,7 +367,7 @@ def sensor_spec(
     origin: str | None,
     sensor_pose: str | None,
 ) -> SensorSpec:
-    """The noise of the cloud sides from the CLI's options."""
+    """Build the noise of the cloud sides from the CLI's options."""
     o = None if origin is None else parse_vector(origin, 3, "--origin")
     sp = None if sensor_pose is None else parse_pose(sensor_pose, "--sensor-pose")
     if kind is None:

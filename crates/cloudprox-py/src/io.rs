@@ -5,11 +5,15 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use cloudprox::cloud::{pose_to_matrix, PointCloud};
+use cloudprox::io::pointcloud2::{
+    read_pointcloud2 as read_pc2, write_pointcloud2 as write_pc2, PointCloud2Layout, PointField,
+};
 use cloudprox::io::{self, CloudData, CloudFormat, Encoding, MeshFormat};
 use cloudprox::math::{Matrix3, Pose};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
 
 use crate::cloud::{noise_from, PyPointCloud};
 use crate::convert::{matrices3_to_py, points_from, points_to_py, rows3_to_py};
@@ -338,4 +342,106 @@ pub fn write_mesh(
     let encoding = encoding_from(py, encoding, write_ascii, false)?;
     let mesh = Arc::clone(&mesh.get().inner);
     run_detached(py, move || io::write_mesh(&path, &mesh, format, encoding))
+}
+
+/// One field of a PointCloud2 layout from a `(name, offset, datatype, count)`
+/// tuple or an object with those attributes (a ROS `PointField`).
+fn point_field_from(obj: &Bound<'_, PyAny>, i: usize) -> PyResult<PointField> {
+    let py = obj.py();
+    let bad = |e: PyErr| {
+        invalid_input(
+            py,
+            format!(
+                "fields[{i}] must be (name, offset, datatype, count) or have those attributes: {}",
+                e.value(py)
+            ),
+        )
+    };
+    let (name, offset, datatype, count): (String, u32, u8, u32) = if obj.hasattr("name")? {
+        (
+            obj.getattr("name")?.extract().map_err(bad)?,
+            obj.getattr("offset")?.extract().map_err(bad)?,
+            obj.getattr("datatype")?.extract().map_err(bad)?,
+            obj.getattr("count")?.extract().map_err(bad)?,
+        )
+    } else {
+        obj.extract().map_err(bad)?
+    };
+    Ok(PointField {
+        name,
+        offset,
+        datatype,
+        count,
+    })
+}
+
+/// Reads a ROS `sensor_msgs/PointCloud2` from its raw `data` bytes and layout
+/// (no ROS needed). `fields` are `(name, offset, datatype, count)` tuples or ROS
+/// `PointField` objects. NaN points (holes of organized clouds) are skipped and
+/// counted in `CloudFile.skipped`.
+#[pyfunction]
+#[pyo3(signature = (data, fields, *, height, width, point_step, row_step, is_bigendian=false))]
+pub fn read_pointcloud2(
+    py: Python<'_>,
+    data: &Bound<'_, PyAny>,
+    fields: &Bound<'_, PyAny>,
+    height: u32,
+    width: u32,
+    point_step: u32,
+    row_step: u32,
+    is_bigendian: bool,
+) -> PyResult<PyCloudFile> {
+    let bytes: Vec<u8> = if let Ok(b) = data.cast::<PyBytes>() {
+        b.as_bytes().to_vec()
+    } else {
+        // bytearray, memoryview, array.array('B'), numpy uint8 arrays, lists of ints
+        py.import("builtins")?
+            .getattr("bytes")?
+            .call1((data,))
+            .map_err(|e| invalid_input(py, format!("data must be bytes-like: {}", e.value(py))))?
+            .cast_into::<PyBytes>()?
+            .as_bytes()
+            .to_vec()
+    };
+    let fields = fields
+        .try_iter()?
+        .enumerate()
+        .map(|(i, f)| point_field_from(&f?, i))
+        .collect::<PyResult<Vec<_>>>()?;
+    let layout = PointCloud2Layout {
+        height,
+        width,
+        fields,
+        is_bigendian,
+        point_step,
+        row_step,
+    };
+    let data = run_detached(py, move || read_pc2(&layout, &bytes))?;
+    Ok(PyCloudFile::new(data, "PointCloud2".to_string()))
+}
+
+/// The layout of `write_pointcloud2`'s message as a dict.
+type Pc2Out<'py> = (Bound<'py, PyDict>, Bound<'py, PyBytes>);
+
+/// Encodes a cloud (`CloudFile`, `PointCloud` or `(n, 3)` array-like) as a dense
+/// PointCloud2 (float32 x, y, z, little endian, height 1): returns the layout
+/// (`height`, `width`, `fields` as `(name, offset, datatype, count)` tuples,
+/// `is_bigendian`, `point_step`, `row_step`) and the data bytes.
+#[pyfunction]
+pub fn write_pointcloud2<'py>(py: Python<'py>, cloud: &Bound<'py, PyAny>) -> PyResult<Pc2Out<'py>> {
+    let data = cloud_data_from(cloud)?;
+    let (layout, bytes) = run_detached(py, move || write_pc2(&data))?;
+    let d = PyDict::new(py);
+    d.set_item("height", layout.height)?;
+    d.set_item("width", layout.width)?;
+    let fields: Vec<(String, u32, u8, u32)> = layout
+        .fields
+        .iter()
+        .map(|f| (f.name.clone(), f.offset, f.datatype, f.count))
+        .collect();
+    d.set_item("fields", fields)?;
+    d.set_item("is_bigendian", layout.is_bigendian)?;
+    d.set_item("point_step", layout.point_step)?;
+    d.set_item("row_step", layout.row_step)?;
+    Ok((d, PyBytes::new(py, &bytes)))
 }
