@@ -39,6 +39,7 @@ __all__ = [
     "exact_proximity",
     "exact_proximity_many",
     "option_names",
+    "parse_mesh",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
@@ -897,3 +898,6 @@ class SelfFilter:
         """The padding (metres)."""
     def apply(self, points: npt.ArrayLike) -> _IntArray:
         """Return the indices (ascending) of the points not on the robot."""
+
+def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> tuple[Mesh, int]:
+    """Read a mesh from bytes (see :func:`cloudprox.io.parse_mesh`)."""

@@ -28,6 +28,7 @@ from collections.abc import Sequence
 from typing import Any, Literal
 
 from cloudprox._native import CloudFile, Mesh
+from cloudprox._native import parse_mesh as _parse_mesh
 from cloudprox._native import read_mesh as _read_mesh
 from cloudprox._native import read_point_cloud as _read_point_cloud
 from cloudprox._native import read_pointcloud2 as _read_pointcloud2
@@ -40,6 +41,7 @@ __all__ = [
     "CloudFile",
     "DegenerateFacesWarning",
     "from_ros_message",
+    "parse_mesh",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
@@ -139,12 +141,27 @@ def read_mesh(path: PathLike, format: MeshFormatName = "auto") -> Mesh:
         If its content is corrupt, truncated or unsupported.
     """
     mesh, dropped = _read_mesh(os.fspath(path), format)
+    _warn_dropped(os.fspath(path), dropped)
+    return mesh
+
+
+def _warn_dropped(source: str, dropped: int) -> None:
     if dropped:
         warnings.warn(
-            f"{os.fspath(path)}: dropped {dropped} degenerate face(s) that repeat a vertex",
+            f"{source}: dropped {dropped} degenerate face(s) that repeat a vertex",
             DegenerateFacesWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
+
+
+def parse_mesh(data: bytes, format: MeshFormatName, name: str = "<bytes>") -> Mesh:
+    """Read a triangle mesh from bytes in memory (e.g. a member of a zip archive).
+
+    As :func:`read_mesh`; ``format`` must be given (``"stl"``, ``"obj"``,
+    ``"ply"`` or ``"off"``) and ``name`` is used in messages.
+    """
+    mesh, dropped = _parse_mesh(data, format, name)
+    _warn_dropped(name, dropped)
     return mesh
 
 

@@ -445,3 +445,25 @@ pub fn write_pointcloud2<'py>(py: Python<'py>, cloud: &Bound<'py, PyAny>) -> PyR
     d.set_item("row_step", layout.row_step)?;
     Ok((d, PyBytes::new(py, &bytes)))
 }
+
+/// Reads a mesh from bytes in memory (`format`: stl, obj, ply or off; `name`
+/// is used in errors); returns the mesh and the number of dropped degenerate faces.
+#[pyfunction]
+#[pyo3(signature = (data, format, name="<bytes>"))]
+pub fn parse_mesh(
+    py: Python<'_>,
+    data: &Bound<'_, PyBytes>,
+    format: &str,
+    name: &str,
+) -> PyResult<(PyMesh, usize)> {
+    let Some(format) = mesh_format(py, format)? else {
+        return Err(invalid_input(
+            py,
+            "parse_mesh needs the format (stl, obj, ply or off), not auto",
+        ));
+    };
+    let bytes = data.as_bytes().to_vec();
+    let name = name.to_string();
+    let data = run_detached(py, move || io::read_mesh_bytes(&bytes, &name, format))?;
+    Ok((PyMesh::wrap(data.mesh), data.dropped_faces))
+}

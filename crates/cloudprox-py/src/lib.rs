@@ -58,6 +58,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::write_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(io::parse_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_pointcloud2, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_pointcloud2, m)?)?;
     m.add_class::<sensor::PyDepthCamera>()?;

@@ -63,6 +63,7 @@ import numpy.typing as npt
 
 from cloudprox._native import Mesh
 from cloudprox.exceptions import DegenerateFacesWarning
+from cloudprox.io import parse_mesh, read_mesh
 
 __all__ = [
     "PANDA_FINGER_MOUNT",
@@ -646,134 +647,9 @@ def load_kinect_frame(path: str | os.PathLike[str] | None = None) -> DepthFrame:
 # ------------------------------------------------------------------ Wavefront OBJ
 
 
-#: Statements that describe no geometry of a polygonal surface.
-_OBJ_IGNORED = frozenset(
-    "vt vn vp usemtl mtllib o g s mg usemap maplib lod bevel c_interp d_interp "
-    "shadow_obj trace_obj".split()
-)
-
-
-def _obj_lines(text: str) -> list[tuple[int, list[str]]]:
-    """Tokenised statements with their (first) line numbers; comments and blanks removed."""
-    statements: list[tuple[int, list[str]]] = []
-    pending: list[str] = []
-    start = 0
-    for number, line in enumerate(text.split("\n"), start=1):
-        line = line.split("#", 1)[0]
-        if not pending:
-            start = number
-        stripped = line.rstrip()
-        if stripped.endswith("\\"):  # continuation line
-            pending.append(stripped[:-1])
-            continue
-        tokens = " ".join([*pending, line]).split()
-        pending = []
-        if tokens:
-            statements.append((start, tokens))
-    if pending:
-        tokens = " ".join(pending).split()
-        if tokens:
-            statements.append((start, tokens))
-    return statements
-
-
-def _parse_obj(text: str, source: str) -> tuple[Mesh, int]:
-    """Parse OBJ text into a mesh; also return the number of degenerate faces dropped."""
-    vertices: list[tuple[float, float, float]] = []
-    triangles: list[tuple[int, int, int]] = []
-    face_lines: list[int] = []
-    for number, tokens in _obj_lines(text):
-        keyword, args = tokens[0], tokens[1:]
-        where = f"{source}, line {number}"
-        if keyword == "v":
-            if len(args) not in (3, 4):
-                raise ValueError(f"{where}: a vertex needs 3 or 4 numbers, found {len(args)}")
-            try:
-                if any("_" in a for a in args):  # Python's float() would accept 1_0
-                    raise ValueError
-                coords = [float(a) for a in args]
-            except ValueError:
-                raise ValueError(f"{where}: malformed number in vertex {args}") from None
-            if not all(math.isfinite(c) for c in coords):
-                raise ValueError(f"{where}: non-finite vertex coordinate {args}")
-            vertices.append((coords[0], coords[1], coords[2]))
-        elif keyword == "f":
-            if len(args) < 3:
-                raise ValueError(f"{where}: a face needs at least 3 vertices, found {len(args)}")
-            corners: list[int] = []
-            for arg in args:
-                parts = arg.split("/")
-                try:
-                    if "_" in arg or len(parts) > 3 or any(p and int(p) == 0 for p in parts[1:]):
-                        raise ValueError
-                    index = int(parts[0])
-                except ValueError:
-                    raise ValueError(f"{where}: malformed face vertex {arg!r}") from None
-                if index == 0:
-                    raise ValueError(f"{where}: face vertex index 0 (indices start at 1)")
-                # Negative indices count back from the last vertex defined so far.
-                resolved = index - 1 if index > 0 else len(vertices) + index
-                if resolved < 0:
-                    raise ValueError(
-                        f"{where}: face vertex index {index} out of range "
-                        f"({len(vertices)} vertices defined so far)"
-                    )
-                corners.append(resolved)
-            for i in range(1, len(corners) - 1):  # fan triangulation
-                triangles.append((corners[0], corners[i], corners[i + 1]))
-                face_lines.append(number)
-        elif keyword not in _OBJ_IGNORED:
-            raise ValueError(f"{where}: unsupported OBJ statement {keyword!r}")
-    if not triangles:
-        raise ValueError(f"{source}: no faces")
-    faces = np.array(triangles, dtype=np.int64)
-    too_big = np.flatnonzero(faces.max(axis=1) >= len(vertices))
-    if too_big.size:
-        k = int(too_big[0])
-        raise ValueError(
-            f"{source}, line {face_lines[k]}: face vertex index {int(faces[k].max()) + 1} "
-            f"out of range ({len(vertices)} vertices)"
-        )
-    degenerate = (
-        (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
-    )
-    if degenerate.all():
-        raise ValueError(f"{source}: no faces (all {len(faces)} repeat a vertex)")
-    mesh = Mesh(np.array(vertices, dtype=np.float64), faces[~degenerate])
-    return mesh, int(degenerate.sum())
-
-
-def _warn_degenerate(source: str, dropped: int) -> None:
-    if dropped:
-        warnings.warn(
-            f"{source}: dropped {dropped} degenerate face(s) that repeat a vertex",
-            DegenerateFacesWarning,
-            stacklevel=3,
-        )
-
-
 def load_obj(path: str | os.PathLike[str]) -> Mesh:
-    """Read a triangle mesh from a Wavefront OBJ file.
-
-    Reads ``v x y z [w]`` (``w`` ignored) and ``f`` statements with ``a``,
-    ``a/b``, ``a//c`` or ``a/b/c`` corners (1-based, or negative: relative to the
-    last vertex defined so far); polygons are split into a fan of triangles.
-    Texture coordinates, normals, materials, groups, objects and smoothing
-    groups are ignored; other statements (lines, curves, ...) are rejected.
-    Triangles that repeat a vertex are dropped with a
-    :class:`DegenerateFacesWarning` giving their number.
-
-    Raises
-    ------
-    ValueError
-        Naming the file and line: a malformed number, an index out of range, a
-        face with fewer than 3 vertices, an unsupported statement; or no face.
-    """
-    source = Path(path)
-    text = source.read_bytes().decode("utf-8", "replace")
-    mesh, dropped = _parse_obj(text, str(source))
-    _warn_degenerate(str(source), dropped)
-    return mesh
+    """Read a triangle mesh from a Wavefront OBJ file (:func:`cloudprox.io.read_mesh`)."""
+    return read_mesh(path, "obj")
 
 
 # ------------------------------------------------------------------ Panda gripper
@@ -830,11 +706,9 @@ def _panda_meshes(wheel: Path) -> tuple[Mesh, Mesh]:
     with zipfile.ZipFile(wheel) as archive:
         for name in ("hand.obj", "finger.obj"):
             member = _PANDA_ASSETS + name
-            text = archive.read(member).decode("utf-8", "replace")
-            mesh, dropped = _parse_obj(text, f"{wheel}!{member}")
-            if dropped:
-                raise ValueError(f"{wheel}!{member}: {dropped} faces repeat a vertex")
-            meshes.append(mesh)
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", DegenerateFacesWarning)
+                meshes.append(parse_mesh(archive.read(member), "obj", f"{wheel}!{member}"))
     return meshes[0], meshes[1]
 
 

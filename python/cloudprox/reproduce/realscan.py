@@ -48,7 +48,13 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial import ConvexHull
 
-from cloudprox._native import ExactShape, Mesh, exact_intersects_many, exact_proximity_many
+from cloudprox._native import (
+    DepthCamera,
+    ExactShape,
+    Mesh,
+    exact_intersects_many,
+    exact_proximity_many,
+)
 from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.data import (
     DepthFrame,
@@ -67,6 +73,7 @@ __all__ = [
     "ScanResult",
     "convex_hull",
     "kinect_axial_sigma",
+    "kinect_camera",
     "kinect_covariances",
     "run_scan",
     "sample_scan_poses",
@@ -89,25 +96,32 @@ _COARSE = 0.005
 _ROUNDS = 200
 
 
+def kinect_camera(focal: float = 580.0) -> DepthCamera:
+    """The Kinect v1 noise model of Nguyen et al. (2012) with this focal length (px).
+
+    ``sigma_z = 0.0012 + 0.0019 (z - 0.4)^2`` along the optical axis (stretched by
+    ``|p| / z`` along the viewing ray), 0.8 px laterally: the core's
+    :meth:`cloudprox.DepthCamera.nguyen_2012` with the frame's own focal length.
+    """
+    base = DepthCamera.nguyen_2012()
+    return DepthCamera(
+        axial_offset=base.axial_offset,
+        axial_quadratic=base.axial_quadratic,
+        axial_depth0=base.axial_depth0,
+        focal_px=focal,
+        sigma_px=base.sigma_px,
+    )
+
+
 def kinect_axial_sigma(depth: FloatArray) -> FloatArray:
     """Kinect v1 axial standard deviation (metres) at ``depth`` (Nguyen et al. 2012)."""
     z = np.asarray(depth, dtype=float)
-    return 0.0012 + 0.0019 * (z - 0.4) ** 2
+    return np.asarray(kinect_camera().sigma_axial(z.ravel())).reshape(z.shape)
 
 
 def kinect_covariances(points: FloatArray, focal: float) -> FloatArray:
     """Kinect v1 sensor covariances ``(n, 3, 3)`` of points in the optical frame (sensor at 0)."""
-    z = points[:, 2]
-    dist = np.linalg.norm(points, axis=1)
-    # sigma_z is the spread of the depth z; along the ray it is longer by |p| / z.
-    axial = kinect_axial_sigma(z) * dist / z
-    lateral = 0.8 * z / focal
-    ray = points / dist[:, None]
-    outer = ray[:, :, None] * ray[:, None, :]
-    eye = np.eye(3)[None]
-    return np.ascontiguousarray(
-        lateral[:, None, None] ** 2 * (eye - outer) + axial[:, None, None] ** 2 * outer
-    )
+    return np.asarray(kinect_camera(focal).covariances(points, sensor_pose=np.eye(4)))
 
 
 def convex_hull(mesh: Mesh) -> Mesh:
