@@ -97,7 +97,7 @@ _ROUNDS = 200
 
 
 def kinect_camera(focal: float = 580.0) -> DepthCamera:
-    """The Kinect v1 noise model of Nguyen et al. (2012) with this focal length (px).
+    """Return the Kinect v1 noise model of Nguyen et al. (2012) with this focal length (px).
 
     ``sigma_z = 0.0012 + 0.0019 (z - 0.4)^2`` along the optical axis (stretched by
     ``|p| / z`` along the viewing ray), 0.8 px laterally: the core's
