@@ -93,17 +93,17 @@ def test_collide_with_pose_and_options(capsys, npy_files) -> None:
     ("argv", "message"),
     [
         (["collide", "{a}", "{dir}/missing.npy", "--sigma", "0.002"], "no such file"),
-        (["collide", "{a}", "{text}", "--sigma", "0.002"], "not a .npy file"),
-        (["collide", "{a}", "{npz}", "--sigma", "0.002"], ".npz archive"),
+        (["collide", "{a}", "{text}", "--sigma", "0.002"], "not a valid NPY file: wrong magic"),
+        (["collide", "{a}", "{npz}", "--sigma", "0.002"], 'from the extension "npz"'),
         (["collide", "{a}", "{dir}", "--sigma", "0.002"], "is a directory"),
         (
             ["collide", "{a}", "{flat}", "--sigma", "0.002"],
-            "must have shape (n, 3), got shape (5, 2)",
+            "shape (5, 2) has fewer than 3 columns",
         ),
         (["collide", "{a}", "{b}", "--sigma", "-1"], "sigma must be finite and >= 0"),
         (
             ["collide", "{a}", "{b}", "--sigma", "0.002", "--pose-a", "{a}"],
-            "pose_a must have shape",
+            "must hold a (4, 4) matrix",
         ),
         (["collide", "{a}", "{b}", "--sigma", "0.002", "--surface", "cubic"], "invalid choice"),
         (["collide", "{a}", "{b}"], "--sigma"),

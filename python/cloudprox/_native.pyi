@@ -8,6 +8,7 @@ arrays. Units are SI: metres, and metres squared for covariances. Poses map an
 object's own frame to the world; ``None`` means identity.
 """
 
+from collections.abc import Sequence
 from typing import Any, Final, Literal, TypedDict, final
 
 import numpy as np
@@ -755,8 +756,21 @@ class Lidar:
 class CloudFile:
     """A point cloud as read from a file: points and whatever else the file holds.
 
-    Returned by :func:`cloudprox.io.read_point_cloud`.
+    Returned by :func:`cloudprox.io.read_point_cloud`; made directly to write
+    data with a sensor pose or an organized layout (missing pixels are written
+    as NaN records).
     """
+
+    def __new__(
+        cls,
+        points: npt.ArrayLike,
+        *,
+        normals: npt.ArrayLike | None = None,
+        covariances: npt.ArrayLike | None = None,
+        sensor_pose: npt.ArrayLike | None = None,
+        grid_shape: tuple[int, int] | None = None,
+        pixels: Sequence[int] | None = None,
+    ) -> CloudFile: ...
 
     @property
     def points(self) -> _FloatArray:

@@ -8,7 +8,7 @@ use cloudprox::cloud::{pose_to_matrix, PointCloud};
 use cloudprox::io::pointcloud2::{
     read_pointcloud2 as read_pc2, write_pointcloud2 as write_pc2, PointCloud2Layout, PointField,
 };
-use cloudprox::io::{self, CloudData, CloudFormat, Encoding, MeshFormat};
+use cloudprox::io::{self, CloudData, CloudFormat, Encoding, Grid, MeshFormat};
 use cloudprox::math::{Matrix3, Pose};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -115,6 +115,107 @@ impl PyCloudFile {
 
 #[pymethods]
 impl PyCloudFile {
+    /// Data to write: points `(n, 3)` and optionally normals `(n, 3)`,
+    /// covariances `(n, 3, 3)`, the sensor pose `(4, 4)` (written as a PCD
+    /// `VIEWPOINT`) and an organized layout (`grid_shape = (height, width)` with
+    /// the pixel of each point; missing pixels are written as NaN records).
+    #[new]
+    #[pyo3(signature = (points, *, normals=None, covariances=None, sensor_pose=None, grid_shape=None, pixels=None))]
+    fn py_new(
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        normals: Option<&Bound<'_, PyAny>>,
+        covariances: Option<&Bound<'_, PyAny>>,
+        sensor_pose: Option<&Bound<'_, PyAny>>,
+        grid_shape: Option<(usize, usize)>,
+        pixels: Option<Vec<i64>>,
+    ) -> PyResult<Self> {
+        let points = points_from(points, "points")?;
+        let n = points.len();
+        if let Some((i, p)) = points
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(invalid_input(
+                py,
+                format!(
+                    "point {i} has a non-finite coordinate: {:?}",
+                    p.coords.as_slice()
+                ),
+            ));
+        }
+        let mut data = CloudData::from_points(points);
+        if let Some(nr) = normals {
+            let nr = points_from(nr, "normals")?;
+            if nr.len() != n {
+                return Err(invalid_input(
+                    py,
+                    format!("{} normals for {n} points", nr.len()),
+                ));
+            }
+            data.normals = Some(nr.into_iter().map(|p| p.coords).collect());
+            data.fields.extend(["nx", "ny", "nz"].map(String::from));
+        }
+        if let Some(c) = covariances {
+            let c = crate::convert::matrices3_from(c, "covariances")?;
+            if c.len() != n {
+                return Err(invalid_input(
+                    py,
+                    format!("{} covariances for {n} points", c.len()),
+                ));
+            }
+            data.covariances = Some(c);
+            data.fields.extend(
+                ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"].map(String::from),
+            );
+        }
+        if sensor_pose.is_some() {
+            data.sensor = Some(crate::convert::pose_from(py, sensor_pose, "sensor_pose")?);
+        }
+        match (grid_shape, pixels) {
+            (None, None) => {}
+            (Some((height, width)), Some(px)) => {
+                if px.len() != n {
+                    return Err(invalid_input(
+                        py,
+                        format!("{} pixels for {n} points", px.len()),
+                    ));
+                }
+                let total = height.saturating_mul(width);
+                let mut out = Vec::with_capacity(n);
+                for (i, &p) in px.iter().enumerate() {
+                    let ok = u32::try_from(p).ok().filter(|&q| (q as usize) < total);
+                    let Some(q) = ok else {
+                        return Err(invalid_input(
+                            py,
+                            format!("pixels[{i}] = {p} is outside the {height}x{width} grid"),
+                        ));
+                    };
+                    if out.last().is_some_and(|&last| last >= q) {
+                        return Err(invalid_input(
+                            py,
+                            format!("pixels must be strictly increasing; pixels[{i}] = {p}"),
+                        ));
+                    }
+                    out.push(q);
+                }
+                data.grid = Some(Grid {
+                    width,
+                    height,
+                    pixels: out,
+                });
+            }
+            _ => {
+                return Err(invalid_input(
+                    py,
+                    "give both grid_shape and pixels (an organized cloud), or neither",
+                ))
+            }
+        }
+        Ok(Self::new(data, "<memory>".to_string()))
+    }
+
     /// Points with finite coordinates, shape `(n, 3)` (metres).
     #[getter]
     fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {

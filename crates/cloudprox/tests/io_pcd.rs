@@ -122,11 +122,22 @@ fn round_trips_every_encoding_within_f32() {
         back.sensor = cloud.sensor;
         assert_eq!(back, rounded(&cloud), "{enc:?}");
     }
-    // A grid with holes is written unorganized.
+    // A grid with holes is written organized, the holes as NaN records.
     cloud.grid = Some(Grid {
         width: 3,
         height: 2,
         pixels: vec![0, 2, 3, 5],
+    });
+    let bytes = write_pcd(&cloud, Encoding::BinaryCompressed).unwrap();
+    assert!(String::from_utf8_lossy(&bytes).contains("WIDTH 3\nHEIGHT 2\n"));
+    let back = read_pcd(&bytes, "t.pcd").unwrap();
+    assert_eq!(back.skipped, 2);
+    assert_eq!(back.grid.unwrap().pixels, vec![0, 2, 3, 5]);
+    // An inconsistent grid (pixels not increasing) is written unorganized.
+    cloud.grid = Some(Grid {
+        width: 3,
+        height: 2,
+        pixels: vec![2, 0, 3, 5],
     });
     let bytes = write_pcd(&cloud, Encoding::BinaryCompressed).unwrap();
     assert!(String::from_utf8_lossy(&bytes).contains("WIDTH 4\nHEIGHT 1\n"));
@@ -524,5 +535,34 @@ fn prefixes_and_bit_flips_never_panic() {
                 let _ = read_pcd(&f, "f.pcd");
             }
         }
+    }
+}
+
+#[test]
+fn organized_cloud_with_holes_round_trips_in_every_encoding() {
+    let points = vec![
+        Point3::new(0.0, 0.0, 1.0),
+        Point3::new(0.5, 0.0, 1.5),
+        Point3::new(0.0, 0.25, 2.0),
+        Point3::new(0.5, 0.25, 2.5),
+    ];
+    let mut cloud = CloudData::from_points(points.clone());
+    cloud.grid = Some(Grid {
+        width: 3,
+        height: 2,
+        pixels: vec![0, 2, 3, 5],
+    });
+    for enc in [
+        Encoding::Ascii,
+        Encoding::BinaryLittleEndian,
+        Encoding::BinaryCompressed,
+    ] {
+        let bytes = write_pcd(&cloud, enc).unwrap();
+        let back = read_pcd(&bytes, "holes.pcd").unwrap();
+        assert_eq!(back.points, points, "{enc:?}");
+        assert_eq!(back.skipped, 2, "{enc:?}");
+        let g = back.grid.expect("organized");
+        assert_eq!((g.width, g.height), (3, 2));
+        assert_eq!(g.pixels, vec![0, 2, 3, 5]);
     }
 }

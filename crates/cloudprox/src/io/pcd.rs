@@ -609,7 +609,9 @@ fn put(out: &mut Vec<u8>, v: f64, size: usize) {
 /// Encodes a point cloud as PCD v0.7 (`Ascii` → `DATA ascii`,
 /// `BinaryLittleEndian` → `DATA binary`, `BinaryCompressed` →
 /// `DATA binary_compressed`): `x y z` and normals as `F4`, covariances as
-/// `F8` (see the module documentation).
+/// `F8` (see the module documentation). A cloud with a consistent [`crate::io::Grid`]
+/// is written organized (`WIDTH x HEIGHT` records, NaN for the pixels it does
+/// not hold), else unorganized.
 ///
 /// # Errors
 /// [`Error::InvalidInput`] for [`Encoding::BinaryBigEndian`] or when the
@@ -651,16 +653,28 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         .map(|n| if n.starts_with("cov_") { 8 } else { 4 })
         .collect();
     let step: usize = sizes.iter().sum();
-    let (width, height) = match &cloud.grid {
-        Some(g)
-            if g.width.checked_mul(g.height) == Some(n)
-                && g.pixels.len() == n
-                && g.pixels.iter().enumerate().all(|(i, &p)| p as usize == i) =>
-        {
-            (g.width, g.height)
+    // Organized when the grid is consistent (pixels strictly increasing, inside
+    // the image): every pixel becomes a record, missing ones NaN (as PCL writes
+    // the holes of a depth image).
+    let organized = cloud.grid.as_ref().filter(|g| {
+        g.pixels.len() == n
+            && g.width.checked_mul(g.height).is_some()
+            && g.pixels.windows(2).all(|w| w[0] < w[1])
+            && g.pixels
+                .last()
+                .is_none_or(|&p| (p as usize) < g.width * g.height)
+    });
+    let (width, height, slots): (usize, usize, Vec<Option<usize>>) = match organized {
+        Some(g) => {
+            let mut slots = vec![None; g.width * g.height];
+            for (i, &p) in g.pixels.iter().enumerate() {
+                slots[p as usize] = Some(i);
+            }
+            (g.width, g.height, slots)
         }
-        _ => (n, 1),
+        None => (n, 1, (0..n).map(Some).collect()),
     };
+    let records = slots.len();
     let pose = cloud.sensor.unwrap_or_else(Pose::identity);
     let t = pose.translation.vector;
     let q = pose.rotation.quaternion();
@@ -681,8 +695,11 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         "VIEWPOINT {} {} {} {} {} {} {}",
         t.x, t.y, t.z, q.w, q.i, q.j, q.k
     );
-    let _ = writeln!(head, "POINTS {n}\nDATA {data}");
-    let row = |i: usize| -> Vec<f64> {
+    let _ = writeln!(head, "POINTS {records}\nDATA {data}");
+    let row = |slot: usize| -> Vec<f64> {
+        let Some(i) = slots[slot] else {
+            return vec![f64::NAN; k];
+        };
         let mut r: Vec<f64> = cloud.points[i].coords.iter().copied().collect();
         if let Some(normals) = &cloud.normals {
             r.extend(normals[i].iter());
@@ -705,7 +722,7 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         Encoding::Ascii => {
             // Shortest forms that read back as the same f32 / f64.
             let mut text = String::new();
-            for i in 0..n {
+            for i in 0..records {
                 for (f, (v, &size)) in row(i).into_iter().zip(&sizes).enumerate() {
                     let sep = if f == 0 { "" } else { " " };
                     let _ = if size == 4 {
@@ -719,8 +736,8 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
             out.extend_from_slice(text.as_bytes());
         }
         Encoding::BinaryLittleEndian => {
-            out.reserve(n * step);
-            for i in 0..n {
+            out.reserve(records * step);
+            for i in 0..records {
                 for (v, &size) in row(i).into_iter().zip(&sizes) {
                     put(&mut out, v, size);
                 }
@@ -728,8 +745,8 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         }
         _ => {
             // Field by field: all values of field 0, then of field 1, ...
-            let mut raw = Vec::with_capacity(n * step);
-            let rows: Vec<Vec<f64>> = (0..n).map(row).collect();
+            let mut raw = Vec::with_capacity(records * step);
+            let rows: Vec<Vec<f64>> = (0..records).map(row).collect();
             for (f, &size) in sizes.iter().enumerate() {
                 for r in &rows {
                     put(&mut raw, r[f], size);
