@@ -771,7 +771,6 @@ class CloudFile:
         grid_shape: tuple[int, int] | None = None,
         pixels: Sequence[int] | None = None,
     ) -> CloudFile: ...
-
     @property
     def points(self) -> _FloatArray:
         """Points with finite coordinates, shape ``(n, 3)`` (metres)."""

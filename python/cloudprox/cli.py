@@ -8,6 +8,8 @@
     or meshes (STL, OBJ, OFF, PLY with faces).
 ``cloudprox info FILE``
     A summary of a point-cloud or mesh file.
+``cloudprox example [DIR]``
+    Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 ``cloudprox bench``
     cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
 ``cloudprox reproduce [--quick] [--out DIR]``
@@ -264,6 +266,25 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
     )
     console.print(f"stats: {stats}")
+    return 0
+
+
+# ------------------------------------------------------------------------ example
+
+
+def _cmd_example(args: argparse.Namespace) -> int:
+    from cloudprox.examples import write_example_files
+
+    paths = write_example_files(args.out, seed=args.seed)
+    console = _console()
+    console.print(f"wrote the example files to {Path(args.out).resolve()}:")
+    for name, path in paths.items():
+        console.print(f"  {name}: {path.name}")
+    console.print(
+        "try: cloudprox collide "
+        f"{paths['gripper']} {paths['scan']} --pose-a {paths['grasp-free']} "
+        "--sensor depth-camera --preset nguyen-2012 --filter shadow"
+    )
     return 0
 
 
@@ -618,6 +639,16 @@ def _parser() -> argparse.ArgumentParser:
     col.add_argument("--json", action="store_true", help="print the result as JSON")
     col.set_defaults(func=_cmd_collide)
 
+    ex = sub.add_parser(
+        "example",
+        help="write example files: a depth-camera scan (PCD), a gripper (STL), two grasp poses",
+    )
+    ex.add_argument(
+        "out", nargs="?", default="cloudprox-example", help="folder (default: %(default)s)"
+    )
+    ex.add_argument("--seed", type=int, default=0, help="noise seed (default: %(default)s)")
+    ex.set_defaults(func=_cmd_example)
+
     info = sub.add_parser(
         "info", help="summarize a point-cloud or mesh file (points, bounds, fields, spacing)"
     )
@@ -685,7 +716,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_usage(sys.stderr)
         print(
-            "cloudprox: error: a command is required (demo, collide, info, bench or reproduce)",
+            "cloudprox: error: a command is required (demo, collide, info, example, bench or reproduce)",
             file=sys.stderr,
         )
         return 2
