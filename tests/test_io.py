@@ -380,12 +380,17 @@ def test_cloudprox_reads_what_open3d_writes(
         np.testing.assert_array_equal(got.points, pts)
         assert got.normals is not None
         np.testing.assert_array_equal(got.normals, nrm)
-    elif name == "ascii.ply":  # Open3D's ascii PLY keeps about 7 significant digits
-        np.testing.assert_allclose(got.points, pts, rtol=1e-6, atol=1e-6)
+    elif name == "ascii.ply":  # Open3D writes 6 significant digits: compare with the text
+        body = path.read_text().split("end_header\n", 1)[1]
+        table = np.loadtxt(body.splitlines(), ndmin=2)
+        np.testing.assert_allclose(table[:, :3], pts, atol=5e-6)
+        np.testing.assert_array_equal(got.points, table[:, :3])
         assert got.normals is not None
-        np.testing.assert_allclose(got.normals, nrm, atol=1e-6)
-    else:
-        np.testing.assert_allclose(got.points, pts, rtol=1e-9, atol=0.0)
+        np.testing.assert_array_equal(got.normals, table[:, 3:6])
+    else:  # Open3D writes 10 decimals: compare with the text
+        table = np.loadtxt(path, ndmin=2)
+        np.testing.assert_allclose(table, pts, rtol=0.0, atol=1e-10)
+        np.testing.assert_array_equal(got.points, table)
 
 
 @pytest.mark.parametrize("case", MESH_CASES, ids=case_id)
@@ -398,8 +403,8 @@ def test_open3d_reads_cloudprox_meshes(tmp_path: Path, case: tuple[str, str | No
     tm = o3d.io.read_triangle_mesh(str(path))
     verts, faces = np.asarray(tm.vertices), np.asarray(tm.triangles)
     assert len(faces) == len(m.faces)
-    # Open3D reads OBJ and OFF coordinates as float32, binary STL stores float32.
-    exact = ext == "ply" or (ext == "stl" and encoding == "ascii")
+    # Open3D reads STL, OBJ and OFF coordinates as float32; binary STL stores float32.
+    exact = ext == "ply"
     want = m.vertices if exact else f32(m.vertices)
     got_tris = np.array(triangles(verts, faces))
     want_tris = np.array(triangles(want, m.faces))
@@ -572,15 +577,45 @@ def test_organized_pcd_with_holes_and_viewpoint(tmp_path: Path) -> None:
     with_disc = cf.to_point_cloud(sensor=cam)
     np.testing.assert_array_equal(with_disc.sensor_covariances, want)
 
-    # Written back: holes cannot keep the grid, so the cloud is unorganized.
-    out = tmp_path / "out.pcd"
-    cp.io.write_point_cloud(out, cf, encoding="ascii")
-    again = cp.io.read_point_cloud(out)
-    assert b"\nWIDTH 3\nHEIGHT 1\n" in out.read_bytes()
-    assert again.grid_shape is None
-    np.testing.assert_array_equal(again.points, cf.points)
-    assert again.sensor_pose is not None
-    np.testing.assert_allclose(again.sensor_pose, cf.sensor_pose, atol=1e-12)
+    # Written back, the grid is kept with NaN records for the holes (as PCL writes them).
+    for encoding in ("ascii", "binary", "binary_compressed"):
+        out = tmp_path / f"out-{encoding}.pcd"
+        cp.io.write_point_cloud(out, cf, encoding=encoding)  # type: ignore[arg-type]
+        assert b"\nWIDTH 3\nHEIGHT 2\n" in out.read_bytes()
+        assert b"\nPOINTS 6\n" in out.read_bytes()
+        again = cp.io.read_point_cloud(out)
+        np.testing.assert_array_equal(again.points, cf.points)
+        assert again.grid_shape == (2, 3)
+        assert again.pixels is not None
+        np.testing.assert_array_equal(again.pixels, cf.pixels)
+        assert again.skipped == 3
+        assert again.sensor_pose is not None
+        np.testing.assert_allclose(again.sensor_pose, cf.sensor_pose, atol=1e-12)
+
+
+def test_cloudfile_made_for_writing(tmp_path: Path) -> None:
+    pose = np.eye(4)
+    pose[:3, :3] = rotation(0.0, np.pi / 2)
+    pose[:3, 3] = (0.1, 0.2, 0.3)
+    pts = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 2.0]])
+    cf = cp.io.CloudFile(pts, sensor_pose=pose, grid_shape=(2, 2), pixels=[0, 1, 3])
+    assert cf.skipped == 0
+    assert cf.grid_shape == (2, 2)
+    path = tmp_path / "made.pcd"
+    cp.io.write_point_cloud(path, cf)
+    got = cp.io.read_point_cloud(path)
+    np.testing.assert_array_equal(got.points, pts)
+    assert got.pixels is not None
+    np.testing.assert_array_equal(got.pixels, [0, 1, 3])
+    assert got.skipped == 1
+    assert got.sensor_pose is not None
+    np.testing.assert_allclose(got.sensor_pose, pose, atol=1e-12)
+    with pytest.raises(InvalidInputError, match=r"pixels\[1\] = 2 is outside the 1x2 grid"):
+        cp.io.CloudFile(pts[:2], grid_shape=(1, 2), pixels=[0, 2])
+    with pytest.raises(InvalidInputError, match="strictly increasing"):
+        cp.io.CloudFile(pts[:2], grid_shape=(1, 2), pixels=[1, 0])
+    with pytest.raises(InvalidInputError, match="give both grid_shape and pixels"):
+        cp.io.CloudFile(pts[:2], pixels=[0, 1])
 
 
 @pytest.mark.parametrize(
@@ -799,7 +834,7 @@ WRONG_MESHES: list[tuple[str, str | None, Callable[[bytes], bytes], str]] = [
     ("stl", "binary", set_u32(80, 47), "promises 47 triangles"),
     ("stl", "binary", lambda d: d + b"\0" * 50, "more"),
     ("stl", "ascii", replace(b"endloop", b"endlop"), "endloop"),
-    ("stl", "ascii", replace(b"vertex ", b"vertex x"), ""),
+    ("stl", "ascii", replace(b"vertex ", b"vertex x"), "x"),
     ("off", None, replace(b"OFF\n26 48 0", b"OFF\n27 48 0"), "promises 48 faces"),
     ("off", None, replace(b"OFF\n26 48 0", b"OFF\n26 47 0"), "after the 47 faces"),
     ("off", None, replace(b"\n3 ", b"\n4 "), "announces 4 vertices"),
@@ -864,7 +899,7 @@ DEGENERATE: list[tuple[str, str | bytes, int, int]] = [
         4,
     ),
     ("obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 2 3 4\n", 1, 2),
-    ("off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 0 1\n4 0 1 3 3\n3 1 1 1\n", 4, 2),
+    ("off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 0 1\n4 0 1 3 3\n3 1 1 1\n", 3, 2),
     (
         "ply",
         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"

@@ -716,7 +716,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_usage(sys.stderr)
         print(
-            "cloudprox: error: a command is required (demo, collide, info, example, bench or reproduce)",
+            "cloudprox: error: a command is required "
+            "(demo, collide, info, example, bench or reproduce)",
             file=sys.stderr,
         )
         return 2

@@ -22,10 +22,15 @@ Examples
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
 
 from cloudprox._native import CloudFile, Mesh
 from cloudprox._native import parse_mesh as _parse_mesh
@@ -35,16 +40,18 @@ from cloudprox._native import read_pointcloud2 as _read_pointcloud2
 from cloudprox._native import write_mesh as _write_mesh
 from cloudprox._native import write_point_cloud as _write_point_cloud
 from cloudprox._native import write_pointcloud2 as _write_pointcloud2
-from cloudprox.exceptions import DegenerateFacesWarning
+from cloudprox.exceptions import DegenerateFacesWarning, InvalidInputError
 
 __all__ = [
     "CloudFile",
     "DegenerateFacesWarning",
     "from_ros_message",
     "parse_mesh",
+    "parse_numbers",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
+    "read_pose",
     "write_mesh",
     "write_point_cloud",
     "write_pointcloud2",
@@ -54,6 +61,7 @@ CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy
 MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
 EncodingName = Literal["ascii", "binary", "binary_big_endian", "binary_compressed"]
 PathLike = str | os.PathLike[str]
+FloatArray = npt.NDArray[np.float64]
 
 
 def read_point_cloud(path: PathLike, format: CloudFormatName = "auto") -> CloudFile:
@@ -262,3 +270,84 @@ def write_pointcloud2(cloud: object) -> tuple[dict[str, Any], bytes]:
         The message's ``data``.
     """
     return _write_pointcloud2(cloud)
+
+
+def parse_numbers(text: str, n: int, what: str = "numbers") -> FloatArray:
+    """Parse ``n`` finite numbers separated by commas or spaces."""
+    parts = [p for p in text.replace(",", " ").split() if p]
+    try:
+        values = np.array([float(p) for p in parts], dtype=np.float64)
+    except ValueError:
+        raise InvalidInputError(f"{what}: expected {n} numbers, got {text!r}") from None
+    if len(values) != n or not np.all(np.isfinite(values)):
+        raise InvalidInputError(f"{what}: expected {n} finite numbers, got {text!r}")
+    return values
+
+
+def _quaternion_matrix(w: float, x: float, y: float, z: float, what: str) -> FloatArray:
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
+    if not norm > 0.0:
+        raise InvalidInputError(f"{what}: the quaternion (w x y z) is zero")
+    w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def read_pose(text: str | os.PathLike[str], what: str = "pose") -> FloatArray:
+    """Read a ``(4, 4)`` pose from a file, or parse it from inline numbers.
+
+    Accepted: a ``.npy`` file holding a ``(4, 4)`` array; a text file of 16
+    numbers (row-major); inline ``"x,y,z"`` (a translation), ``"x,y,z,qw,qx,qy,qz"``
+    (translation and unit quaternion) or 16 numbers (row-major matrix).
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming ``what`` and the problem (missing file, wrong count, not numbers).
+    """
+    path = Path(text)
+    text = os.fspath(text)
+    if path.suffix.lower() == ".npy" or path.is_file():
+        if not path.is_file():
+            raise InvalidInputError(f"{what}: no such file: {text}")
+        if path.suffix.lower() == ".npy":
+            try:
+                m = np.load(path, allow_pickle=False)
+            except (ValueError, OSError) as e:
+                raise InvalidInputError(
+                    f"{what}: {text} is not a readable .npy file ({e})"
+                ) from None
+        else:
+            try:
+                m = np.loadtxt(path, dtype=np.float64, ndmin=1)
+            except ValueError as e:
+                raise InvalidInputError(
+                    f"{what}: {text} is not a text file of numbers ({e})"
+                ) from None
+        m = np.asarray(m, dtype=np.float64)
+        if m.size != 16:
+            raise InvalidInputError(
+                f"{what}: {text} must hold a (4, 4) matrix, got shape {m.shape}"
+            )
+        return m.reshape(4, 4)
+    parts = [p for p in text.replace(",", " ").split() if p]
+    values = parse_numbers(text, len(parts), what) if parts else np.zeros(0)
+    pose = np.eye(4)
+    if len(values) == 3:
+        pose[:3, 3] = values
+    elif len(values) == 7:
+        pose[:3, 3] = values[:3]
+        pose[:3, :3] = _quaternion_matrix(*values[3:], what=what)
+    elif len(values) == 16:
+        pose = values.reshape(4, 4)
+    else:
+        raise InvalidInputError(
+            f"{what}: expected a pose file, or 3 (x,y,z), 7 (x,y,z,qw,qx,qy,qz) or 16 numbers, "
+            f"got {text!r}"
+        )
+    return pose

@@ -16,7 +16,6 @@ A cloud side goes through
 
 from __future__ import annotations
 
-import math
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -55,73 +54,14 @@ class PipelineError(ValueError):
     """A user error in a pose, a sensor or a filter step (the message says which)."""
 
 
+def parse_pose(text: str, what: str) -> FloatArray:
+    """Parse a ``(4, 4)`` pose (see :func:`cloudprox.io.read_pose`)."""
+    return io.read_pose(text, what)
+
+
 def parse_vector(text: str, n: int, what: str) -> FloatArray:
     """Parse ``n`` numbers separated by commas or spaces."""
-    parts = [p for p in text.replace(",", " ").split() if p]
-    try:
-        values = np.array([float(p) for p in parts], dtype=np.float64)
-    except ValueError:
-        raise PipelineError(f"{what}: expected {n} numbers, got {text!r}") from None
-    if len(values) != n or not np.all(np.isfinite(values)):
-        raise PipelineError(f"{what}: expected {n} finite numbers, got {text!r}")
-    return values
-
-
-def _quaternion_matrix(w: float, x: float, y: float, z: float, what: str) -> FloatArray:
-    norm = math.sqrt(w * w + x * x + y * y + z * z)
-    if not norm > 0.0:
-        raise PipelineError(f"{what}: the quaternion (w x y z) is zero")
-    w, x, y, z = w / norm, x / norm, y / norm, z / norm
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def parse_pose(text: str, what: str) -> FloatArray:
-    """Parse a ``(4, 4)`` pose from a file or inline numbers.
-
-    Accepted: a ``.npy`` file holding a ``(4, 4)`` array; a text file of 16
-    numbers (row-major); inline ``"x,y,z"`` (a translation), ``"x,y,z,qw,qx,qy,qz"``
-    (translation and unit quaternion) or 16 numbers (row-major matrix).
-    """
-    path = Path(text)
-    if path.suffix.lower() == ".npy" or path.is_file():
-        if not path.is_file():
-            raise PipelineError(f"{what}: no such file: {text}")
-        if path.suffix.lower() == ".npy":
-            try:
-                m = np.load(path, allow_pickle=False)
-            except (ValueError, OSError) as e:
-                raise PipelineError(f"{what}: {text} is not a readable .npy file ({e})") from None
-        else:
-            try:
-                m = np.loadtxt(path, dtype=np.float64, ndmin=1)
-            except ValueError as e:
-                raise PipelineError(f"{what}: {text} is not a text file of numbers ({e})") from None
-        m = np.asarray(m, dtype=np.float64)
-        if m.size != 16:
-            raise PipelineError(f"{what}: {text} must hold a (4, 4) matrix, got shape {m.shape}")
-        return m.reshape(4, 4)
-    parts = [p for p in text.replace(",", " ").split() if p]
-    values = parse_vector(text, len(parts), what) if parts else np.zeros(0)
-    pose = np.eye(4)
-    if len(values) == 3:
-        pose[:3, 3] = values
-    elif len(values) == 7:
-        pose[:3, 3] = values[:3]
-        pose[:3, :3] = _quaternion_matrix(*values[3:], what=what)
-    elif len(values) == 16:
-        pose = values.reshape(4, 4)
-    else:
-        raise PipelineError(
-            f"{what}: expected a pose file, or 3 (x,y,z), 7 (x,y,z,qw,qx,qy,qz) or 16 numbers, "
-            f"got {text!r}"
-        )
-    return pose
+    return io.parse_numbers(text, n, what)
 
 
 @dataclass(frozen=True)
