@@ -147,3 +147,173 @@ def test_bench_table(capsys) -> None:
     code, out, _ = run(capsys, "bench", "--points", "200", "--repeat", "1")
     assert code == 0
     assert "cloudprox" in out and "kdtree" in out and "ratio" in out
+
+
+# ------------------------------------------------------------ files of any format
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory) -> dict[str, str]:
+    from cloudprox.examples import write_example_files
+
+    paths = write_example_files(tmp_path_factory.mktemp("example"))
+    return {k: str(v) for k, v in paths.items()}
+
+
+def _collide(capsys, example, *extra: str) -> tuple[int, dict, str]:
+    code, out, err = run(
+        capsys,
+        "collide",
+        example["gripper"],
+        example["scan"],
+        "--sensor",
+        "depth-camera",
+        "--preset",
+        "nguyen-2012",
+        *extra,
+        "--json",
+    )
+    return code, (json.loads(out) if code == 0 else {}), err
+
+
+def test_collide_gripper_stl_against_pcd_scan(capsys, example) -> None:
+    code, doc, err = _collide(
+        capsys, example, "--pose-a", example["grasp-free"], "--filter", "shadow"
+    )
+    assert code == 0, err
+    assert doc["state"] == "free"
+    assert doc["a"]["kind"] == "mesh" and doc["a"]["faces"] == 36
+    b = doc["b"]
+    assert b["kind"] == "cloud" and b["points_read"] == 320 * 240
+    assert b["skipped_non_finite"] > 0
+    assert b["filters"][0]["filter"] == "shadow"
+    assert b["filters"][0]["after"] < b["filters"][0]["before"]
+    code, doc, err = _collide(capsys, example, "--pose-a", example["grasp-collision"])
+    assert code == 0, err
+    assert doc["state"] == "collision"
+
+
+def test_collide_inline_pose_and_filter_chain(capsys, example) -> None:
+    # The free grasp written inline (translation only), through crop and voxel steps.
+    pose = np.loadtxt(example["grasp-free"])
+    inline = ",".join(str(x) for x in pose[:3, 3])
+    code, doc, err = _collide(
+        capsys,
+        example,
+        "--pose-a",
+        inline,
+        "--filter",
+        "shadow",
+        "--filter",
+        "crop:-0.5,0,0.7,0.5,0.8,1.2",
+        "--filter",
+        "voxel:0.004",
+    )
+    assert code == 0, err
+    steps = [f["filter"] for f in doc["b"]["filters"]]
+    assert steps == ["shadow", "crop:-0.5,0,0.7,0.5,0.8,1.2", "voxel:0.004"]
+    counts = [f["after"] for f in doc["b"]["filters"]]
+    assert counts[0] > counts[1] > counts[2] > 0
+    assert doc["state"] == "free"
+
+
+def test_self_filter_step_removes_the_robot(capsys, example, tmp_path) -> None:
+    # The gripper mesh placed where the box is: the self-filter removes the box's
+    # points, so the colliding grasp becomes free.
+    box = cp.Mesh.cuboid(0.045, 0.045, 0.08)
+    stl = tmp_path / "box.stl"
+    cp.io.write_mesh(stl, box)
+    where = "0.1,0.3,0.825"
+    code, doc, err = _collide(
+        capsys,
+        example,
+        "--pose-a",
+        example["grasp-collision"],
+        "--filter",
+        "shadow",
+        "--filter",
+        f"self:{stl}:0.01:{where}",
+    )
+    assert code == 0, err
+    assert doc["state"] == "free"
+    assert doc["b"]["filters"][1]["after"] < doc["b"]["filters"][1]["before"]
+
+
+def test_collide_point_cloud_formats(capsys, npy_files, tmp_path) -> None:
+    a = np.load(npy_files["a"])
+    b = np.load(npy_files["b_far"])
+    for ext in ("ply", "pcd", "xyz", "csv"):
+        pa, pb = tmp_path / f"a.{ext}", tmp_path / f"b.{ext}"
+        cp.io.write_point_cloud(pa, a)
+        cp.io.write_point_cloud(pb, b)
+        code, out, err = run(capsys, "collide", str(pa), str(pb), "--sigma", "0.002", "--json")
+        assert code == 0, f"{ext}: {err}"
+        assert json.loads(out)["state"] == "free", ext
+
+
+def test_lidar_sensor_with_origin(capsys, npy_files) -> None:
+    code, out, err = run(
+        capsys,
+        "collide",
+        npy_files["a"],
+        npy_files["b_deep"],
+        "--sensor",
+        "lidar",
+        "--sigma-range",
+        "0.002",
+        "--origin",
+        "0,0,2",
+        "--json",
+    )
+    assert code == 0, err
+    assert json.loads(out)["state"] == "collision"
+
+
+def test_info_point_cloud_and_mesh(capsys, example) -> None:
+    code, out, err = run(capsys, "info", example["scan"], "--json")
+    assert code == 0, err
+    info = json.loads(out)
+    assert info["kind"] == "point cloud"
+    assert info["organized"] == [240, 320]
+    assert info["points"] + info["skipped_non_finite"] == 320 * 240
+    assert info["sensor_pose"][0][3] == pytest.approx(0.0)
+    assert 0.001 < info["spacing_m"]["median"] < 0.05
+    code, out, err = run(capsys, "info", example["gripper"], "--json")
+    assert code == 0, err
+    info = json.loads(out)
+    assert info["kind"] == "mesh" and info["closed"]
+    assert info["volume_m3"] == pytest.approx(0.06 * 0.18 * 0.04 + 2 * 0.02 * 0.02 * 0.05, rel=1e-6)
+    code, out, _ = run(capsys, "info", example["scan"])
+    assert "organized: [240, 320]" in out and "spacing" in out
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--filter", "blur"], "unknown filter 'blur'"),
+        (["--filter", "voxel"], "voxel needs a size"),
+        (["--filter", "voxel:0"], "voxel"),
+        (["--pose-a", "1,2"], "expected a pose file, or 3"),
+        (["--pose-a", "nofile.npy"], "no such file"),
+        (["--sigma", "0.01"], "--sigma is for --sensor isotropic"),
+        (["--baseline", "0.1"], "--baseline do not apply to --sensor depth-camera"),
+    ],
+)
+def test_file_collide_user_errors(capsys, example, extra: list[str], message: str) -> None:
+    code, _, err = _collide(capsys, example, *extra)
+    assert code == 2
+    assert message in err, err
+    assert "Traceback" not in err
+
+
+def test_sensor_without_viewpoint_and_corrupt_file(capsys, npy_files, tmp_path) -> None:
+    code, _, err = run(capsys, "collide", npy_files["a"], npy_files["b"], "--sensor", "stereo")
+    assert code == 2
+    assert "records no sensor viewpoint" in err
+    bad = tmp_path / "bad.pcd"
+    bad.write_bytes(b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n")
+    code, _, err = run(capsys, "collide", str(bad), npy_files["b"], "--sigma", "0.01")
+    assert code == 2
+    assert str(bad) in err and "PCD" in err
+    code, _, err = run(capsys, "info", str(tmp_path / "missing.ply"))
+    assert code == 2 and "no such file" in err
