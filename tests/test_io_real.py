@@ -119,13 +119,13 @@ def test_pcd(name: str) -> None:
         assert len(cf.pixels) == n_finite
         if truth["nonfinite"] == 0:
             np.testing.assert_array_equal(cf.pixels, np.arange(n_finite))
-    viewpoint = truth["viewpoint"]
-    if viewpoint is None or tuple(viewpoint) == IDENTITY_VIEWPOINT:  # type: ignore[arg-type]
+    viewpoint: tuple[float, ...] | None = truth["viewpoint"]  # type: ignore[assignment]
+    if viewpoint is None or tuple(viewpoint) == IDENTITY_VIEWPOINT:
         # PCL writes the identity when it knows no viewpoint: "no sensor pose".
         assert cf.sensor_pose is None
     else:
         assert cf.sensor_pose is not None
-        np.testing.assert_allclose(cf.sensor_pose, viewpoint_pose(viewpoint), atol=1e-12)  # type: ignore[arg-type]
+        np.testing.assert_allclose(cf.sensor_pose, viewpoint_pose(viewpoint), atol=1e-12)
 
 
 @pytest.mark.parametrize("name", cases("pcd"))
