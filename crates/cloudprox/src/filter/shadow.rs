@@ -116,33 +116,32 @@ pub fn shadow_filter(
     }
     let cos_max = settings.min_angle.cos();
     let origin = *origin;
-    let removed: Vec<bool> = match grid {
-        Some(grid) => organized(points, &origin, grid, settings.window, cos_max)?,
-        None => {
-            // Neighbours in viewing direction: the pixels around a point in a
-            // virtual image taken from the origin.
-            let directions: Vec<Point3> = points
-                .par_iter()
-                .map(|p| {
-                    let ray = p - origin;
-                    let n = ray.norm();
-                    if n > 0.0 {
-                        Point3::from(ray / n)
-                    } else {
-                        Point3::origin()
-                    }
-                })
-                .collect();
-            for_each_knn(&directions, settings.k, |i, nb| {
-                let p = &points[i];
+    let removed: Vec<bool> = if let Some(grid) = grid {
+        organized(points, &origin, grid, settings.window, cos_max)?
+    } else {
+        // Neighbours in viewing direction: the pixels around a point in a
+        // virtual image taken from the origin.
+        let directions: Vec<Point3> = points
+            .par_iter()
+            .map(|p| {
                 let ray = p - origin;
-                let ray_norm = ray.norm();
-                ray_norm > 0.0
-                    && nb
-                        .iter()
-                        .any(|&(_, j)| along_ray(p, &ray, ray_norm, &points[j as usize], cos_max))
+                let n = ray.norm();
+                if n > 0.0 {
+                    Point3::from(ray / n)
+                } else {
+                    Point3::origin()
+                }
             })
-        }
+            .collect();
+        for_each_knn(&directions, settings.k, |i, nb| {
+            let p = &points[i];
+            let ray = p - origin;
+            let ray_norm = ray.norm();
+            ray_norm > 0.0
+                && nb
+                    .iter()
+                    .any(|&(_, j)| along_ray(p, &ray, ray_norm, &points[j as usize], cos_max))
+        })
     };
     Ok(removed
         .par_iter()
@@ -189,7 +188,7 @@ fn organized(
         }
         *slot = i as u32;
     }
-    let win = window.min(w.max(h)) as isize;
+    let win = window.min(w.max(h));
     Ok(points
         .par_iter()
         .zip(grid.pixels.par_iter())
@@ -199,18 +198,13 @@ fn organized(
             if ray_norm == 0.0 {
                 return false;
             }
-            let (row, col) = ((px as usize / w) as isize, (px as usize % w) as isize);
-            for dr in -win..=win {
-                let r = row + dr;
-                if r < 0 || r >= h as isize {
-                    continue;
-                }
-                for dc in -win..=win {
-                    let c = col + dc;
-                    if (dr == 0 && dc == 0) || c < 0 || c >= w as isize {
+            let (row, col) = (px as usize / w, px as usize % w);
+            for r in row.saturating_sub(win)..=(row + win).min(h - 1) {
+                for c in col.saturating_sub(win)..=(col + win).min(w - 1) {
+                    if r == row && c == col {
                         continue;
                     }
-                    let j = image[r as usize * w + c as usize];
+                    let j = image[r * w + c];
                     if j != u32::MAX && along_ray(p, &ray, ray_norm, &points[j as usize], cos_max) {
                         return true;
                     }
