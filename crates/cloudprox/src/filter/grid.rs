@@ -102,13 +102,6 @@ impl Layout {
     fn key_of(&self, p: &Point3) -> u64 {
         pack(self.cell_of(&[p.x, p.y, p.z]))
     }
-
-    /// Non-empty cells over `points`.
-    fn count_cells(&self, points: &[Point3]) -> usize {
-        let mut keys: Vec<u64> = points.par_iter().map(|p| self.key_of(p)).collect();
-        keys.par_sort_unstable();
-        1 + keys.windows(2).filter(|w| w[0] != w[1]).count()
-    }
 }
 
 /// A uniform grid over a cloud, with its points sorted by cell.
@@ -137,16 +130,18 @@ impl PointGrid {
         if extent == 0.0 {
             return Self::with_layout(points, Layout::new(lo, hi, 1.0));
         }
-        // First guess: a volume-filling cloud; then correct by the measured
-        // occupancy, assuming a surface (the usual case of a sensor cloud).
-        let floor = extent * 1e-3;
-        let volume: f64 = (0..3).map(|a| (hi[a] - lo[a]).max(floor)).product();
-        let mut cell = (volume * target / n).cbrt();
+        // First guess: a surface spanning the two largest extents (a depth
+        // image); then correct by the measured occupancy (a surface, a volume
+        // or a curve all converge in a few steps).
+        let mut e: Vec<f64> = (0..3).map(|a| (hi[a] - lo[a]).max(extent * 1e-3)).collect();
+        e.sort_by(f64::total_cmp);
+        let mut cell = (e[1] * e[2] * target / n).sqrt();
         let mut layout = Layout::new(lo, hi, cell);
         for _ in 0..4 {
-            let occupancy = n / layout.count_cells(points) as f64;
+            let grid = Self::with_layout(points, layout);
+            let occupancy = n / (grid.starts.len() - 1) as f64;
             if occupancy > 0.5 * target && occupancy < 2.0 * target {
-                break;
+                return grid;
             }
             cell = layout.cell * (target / occupancy).sqrt().clamp(0.125, 8.0);
             layout = Layout::new(lo, hi, cell);
@@ -244,6 +239,83 @@ impl PointGrid {
         }
     }
 
+    /// Answers the queries of every point of cell `cell` (by rank) against the
+    /// 3x3x3 block of cells around it, pushing `(index, Some(f(...)))` into
+    /// `acc`, or `(index, None)` when the block cannot settle the query.
+    fn block_queries<T, F>(
+        &self,
+        cell: usize,
+        k: usize,
+        f: &F,
+        block: &mut Vec<([f64; 3], u32)>,
+        buf: &mut Vec<(f64, u32)>,
+        acc: &mut Vec<(u32, Option<T>)>,
+    ) where
+        F: Fn(usize, &[(f64, u32)]) -> T,
+    {
+        let l = &self.layout;
+        let members = self.starts[cell] as usize..self.starts[cell + 1] as usize;
+        let first = &self.sorted[members.start];
+        let c = l.cell_of(first);
+        block.clear();
+        for dx in -1..=1 {
+            let x = c[0] + dx;
+            if x < 0 || x >= l.dims[0] {
+                continue;
+            }
+            for dy in -1..=1 {
+                let y = c[1] + dy;
+                if y < 0 || y >= l.dims[1] {
+                    continue;
+                }
+                for dz in -1..=1 {
+                    let z = c[2] + dz;
+                    if z >= 0 && z < l.dims[2] {
+                        for s in self.cell_range([x, y, z]) {
+                            block.push((self.sorted[s], self.index[s]));
+                        }
+                    }
+                }
+            }
+        }
+        // Distance bound of the block, per axis side (infinite at the grid's edge).
+        let mut lower = [f64::NEG_INFINITY; 3];
+        let mut upper = [f64::INFINITY; 3];
+        for a in 0..3 {
+            if c[a] - 1 > 0 {
+                lower[a] = l.origin[a] + (c[a] - 1) as f64 * l.cell;
+            }
+            if c[a] + 1 < l.dims[a] - 1 {
+                upper[a] = l.origin[a] + (c[a] + 2) as f64 * l.cell;
+            }
+        }
+        for s in members {
+            let q = &self.sorted[s];
+            let exclude = self.index[s];
+            // Only candidates nearer than everything outside the block can be
+            // among the k nearest of a settled query.
+            let mut bound = f64::INFINITY;
+            for a in 0..3 {
+                bound = bound.min(q[a] - lower[a]).min(upper[a] - q[a]);
+            }
+            let bound2 = bound * bound;
+            buf.clear();
+            for (p, i) in block.iter() {
+                let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+                let d2 = dx * dx + dy * dy + dz * dz;
+                if d2 <= bound2 && *i != exclude {
+                    buf.push((d2, *i));
+                }
+            }
+            let settled = buf.len() >= k;
+            if buf.len() > k {
+                buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+                buf.truncate(k);
+            }
+            acc.push((exclude, settled.then(|| f(exclude as usize, buf))));
+        }
+    }
+
     /// The `k` nearest points to `q` other than point `exclude`, as `(squared
     /// distance, index)` by increasing distance, into `out`; fewer if the cloud
     /// has fewer. Returns `false` (and an incomplete `out`) if more than
@@ -313,7 +385,7 @@ impl PointGrid {
 
 /// For every point `i` of a non-empty, finite cloud (fewer than 2^32 points),
 /// `f(i, neighbours)` with its `k` nearest other points as `(squared distance,
-/// index)` by increasing distance (fewer if the cloud has fewer than `k + 1`
+/// index)`, in no particular order (fewer if the cloud has fewer than `k + 1`
 /// points). Runs in parallel; results in point order.
 pub(crate) fn for_each_knn<T, F>(points: &[Point3], k: usize, f: F) -> Vec<T>
 where
@@ -327,8 +399,28 @@ where
     }
     let mut grid = PointGrid::for_neighbours(points, k);
     let (lo, hi) = (grid.layout.origin, bounds(points).1);
-    let mut pending: Vec<u32> = grid.index.clone();
-    loop {
+    // First pass: cell by cell, each query against the 27 cells around its own.
+    let first: Vec<(u32, Option<T>)> = (0..grid.starts.len() - 1)
+        .into_par_iter()
+        .fold(
+            || (Vec::new(), Vec::new(), Vec::with_capacity(k + 1)),
+            |(mut acc, mut block, mut buf), cell| {
+                grid.block_queries(cell, k, &f, &mut block, &mut buf, &mut acc);
+                (acc, block, buf)
+            },
+        )
+        .map(|(acc, _, _)| acc)
+        .flatten()
+        .collect();
+    let mut pending = Vec::new();
+    for (i, outcome) in first {
+        match outcome {
+            Some(t) => results[i as usize] = Some(t),
+            None => pending.push(i),
+        }
+    }
+    // Then shell by shell on the same grid, then on ever coarser grids.
+    while !pending.is_empty() {
         let coarse = grid.layout.dims.iter().all(|&d| d <= COARSE_CELLS);
         let max_shells = if coarse { i64::MAX } else { MAX_SHELLS };
         let outcomes: Vec<(u32, Option<T>)> = pending
@@ -384,6 +476,8 @@ mod tests {
         for k in [1, 5, 20] {
             let got = for_each_knn(&points, k, |_, nb| nb.to_vec());
             for (i, nb) in got.iter().enumerate() {
+                let mut nb = nb.clone();
+                nb.sort_by(|a, b| a.0.total_cmp(&b.0));
                 let mut d: Vec<f64> = (0..points.len())
                     .filter(|&j| j != i)
                     .map(|j| (points[j] - points[i]).norm_squared())

@@ -21,8 +21,9 @@ pub struct ShadowSettings {
     /// `window` rows and columns away (`(2 window + 1)² - 1` of them). Default 1
     /// (ROS `neighbors`/`window` 1). Must be at least 1.
     pub window: usize,
-    /// Unorganized clouds: the number of nearest neighbours examined. Default 8
-    /// (about the 3x3 pixel window of an organized cloud). Must be at least 1.
+    /// Unorganized clouds: the number of neighbours in viewing direction
+    /// examined. Default 8 (the 3x3 pixel window of an organized cloud). Must be
+    /// at least 1.
     pub k: usize,
 }
 
@@ -79,7 +80,11 @@ fn along_ray(p: &Point3, ray: &Vector3, ray_norm: f64, q: &Point3, cos_max: f64)
 /// `p - origin` and `q - p`; `p` is removed when, for some neighbour, `θ <
 /// min_angle` or `θ > π - min_angle`. The neighbours are the image pixels within
 /// `settings.window` of `p`'s pixel when `grid` is given (organized cloud: the
-/// pixel of point `i` is `grid.pixels[i]`), else its `settings.k` nearest points.
+/// pixel of point `i` is `grid.pixels[i]`), else the `settings.k` points nearest
+/// to it *in viewing direction* (the nearest unit vectors `(q - origin)/|q -
+/// origin|`: its pixels in a virtual image taken from `origin`; Euclidean
+/// neighbours would not do, as a veil is a curtain of points along the rays,
+/// dense along the edge and sparse across it).
 /// `origin` is the sensor's position in the cloud's frame. Defaults: see
 /// [`ShadowSettings`] (10°, window 1, k 8).
 ///
@@ -111,9 +116,24 @@ pub fn shadow_filter(
     }
     let cos_max = settings.min_angle.cos();
     let origin = *origin;
-    let removed: Vec<bool> = match grid {
-        Some(grid) => organized(points, &origin, grid, settings.window, cos_max)?,
-        None => for_each_knn(points, settings.k, |i, nb| {
+    let removed: Vec<bool> = if let Some(grid) = grid {
+        organized(points, &origin, grid, settings.window, cos_max)?
+    } else {
+        // Neighbours in viewing direction: the pixels around a point in a
+        // virtual image taken from the origin.
+        let directions: Vec<Point3> = points
+            .par_iter()
+            .map(|p| {
+                let ray = p - origin;
+                let n = ray.norm();
+                if n > 0.0 {
+                    Point3::from(ray / n)
+                } else {
+                    Point3::origin()
+                }
+            })
+            .collect();
+        for_each_knn(&directions, settings.k, |i, nb| {
             let p = &points[i];
             let ray = p - origin;
             let ray_norm = ray.norm();
@@ -121,7 +141,7 @@ pub fn shadow_filter(
                 && nb
                     .iter()
                     .any(|&(_, j)| along_ray(p, &ray, ray_norm, &points[j as usize], cos_max))
-        }),
+        })
     };
     Ok(removed
         .par_iter()
@@ -168,7 +188,7 @@ fn organized(
         }
         *slot = i as u32;
     }
-    let win = window.min(w.max(h)) as isize;
+    let win = window.min(w.max(h));
     Ok(points
         .par_iter()
         .zip(grid.pixels.par_iter())
@@ -178,18 +198,13 @@ fn organized(
             if ray_norm == 0.0 {
                 return false;
             }
-            let (row, col) = ((px as usize / w) as isize, (px as usize % w) as isize);
-            for dr in -win..=win {
-                let r = row + dr;
-                if r < 0 || r >= h as isize {
-                    continue;
-                }
-                for dc in -win..=win {
-                    let c = col + dc;
-                    if (dr == 0 && dc == 0) || c < 0 || c >= w as isize {
+            let (row, col) = (px as usize / w, px as usize % w);
+            for r in row.saturating_sub(win)..=(row + win).min(h - 1) {
+                for c in col.saturating_sub(win)..=(col + win).min(w - 1) {
+                    if r == row && c == col {
                         continue;
                     }
-                    let j = image[r as usize * w + c as usize];
+                    let j = image[r * w + c];
                     if j != u32::MAX && along_ray(p, &ray, ray_norm, &points[j as usize], cos_max) {
                         return true;
                     }

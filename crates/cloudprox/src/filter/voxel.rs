@@ -114,7 +114,7 @@ pub fn voxel_downsample_with(
     let inv = 1.0 / voxel_size;
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let cells = ((hi[a] - lo[a]) * inv).floor();
-        if !(cells < AXIS_MAX) {
+        if cells.is_nan() || cells >= AXIS_MAX {
             return Err(Error::invalid(format!(
                 "voxel_downsample: voxel_size {voxel_size} is too small for the cloud's \
                  extent along {axis} ({} m, more than 2^21 - 1 voxels)",
