@@ -212,8 +212,10 @@ def test_open3d_spellings_of_the_encoding(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("ext", "encoding", "pattern"),
     [
-        ("ply", "binary_compressed", "PLY has no compressed encoding"),
-        ("pcd", "binary_big_endian", "PCD has no big-endian encoding"),
+        ("ply", "binary_compressed", "PLY cannot be written as binary_compressed; choose one of"),
+        ("pcd", "binary_big_endian", "PCD cannot be written as binary_big_endian; choose one of"),
+        ("xyz", "binary", "XYZ has a single encoding"),
+        ("npy", "ascii", "NPY has a single encoding"),
         ("ply", "utf8", 'unknown encoding "utf8"'),
         ("las", None, "writing LAS/LAZ is not supported"),
         ("laz", None, "writing LAS/LAZ is not supported"),
@@ -325,8 +327,10 @@ def test_mesh_round_trip(tmp_path: Path, case: tuple[str, str | None]) -> None:
 def test_write_mesh_refuses_unknown_extension_and_encoding(tmp_path: Path) -> None:
     with pytest.raises(InvalidInputError, match="cannot tell the mesh format"):
         cp.io.write_mesh(tmp_path / "mesh.foo", mesh())
-    with pytest.raises(InvalidInputError, match="STL is written as"):
+    with pytest.raises(InvalidInputError, match="STL cannot be written as binary_big_endian"):
         cp.io.write_mesh(tmp_path / "mesh.stl", mesh(), encoding="binary_big_endian")
+    with pytest.raises(InvalidInputError, match="OBJ has a single encoding"):
+        cp.io.write_mesh(tmp_path / "mesh.obj", mesh(), encoding="binary")
 
 
 # ----------------------------------------------------------- independent readers

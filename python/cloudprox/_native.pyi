@@ -883,7 +883,7 @@ def voxel_downsample(
     """One point per occupied voxel (see :mod:`cloudprox.filters`)."""
 
 def statistical_outlier_removal(
-    points: npt.ArrayLike, k: int = ..., std_ratio: float = ...
+    points: npt.ArrayLike, k: int | None = None, std_ratio: float = ...
 ) -> _IntArray:
     """Return the indices (ascending) of the points kept (see :mod:`cloudprox.filters`)."""
 

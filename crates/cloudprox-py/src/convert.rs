@@ -132,7 +132,12 @@ pub fn points_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point3>> 
         None => to_f64_array(obj, what)?,
     };
     check_shape(&arr, &[None, Some(3)], what, "(n, 3)")?;
-    Ok(data(&arr, what)?
+    // One copy, straight from numpy's buffer into points.
+    let ro = arr.readonly();
+    let flat = ro
+        .as_slice()
+        .map_err(|_| invalid_input(arr.py(), format!("{what} is not contiguous")))?;
+    Ok(flat
         .chunks_exact(3)
         .map(|c| Point3::new(c[0], c[1], c[2]))
         .collect())

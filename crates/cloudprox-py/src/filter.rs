@@ -104,15 +104,18 @@ pub fn voxel_downsample<'py>(
 /// rule: mean distance to the `k` nearest neighbours above the global mean plus
 /// `std_ratio` standard deviations removes a point).
 #[pyfunction]
-#[pyo3(signature = (points, k=SOR_DEFAULT_K as i64, std_ratio=SOR_DEFAULT_STD_RATIO))]
+#[pyo3(signature = (points, k=None, std_ratio=SOR_DEFAULT_STD_RATIO))]
 pub fn statistical_outlier_removal<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
-    k: i64,
+    k: Option<i64>,
     std_ratio: f64,
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let points = points_from(points, "points")?;
-    let k = usize_arg(py, k, "k", 1)?;
+    let k = match k {
+        Some(k) => usize_arg(py, k, "k", 1)?,
+        None => SOR_DEFAULT_K,
+    };
     let keep = run_detached(py, move || {
         filter::statistical_outlier_removal(&points, k, std_ratio)
     })?;

@@ -57,6 +57,67 @@ fn mesh_format(py: Python<'_>, format: &str) -> PyResult<Option<MeshFormat>> {
     }))
 }
 
+/// The encodings a format can be written in, by their Python names (`None`:
+/// the format has no choice).
+fn encodings_of(format: Option<&str>) -> Option<&'static [&'static str]> {
+    match format {
+        Some("ply") => Some(&["ascii", "binary", "binary_big_endian"]),
+        Some("pcd") => Some(&["ascii", "binary", "binary_compressed"]),
+        Some("stl") => Some(&["ascii", "binary"]),
+        _ => None,
+    }
+}
+
+/// Refuses an encoding the format cannot be written in, with the Python names.
+fn check_encoding(
+    py: Python<'_>,
+    path: &std::path::Path,
+    format: &str,
+    encoding: Option<&str>,
+    write_ascii: bool,
+    compressed: bool,
+) -> PyResult<()> {
+    let name = if format.eq_ignore_ascii_case("auto") {
+        path.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+    } else {
+        Some(format.to_ascii_lowercase())
+    };
+    let asked = match (encoding, write_ascii, compressed) {
+        (Some(e), _, _) => Some(
+            e.to_ascii_lowercase()
+                .replace("binary_little_endian", "binary"),
+        ),
+        (None, true, _) => Some("ascii".to_string()),
+        (None, false, true) => Some("binary_compressed".to_string()),
+        (None, false, false) => None,
+    };
+    let Some(asked) = asked else { return Ok(()) };
+    if !["ascii", "binary", "binary_big_endian", "binary_compressed"].contains(&asked.as_str()) {
+        return Ok(()); // an unknown name: `encoding_from` says so
+    }
+    let fmt = name.clone().unwrap_or_default();
+    match encodings_of(name.as_deref()) {
+        Some(list) if list.contains(&asked.as_str()) => Ok(()),
+        Some(list) => Err(invalid_input(
+            py,
+            format!(
+                "{} cannot be written as {asked}; choose one of: {}",
+                fmt.to_uppercase(),
+                list.join(", ")
+            ),
+        )),
+        None => Err(invalid_input(
+            py,
+            format!(
+                "{} has a single encoding: do not give encoding, write_ascii or compressed",
+                fmt.to_uppercase()
+            ),
+        )),
+    }
+}
+
 fn encoding_from(
     py: Python<'_>,
     encoding: Option<&str>,
@@ -410,6 +471,7 @@ pub fn write_point_cloud(
     write_ascii: bool,
     compressed: bool,
 ) -> PyResult<()> {
+    check_encoding(py, &path, format, encoding, write_ascii, compressed)?;
     let format = cloud_format(py, format)?;
     let encoding = encoding_from(py, encoding, write_ascii, compressed)?;
     let data = cloud_data_from(cloud)?;
@@ -439,6 +501,7 @@ pub fn write_mesh(
     encoding: Option<&str>,
     write_ascii: bool,
 ) -> PyResult<()> {
+    check_encoding(py, &path, format, encoding, write_ascii, false)?;
     let format = mesh_format(py, format)?;
     let encoding = encoding_from(py, encoding, write_ascii, false)?;
     let mesh = Arc::clone(&mesh.get().inner);

@@ -23,8 +23,9 @@
 //! `F8` (exact; they are cloudprox's own fields, other readers skip them);
 //! `VIEWPOINT` from
 //! [`CloudData::sensor`] (identity when none), `WIDTH`/`HEIGHT` from
-//! [`CloudData::grid`] when it is present and every pixel holds a point (else
-//! `WIDTH n HEIGHT 1`).
+//! [`CloudData::grid`] when it is consistent (pixels strictly increasing and
+//! inside the image; the pixels it does not hold are written as NaN records),
+//! else `WIDTH n HEIGHT 1`.
 
 use std::fmt::Write as _;
 
