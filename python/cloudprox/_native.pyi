@@ -514,8 +514,10 @@ def collide(
     Raises
     ------
     InvalidInputError
-        On a bad pose, an unknown option name or an option out of its domain, two
-        meshes, or a side that is neither a cloud nor a mesh.
+        On a bad pose, an unknown option name or an option out of its domain, or
+        two meshes.
+    TypeError
+        If a side is neither a cloud nor a mesh.
     """
 
 def collide_many(

@@ -57,13 +57,10 @@ impl Side {
             return Ok(Side::Foreign(Arc::new(mesh)));
         }
         let ty = obj.get_type().name()?;
-        Err(invalid_input(
-            obj.py(),
-            format!(
-                "{what} must be a PointCloud or a mesh (cloudprox.Mesh, trimesh.Trimesh, \
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what} must be a PointCloud or a mesh (cloudprox.Mesh, trimesh.Trimesh, \
                  open3d TriangleMesh), got {ty}; wrap arrays in PointCloud(points, sigma=...)"
-            ),
-        ))
+        )))
     }
 
     fn is_cloud(&self) -> bool {

@@ -37,6 +37,26 @@ pub struct CloudData {
 }
 
 impl CloudData {
+    /// Checks that the normals and covariances, when present, have one entry
+    /// per point (what every writer needs).
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidInput`] naming the count that differs.
+    pub fn check_lengths(&self) -> crate::Result<()> {
+        let n = self.points.len();
+        for (what, len) in [
+            ("normals", self.normals.as_ref().map(Vec::len)),
+            ("covariances", self.covariances.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|&len| len != n) {
+                return Err(crate::Error::invalid(format!(
+                    "cloud has {n} points but {len} {what}"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Data holding just these points (no covariances, normals, sensor or grid).
     pub fn from_points(points: Vec<Point3>) -> Self {
         Self {

@@ -1,48 +1,12 @@
 //! Helpers shared by the mesh readers and writers (STL, OBJ, OFF): building
-//! [`MeshData`] from parsed triangles, welding, number parsing and formatting.
+//! [`MeshData`] from parsed triangles, welding, lines and comments.
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
 use crate::io::MeshData;
 use crate::math::Point3;
 use crate::shape::Mesh;
-
-/// At most this many characters of a bad token are quoted in an error.
-const QUOTE_MAX: usize = 40;
-
-/// A token as it is quoted in an error message (lossy UTF-8, shortened).
-pub(crate) fn quote(token: &[u8]) -> String {
-    let text = String::from_utf8_lossy(token);
-    if text.chars().count() > QUOTE_MAX {
-        let short: String = text.chars().take(QUOTE_MAX).collect();
-        format!("{short:?}...")
-    } else {
-        format!("{text:?}")
-    }
-}
-
-/// Parses a decimal float token (`1`, `-2.5`, `3e-4`, `nan`, `inf` all parse; the
-/// caller decides about finiteness).
-pub(crate) fn parse_f64(token: &[u8]) -> Option<f64> {
-    std::str::from_utf8(token).ok()?.parse::<f64>().ok()
-}
-
-/// Parses a decimal integer token.
-pub(crate) fn parse_i64(token: &[u8]) -> Option<i64> {
-    std::str::from_utf8(token).ok()?.parse::<i64>().ok()
-}
-
-/// Formats a coordinate so that it reads back to exactly the same `f64`.
-pub(crate) fn push_real(out: &mut String, x: f64) {
-    let a = x.abs();
-    if x == 0.0 || (1e-5..1e15).contains(&a) {
-        let _ = write!(out, "{x}");
-    } else {
-        let _ = write!(out, "{x:e}");
-    }
-}
 
 /// Welds vertices by exact coordinate equality (`-0.0` equals `0.0`).
 #[derive(Debug, Default)]

@@ -23,7 +23,8 @@ use std::borrow::Cow;
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
-use crate::io::mesh_text::{finish_mesh, lines, parse_f64, parse_i64, push_real, quote, tokens};
+use crate::io::mesh_text::{finish_mesh, lines, tokens};
+use crate::io::text::{parse_f64, parse_i64, push_real, quote};
 use crate::io::MeshData;
 use crate::math::Point3;
 use crate::shape::Mesh;

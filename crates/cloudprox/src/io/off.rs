@@ -14,9 +14,8 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
-use crate::io::mesh_text::{
-    finish_mesh, lines, parse_f64, parse_i64, push_real, quote, strip_comment, tokens,
-};
+use crate::io::mesh_text::{finish_mesh, lines, strip_comment, tokens};
+use crate::io::text::{parse_f64, parse_i64, push_real, quote};
 use crate::io::MeshData;
 use crate::math::Point3;
 use crate::shape::Mesh;

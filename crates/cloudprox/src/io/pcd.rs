@@ -628,18 +628,7 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
             )),
         };
     let n = cloud.points.len();
-    for (what, len) in [
-        ("normals", cloud.normals.as_ref().map(Vec::len)),
-        ("covariances", cloud.covariances.as_ref().map(Vec::len)),
-    ] {
-        if let Some(len) = len {
-            if len != n {
-                return Err(Error::invalid(format!(
-                    "cloud has {n} points but {len} {what}"
-                )));
-            }
-        }
-    }
+    cloud.check_lengths()?;
     let mut names = vec!["x", "y", "z"];
     if cloud.normals.is_some() {
         names.extend_from_slice(&["normal_x", "normal_y", "normal_z"]);

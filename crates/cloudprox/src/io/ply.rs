@@ -619,18 +619,7 @@ fn push_rows(out: &mut Vec<u8>, encoding: Encoding, row: &[f64], text: &mut Stri
 pub fn write_ply(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
     let format = check_encoding(encoding)?;
     let n = cloud.points.len();
-    for (what, len) in [
-        ("normals", cloud.normals.as_ref().map(Vec::len)),
-        ("covariances", cloud.covariances.as_ref().map(Vec::len)),
-    ] {
-        if let Some(len) = len {
-            if len != n {
-                return Err(Error::invalid(format!(
-                    "cloud has {n} points but {len} {what}"
-                )));
-            }
-        }
-    }
+    cloud.check_lengths()?;
     let mut head =
         format!("ply\nformat {format} 1.0\ncomment written by cloudprox\nelement vertex {n}\n");
     let mut names = vec!["x", "y", "z"];

@@ -22,7 +22,8 @@
 //! winding order defines the orientation). A file with no triangle is an error.
 
 use crate::error::{Error, Result};
-use crate::io::mesh_text::{finish_mesh, parse_f64, push_real, quote, Welder};
+use crate::io::mesh_text::{finish_mesh, Welder};
+use crate::io::text::{parse_f64, push_real, quote, Tokens};
 use crate::io::{ByteCursor, Encoding, MeshData};
 use crate::shape::Mesh;
 
@@ -150,59 +151,7 @@ fn read_binary(bytes: &[u8], name: &str, count: u32) -> Result<MeshData> {
     finish_mesh(name, FORMAT, welder.vertices, triangles)
 }
 
-/// Whitespace-separated tokens with their line numbers.
-struct Tokens<'a> {
-    data: &'a [u8],
-    pos: usize,
-    line: usize,
-}
-
-impl<'a> Tokens<'a> {
-    fn new(data: &'a [u8]) -> Self {
-        Self {
-            data,
-            pos: 0,
-            line: 1,
-        }
-    }
-
-    fn skip_space(&mut self) {
-        while let Some(&b) = self.data.get(self.pos) {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            if b == b'\n' {
-                self.line += 1;
-            }
-            self.pos += 1;
-        }
-    }
-
-    /// The next token and its line.
-    fn next(&mut self) -> Option<(usize, &'a [u8])> {
-        self.skip_space();
-        let start = self.pos;
-        while self
-            .data
-            .get(self.pos)
-            .is_some_and(|b| !b.is_ascii_whitespace())
-        {
-            self.pos += 1;
-        }
-        (self.pos > start).then(|| (self.line, &self.data[start..self.pos]))
-    }
-
-    /// Skips the rest of the current line (a solid's name).
-    fn skip_line(&mut self) {
-        while let Some(&b) = self.data.get(self.pos) {
-            if b == b'\n' {
-                break;
-            }
-            self.pos += 1;
-        }
-    }
-}
-
+/// The ascii STL parser: tokens and the file's name for errors.
 struct Ascii<'a> {
     tokens: Tokens<'a>,
     name: &'a str,
@@ -215,21 +164,21 @@ impl Ascii<'_> {
 
     /// The next token, which must be `keyword` (case-insensitive).
     fn expect(&mut self, keyword: &str, context: &str) -> Result<usize> {
-        match self.tokens.next() {
+        match self.tokens.next_token().map(|(t, l)| (l, t)) {
             Some((line, t)) if t.eq_ignore_ascii_case(keyword.as_bytes()) => Ok(line),
             Some((line, t)) => Err(self.error(
                 line,
                 format!("expected \"{keyword}\" {context}, found {}", quote(t)),
             )),
             None => Err(self.error(
-                self.tokens.line,
+                self.tokens.current_line(),
                 format!("expected \"{keyword}\" {context}, found the end of the file"),
             )),
         }
     }
 
     fn number(&mut self, what: &str) -> Result<f64> {
-        match self.tokens.next() {
+        match self.tokens.next_token().map(|(t, l)| (l, t)) {
             Some((line, t)) => match parse_f64(t) {
                 Some(x) if x.is_finite() => Ok(x),
                 Some(_) => {
@@ -241,7 +190,7 @@ impl Ascii<'_> {
                 )),
             },
             None => Err(self.error(
-                self.tokens.line,
+                self.tokens.current_line(),
                 format!("expected a number in {what}, found the end of the file"),
             )),
         }
@@ -250,18 +199,18 @@ impl Ascii<'_> {
 
 fn read_ascii(bytes: &[u8], name: &str) -> Result<MeshData> {
     let mut p = Ascii {
-        tokens: Tokens::new(bytes),
+        tokens: Tokens::new(bytes, 1),
         name,
     };
     let mut welder = Welder::default();
     let mut triangles = Vec::new();
     let mut solids = 0usize;
     loop {
-        match p.tokens.next() {
+        match p.tokens.next_token().map(|(t, l)| (l, t)) {
             None if solids > 0 => break,
             None => {
                 return Err(p.error(
-                    p.tokens.line,
+                    p.tokens.current_line(),
                     "expected \"solid\", found the end of the file",
                 ))
             }
@@ -284,9 +233,9 @@ fn read_ascii(bytes: &[u8], name: &str) -> Result<MeshData> {
         solids += 1;
         p.tokens.skip_line();
         loop {
-            let Some((line, t)) = p.tokens.next() else {
+            let Some((line, t)) = p.tokens.next_token().map(|(t, l)| (l, t)) else {
                 return Err(p.error(
-                    p.tokens.line,
+                    p.tokens.current_line(),
                     "expected \"facet\" or \"endsolid\", found the end of the file",
                 ));
             };

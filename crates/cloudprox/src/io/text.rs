@@ -1,5 +1,5 @@
-//! Helpers shared by the text readers: a whitespace tokenizer that knows its
-//! line, and number formatting.
+//! Helpers shared by the text readers and writers: a whitespace tokenizer that
+//! knows its line, number parsing and formatting, tokens quoted in messages.
 
 use std::fmt::Write as _;
 
@@ -24,6 +24,11 @@ impl<'a> Tokens<'a> {
     /// The line of the next token (or of the end).
     pub(crate) fn line(&mut self) -> usize {
         self.skip_space();
+        self.line
+    }
+
+    /// The line reached so far (at the end of the data: its last line).
+    pub(crate) fn current_line(&self) -> usize {
         self.line
     }
 
@@ -54,13 +59,48 @@ impl<'a> Tokens<'a> {
         }
         Some((&self.data[start..self.pos], self.line))
     }
+
+    /// Skips the rest of the current line (e.g. an STL solid's name).
+    pub(crate) fn skip_line(&mut self) {
+        while let Some(&b) = self.data.get(self.pos) {
+            if b == b'\n' {
+                break;
+            }
+            self.pos += 1;
+        }
+    }
+}
+
+/// At most this many characters of a bad token are shown in an error.
+const SHOW_MAX: usize = 40;
+
+/// A token as it is quoted in an error message (lossy UTF-8, shortened, in
+/// double quotes).
+pub(crate) fn quote(token: &[u8]) -> String {
+    let text = String::from_utf8_lossy(token);
+    if text.chars().count() > SHOW_MAX {
+        let short: String = text.chars().take(SHOW_MAX).collect();
+        format!("{short:?}...")
+    } else {
+        format!("{text:?}")
+    }
+}
+
+/// Formats a coordinate so that it reads back to exactly the same `f64`.
+pub(crate) fn push_real(out: &mut String, x: f64) {
+    let a = x.abs();
+    if x == 0.0 || (1e-5..1e15).contains(&a) {
+        let _ = write!(out, "{x}");
+    } else {
+        let _ = write!(out, "{x:e}");
+    }
 }
 
 /// A token as text for messages (lossy, shortened).
 pub(crate) fn show(token: &[u8]) -> String {
     let s = String::from_utf8_lossy(token);
-    if s.chars().count() > 40 {
-        format!("{}...", s.chars().take(40).collect::<String>())
+    if s.chars().count() > SHOW_MAX {
+        format!("{}...", s.chars().take(SHOW_MAX).collect::<String>())
     } else {
         s.into_owned()
     }

@@ -173,18 +173,7 @@ pub fn write_xyz(cloud: &CloudData, delimiter: u8) -> Result<Vec<u8>> {
         }
     };
     let n = cloud.points.len();
-    for (what, len) in [
-        ("normals", cloud.normals.as_ref().map(Vec::len)),
-        ("covariances", cloud.covariances.as_ref().map(Vec::len)),
-    ] {
-        if let Some(len) = len {
-            if len != n {
-                return Err(Error::invalid(format!(
-                    "cloud has {n} points but {len} {what}"
-                )));
-            }
-        }
-    }
+    cloud.check_lengths()?;
     let sep = delimiter as char;
     let normals = cloud.normals.as_ref().filter(|_| header);
     let covs = cloud.covariances.as_ref().filter(|_| header);
