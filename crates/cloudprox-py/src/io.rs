@@ -227,9 +227,7 @@ impl PyCloudFile {
                 ));
             }
             data.covariances = Some(c);
-            data.fields.extend(
-                ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"].map(String::from),
-            );
+            data.fields.extend(io::COV_FIELDS.map(String::from));
         }
         if sensor_pose.is_some() {
             data.sensor = Some(crate::convert::pose_from(py, sensor_pose, "sensor_pose")?);
@@ -450,9 +448,7 @@ fn cloud_data_from(obj: &Bound<'_, PyAny>) -> PyResult<CloudData> {
         let sensor = inner.sensor_covariances();
         if sensor.iter().any(|m| *m != Matrix3::zeros()) {
             data.covariances = Some(sensor.to_vec());
-            data.fields.extend(
-                ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"].map(String::from),
-            );
+            data.fields.extend(io::COV_FIELDS.map(String::from));
         }
         return Ok(data);
     }

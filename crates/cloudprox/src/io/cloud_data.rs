@@ -3,6 +3,27 @@
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::shape::Mesh;
 
+/// The names of the six covariance fields cloudprox writes and reads (the upper
+/// triangle, row by row), in PLY, PCD and CSV.
+pub const COV_FIELDS: [&str; 6] = ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"];
+
+/// The upper triangle of a symmetric covariance, in [`COV_FIELDS`] order.
+pub(crate) fn cov_to_fields(c: &Matrix3) -> [f64; 6] {
+    [
+        c[(0, 0)],
+        c[(0, 1)],
+        c[(0, 2)],
+        c[(1, 1)],
+        c[(1, 2)],
+        c[(2, 2)],
+    ]
+}
+
+/// The symmetric covariance of its [`COV_FIELDS`] values.
+pub(crate) fn cov_from_fields([xx, xy, xz, yy, yz, zz]: [f64; 6]) -> Matrix3 {
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+}
+
 /// The layout of an organized cloud (a depth image): `width x height` pixels in
 /// row-major order, and the pixel of every point that was kept.
 #[derive(Debug, Clone, PartialEq)]

@@ -40,7 +40,7 @@ pub mod stl;
 mod text;
 pub mod xyz;
 
-pub use cloud_data::{CloudData, CloudDataBuilder, Grid, MeshData};
+pub use cloud_data::{CloudData, CloudDataBuilder, Grid, MeshData, COV_FIELDS};
 pub use cursor::ByteCursor;
 pub use format::{
     read_mesh, read_mesh_bytes, read_point_cloud, read_point_cloud_bytes, write_mesh,

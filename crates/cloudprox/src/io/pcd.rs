@@ -32,14 +32,13 @@ use std::fmt::Write as _;
 use nalgebra::{Quaternion, Translation3, UnitQuaternion};
 
 use crate::error::{Error, Result};
+use crate::io::cloud_data::{cov_from_fields, cov_to_fields, COV_FIELDS};
 use crate::io::lzf;
 use crate::io::text::{parse_f32, parse_f64, show};
 use crate::io::{ByteCursor, CloudData, CloudDataBuilder, Encoding};
-use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::math::{Point3, Pose, Vector3};
 
 const FORMAT: &str = "PCD";
-
-const COV: [&str; 6] = ["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"];
 
 fn err(name: &str, problem: impl Into<String>) -> Error {
     Error::format(name, FORMAT, problem)
@@ -368,17 +367,14 @@ fn layout(h: &Header, name: &str) -> Result<Layout> {
     let normals = group(&["normal_x", "normal_y", "normal_z"])
         .or_else(|| group(&["nx", "ny", "nz"]))
         .map(|v| [v[0], v[1], v[2]]);
-    let covs = group(&COV).map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]]);
+    let covs = group(&COV_FIELDS).map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]]);
     Ok(Layout { xyz, normals, covs })
 }
 
 fn push_point(b: &mut CloudDataBuilder, l: &Layout, index: usize, v: &dyn Fn(usize) -> f64) {
     let p = Point3::new(v(l.xyz[0]), v(l.xyz[1]), v(l.xyz[2]));
     let n = l.normals.map(|n| Vector3::new(v(n[0]), v(n[1]), v(n[2])));
-    let c = l.covs.map(|c| {
-        let [xx, xy, xz, yy, yz, zz] = c.map(v);
-        Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
-    });
+    let c = l.covs.map(|c| cov_from_fields(c.map(v)));
     b.push(index, p, n, c);
 }
 
@@ -634,7 +630,7 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
         names.extend_from_slice(&["normal_x", "normal_y", "normal_z"]);
     }
     if cloud.covariances.is_some() {
-        names.extend_from_slice(&COV);
+        names.extend_from_slice(&COV_FIELDS);
     }
     let k = names.len();
     // Bytes per field: F4 for coordinates and normals, F8 for covariances.
@@ -695,15 +691,7 @@ pub fn write_pcd(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
             r.extend(normals[i].iter());
         }
         if let Some(covs) = &cloud.covariances {
-            let c = &covs[i];
-            r.extend([
-                c[(0, 0)],
-                c[(0, 1)],
-                c[(0, 2)],
-                c[(1, 1)],
-                c[(1, 2)],
-                c[(2, 2)],
-            ]);
+            r.extend(cov_to_fields(&covs[i]));
         }
         r
     };

@@ -15,9 +15,10 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
+use crate::io::cloud_data::{cov_from_fields, cov_to_fields};
 use crate::io::text::{parse_f64, parse_i64, push_row, show, Tokens};
 use crate::io::{ByteCursor, CloudData, CloudDataBuilder, Encoding, MeshData};
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::math::{Point3, Vector3};
 use crate::shape::Mesh;
 
 const FORMAT: &str = "PLY";
@@ -566,13 +567,7 @@ pub fn read_ply(bytes: &[u8], name: &str) -> Result<CloudData> {
     let mut builder = CloudDataBuilder::new(fields, None, normals, covs, cap);
     walk(bytes, name, &header, false, &mut |i, s| {
         let normal = normals.then(|| Vector3::new(s[3], s[4], s[5]));
-        let cov = covs.then(|| {
-            Matrix3::new(
-                s[6], s[7], s[8], //
-                s[7], s[9], s[10], //
-                s[8], s[10], s[11],
-            )
-        });
+        let cov = covs.then(|| cov_from_fields([s[6], s[7], s[8], s[9], s[10], s[11]]));
         builder.push(i, Point3::new(s[0], s[1], s[2]), normal, cov);
     })?;
     Ok(builder.finish())
@@ -643,15 +638,7 @@ pub fn write_ply(cloud: &CloudData, encoding: Encoding) -> Result<Vec<u8>> {
             row.extend_from_slice(normals[i].as_slice());
         }
         if let Some(covs) = &cloud.covariances {
-            let c = &covs[i];
-            row.extend_from_slice(&[
-                c[(0, 0)],
-                c[(0, 1)],
-                c[(0, 2)],
-                c[(1, 1)],
-                c[(1, 2)],
-                c[(2, 2)],
-            ]);
+            row.extend_from_slice(&cov_to_fields(&covs[i]));
         }
         push_rows(&mut out, encoding, &row, &mut text);
     }

@@ -18,9 +18,10 @@
 //! `f64`, so files round-trip exactly.
 
 use crate::error::{Error, Result};
+use crate::io::cloud_data::{cov_from_fields, cov_to_fields, COV_FIELDS};
 use crate::io::text::{parse_f64, push_row, show};
 use crate::io::{CloudData, CloudDataBuilder};
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::math::{Point3, Vector3};
 
 /// The format named in errors: `CSV` for a `.csv` file, else `XYZ`.
 fn err(name: &str, problem: impl Into<String>) -> Error {
@@ -118,7 +119,7 @@ pub fn read_xyz(bytes: &[u8], name: &str) -> Result<CloudData> {
     let group = |names: &[&str]| -> Option<Vec<usize>> { names.iter().map(|n| find(n)).collect() };
     let normals =
         group(&["nx", "ny", "nz"]).or_else(|| group(&["normal_x", "normal_y", "normal_z"]));
-    let covs = group(&["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"]);
+    let covs = group(&COV_FIELDS);
     let mut b = CloudDataBuilder::new(fields, None, normals.is_some(), covs.is_some(), rows.len());
     let mut values = vec![0.0f64; columns];
     for (i, &(no, line)) in rows.iter().enumerate() {
@@ -145,10 +146,9 @@ pub fn read_xyz(bytes: &[u8], name: &str) -> Result<CloudData> {
         let n = normals
             .as_ref()
             .map(|n| Vector3::new(v(n[0]), v(n[1]), v(n[2])));
-        let c = covs.as_ref().map(|c| {
-            let (xx, xy, xz, yy, yz, zz) = (v(c[0]), v(c[1]), v(c[2]), v(c[3]), v(c[4]), v(c[5]));
-            Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
-        });
+        let c = covs
+            .as_ref()
+            .map(|c| cov_from_fields([0, 1, 2, 3, 4, 5].map(|k| v(c[k]))));
         b.push(i, p, n, c);
     }
     Ok(b.finish())
@@ -184,7 +184,7 @@ pub fn write_xyz(cloud: &CloudData, delimiter: u8) -> Result<Vec<u8>> {
             names.extend_from_slice(&["nx", "ny", "nz"]);
         }
         if covs.is_some() {
-            names.extend_from_slice(&["cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"]);
+            names.extend_from_slice(&COV_FIELDS);
         }
         out.push_str(&names.join(&sep.to_string()));
         out.push('\n');
@@ -197,15 +197,7 @@ pub fn write_xyz(cloud: &CloudData, delimiter: u8) -> Result<Vec<u8>> {
             row.extend(normals[i].iter());
         }
         if let Some(covs) = covs {
-            let c = &covs[i];
-            row.extend([
-                c[(0, 0)],
-                c[(0, 1)],
-                c[(0, 2)],
-                c[(1, 1)],
-                c[(1, 2)],
-                c[(2, 2)],
-            ]);
+            row.extend(cov_to_fields(&covs[i]));
         }
         push_row(&mut out, &row, sep);
     }
