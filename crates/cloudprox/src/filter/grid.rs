@@ -11,6 +11,8 @@
 //! shells (isolated points) are retried on a grid with 4x larger cells, and so
 //! on, so that an isolated point never walks thousands of empty cells.
 
+use std::f64::consts::PI;
+
 use rayon::prelude::*;
 
 use crate::math::Point3;
@@ -101,6 +103,35 @@ impl Layout {
 
     fn key_of(&self, p: &Point3) -> u64 {
         pack(self.cell_of(&[p.x, p.y, p.z]))
+    }
+}
+
+/// The points of a 3x3x3 block of cells, in single precision relative to the
+/// centre cell's corner (struct of arrays, so distances vectorize).
+#[derive(Debug, Default)]
+struct Block {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    /// Sorted position of each point.
+    pos: Vec<u32>,
+    /// Scratch: squared distances to the current query.
+    d2: Vec<f32>,
+}
+
+impl Block {
+    fn clear(&mut self) {
+        self.x.clear();
+        self.y.clear();
+        self.z.clear();
+        self.pos.clear();
+    }
+
+    fn push(&mut self, p: &[f64; 3], corner: &[f64; 3], pos: u32) {
+        self.x.push((p[0] - corner[0]) as f32);
+        self.y.push((p[1] - corner[1]) as f32);
+        self.z.push((p[2] - corner[2]) as f32);
+        self.pos.push(pos);
     }
 }
 
@@ -247,7 +278,7 @@ impl PointGrid {
         cell: usize,
         k: usize,
         f: &F,
-        block: &mut Vec<([f64; 3], u32)>,
+        block: &mut Block,
         buf: &mut Vec<(f64, u32)>,
         acc: &mut Vec<(u32, Option<T>)>,
     ) where
@@ -255,8 +286,10 @@ impl PointGrid {
     {
         let l = &self.layout;
         let members = self.starts[cell] as usize..self.starts[cell + 1] as usize;
+        let members_len = members.len();
         let first = &self.sorted[members.start];
         let c = l.cell_of(first);
+        let corner: [f64; 3] = std::array::from_fn(|a| l.origin[a] + c[a] as f64 * l.cell);
         block.clear();
         for dx in -1..=1 {
             let x = c[0] + dx;
@@ -272,7 +305,7 @@ impl PointGrid {
                     let z = c[2] + dz;
                     if z >= 0 && z < l.dims[2] {
                         for s in self.cell_range([x, y, z]) {
-                            block.push((self.sorted[s], self.index[s]));
+                            block.push(&self.sorted[s], &corner, s as u32);
                         }
                     }
                 }
@@ -299,12 +332,43 @@ impl PointGrid {
                 bound = bound.min(q[a] - lower[a]).min(upper[a] - q[a]);
             }
             let bound2 = bound * bound;
-            buf.clear();
-            for (p, i) in block.iter() {
-                let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-                let d2 = dx * dx + dy * dy + dz * dz;
-                if d2 <= bound2 && *i != exclude {
-                    buf.push((d2, *i));
+            // A vectorized single-precision pass (coordinates relative to the
+            // cell's corner), then the exact distance of the few that may pass.
+            let qf: [f32; 3] = std::array::from_fn(|a| (q[a] - corner[a]) as f32);
+            block.d2.clear();
+            block.d2.extend(
+                block
+                    .x
+                    .iter()
+                    .zip(&block.y)
+                    .zip(&block.z)
+                    .map(|((x, y), z)| {
+                        let (dx, dy, dz) = (x - qf[0], y - qf[1], z - qf[2]);
+                        dx * dx + dy * dy + dz * dz
+                    }),
+            );
+            // In a dense cell the k nearest lie well inside the block: first
+            // look within the radius k of them would need on a surface of the
+            // cell's density (with a margin), then, if too few, within the bound.
+            let guess2 = 2.5 * k as f64 * l.cell * l.cell / (PI * members_len as f64);
+            for limit2 in [guess2.min(bound2), bound2] {
+                let loose = (limit2 * (1.0 + 1e-4) + 1e-12 * l.cell * l.cell) as f32;
+                buf.clear();
+                for (j, &d2f) in block.d2.iter().enumerate() {
+                    if d2f > loose {
+                        continue;
+                    }
+                    let sp = block.pos[j] as usize;
+                    let p = &self.sorted[sp];
+                    let (dx, dy, dz) = (p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+                    let d2 = dx * dx + dy * dy + dz * dz;
+                    let i = self.index[sp];
+                    if d2 <= limit2 && i != exclude {
+                        buf.push((d2, i));
+                    }
+                }
+                if buf.len() >= k {
+                    break;
                 }
             }
             let settled = buf.len() >= k;
@@ -403,7 +467,7 @@ where
     let first: Vec<(u32, Option<T>)> = (0..grid.starts.len() - 1)
         .into_par_iter()
         .fold(
-            || (Vec::new(), Vec::new(), Vec::with_capacity(k + 1)),
+            || (Vec::new(), Block::default(), Vec::with_capacity(k + 1)),
             |(mut acc, mut block, mut buf), cell| {
                 grid.block_queries(cell, k, &f, &mut block, &mut buf, &mut acc);
                 (acc, block, buf)
