@@ -215,3 +215,33 @@ fn prefixes_and_bit_flips_never_panic() {
         let _ = read_pointcloud2(&l, &data);
     }
 }
+
+#[test]
+fn duplicate_and_empty_fields_are_named() {
+    let field = |name: &str, offset: u32, count: u32| PointField {
+        name: name.into(),
+        offset,
+        datatype: FLOAT32,
+        count,
+    };
+    let layout = |fields: Vec<PointField>| PointCloud2Layout {
+        height: 1,
+        width: 1,
+        fields,
+        is_bigendian: false,
+        point_step: 16,
+        row_step: 16,
+    };
+    let data = [0u8; 16];
+    let twice = layout(vec![
+        field("x", 0, 1),
+        field("y", 4, 1),
+        field("z", 8, 1),
+        field("x", 12, 1),
+    ]);
+    let msg = read_pointcloud2(&twice, &data).unwrap_err().to_string();
+    assert!(msg.contains("field 'x' appears twice"), "{msg}");
+    let empty = layout(vec![field("x", 0, 0), field("y", 4, 1), field("z", 8, 1)]);
+    let msg = read_pointcloud2(&empty, &data).unwrap_err().to_string();
+    assert!(msg.contains("field 'x' has count 0"), "{msg}");
+}

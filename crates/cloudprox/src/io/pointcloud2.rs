@@ -107,7 +107,8 @@ fn value(b: &[u8], datatype: u8, big: bool) -> f64 {
 ///
 /// # Errors
 /// [`Error::Format`] (file name and format `"PointCloud2"`) naming the
-/// problem: no `x`/`y`/`z` field, an unknown datatype, a field reaching past
+/// problem: no `x`/`y`/`z` field (or one of count 0), a field named twice, an
+/// unknown datatype, a field reaching past
 /// `point_step`, `point_step * width > row_step`, `data` shorter than
 /// `row_step * height`.
 pub fn read_pointcloud2(layout: &PointCloud2Layout, data: &[u8]) -> Result<CloudData> {
@@ -129,6 +130,11 @@ pub fn read_pointcloud2(layout: &PointCloud2Layout, data: &[u8]) -> Result<Cloud
         }
         sizes.push(size);
     }
+    for (i, f) in layout.fields.iter().enumerate() {
+        if layout.fields[..i].iter().any(|g| g.name == f.name) {
+            return Err(err(format!("field '{}' appears twice", f.name)));
+        }
+    }
     let find = |n: &str| {
         layout
             .fields
@@ -138,6 +144,9 @@ pub fn read_pointcloud2(layout: &PointCloud2Layout, data: &[u8]) -> Result<Cloud
     let mut xyz = [0usize; 3];
     for (slot, axis) in xyz.iter_mut().zip(["x", "y", "z"]) {
         *slot = find(axis).ok_or_else(|| {
+            if layout.fields.iter().any(|f| f.name == axis) {
+                return err(format!("field '{axis}' has count 0 (it holds no value)"));
+            }
             let names: Vec<&str> = layout.fields.iter().map(|f| f.name.as_str()).collect();
             err(format!("no field '{axis}' (fields: {})", names.join(", ")))
         })?;
