@@ -317,3 +317,33 @@ def test_sensor_without_viewpoint_and_corrupt_file(capsys, npy_files, tmp_path) 
     assert str(bad) in err and "PCD" in err
     code, _, err = run(capsys, "info", str(tmp_path / "missing.ply"))
     assert code == 2 and "no such file" in err
+
+
+def test_gripper_stl_against_a_las_scan(capsys, example, tmp_path) -> None:
+    # The "LAS file and an STL gripper" path: a laser scan has no sensor pose,
+    # so the noise is given (isotropic here, or --sensor lidar --origin ...).
+    laspy = pytest.importorskip("laspy")
+    pts = cp.io.read_point_cloud(example["scan"]).points
+    header = laspy.LasHeader(point_format=1, version="1.2")
+    header.scales = np.array([1e-4, 1e-4, 1e-4])
+    header.offsets = pts.min(axis=0)
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = pts[:, 0], pts[:, 1], pts[:, 2]
+    path = tmp_path / "scan.laz"
+    las.write(str(path))
+    code, out, err = run(
+        capsys,
+        "collide",
+        example["gripper"],
+        str(path),
+        "--pose-a",
+        example["grasp-collision"],
+        "--sigma",
+        "0.002",
+        "--json",
+    )
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["state"] == "collision"
+    assert doc["b"]["points_read"] == len(pts)
+    assert "classification" in doc["b"]["fields"]
