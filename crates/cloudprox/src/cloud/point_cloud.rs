@@ -2,6 +2,8 @@
 
 use std::sync::OnceLock;
 
+use rayon::prelude::*;
+
 use crate::bvh::{Bvh, BvhSettings};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
@@ -244,15 +246,21 @@ impl PointCloud {
         self.spacing.get_or_init(|| {
             let bvh = self.bvh();
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
-            let mut ws = crate::bvh::BvhWorkspace::default();
-            let mut nn = Vec::with_capacity(k + 1);
             let per_point: Vec<Real> = self
                 .points
-                .iter()
-                .map(|p| {
-                    bvh.nearest_k(&self.points, p, k + 1, &mut ws, &mut nn);
-                    nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
-                })
+                .par_iter()
+                .map_init(
+                    || {
+                        (
+                            crate::bvh::BvhWorkspace::default(),
+                            Vec::with_capacity(k + 1),
+                        )
+                    },
+                    |(ws, nn), p| {
+                        bvh.nearest_k(&self.points, p, k + 1, ws, nn);
+                        nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
+                    },
+                )
                 .collect();
             let per_node = bvh.node_max(&per_point);
             Spacing {

@@ -1,5 +1,7 @@
 //! Discretization error: how sparsely the surface around each point was sampled.
 
+use rayon::prelude::*;
+
 use crate::bvh::{Bvh, BvhWorkspace};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Vector3};
@@ -77,34 +79,37 @@ pub fn discretization_covariances(
         return Ok(vec![Matrix3::zeros(); points.len()]);
     }
     let k = settings.k.min(points.len() - 1);
-    let mut workspace = BvhWorkspace::default();
-    let mut neighbours = Vec::with_capacity(k + 1);
-    let mut out = Vec::with_capacity(points.len());
-    for (i, x) in points.iter().enumerate() {
-        bvh.nearest_k(points, x, k + 1, &mut workspace, &mut neighbours);
-        let d_k = neighbours.last().map_or(0.0, |&(d2, _)| d2.sqrt());
-        if d_k <= 0.0 {
-            out.push(Matrix3::zeros());
-            continue;
-        }
-        let s = settings.weight_scale * d_k;
-        let mut wsum = 0.0;
-        let mut mean = Vector3::zeros();
-        for &(d2, j) in &neighbours {
-            let w = (-d2 / (s * s)).exp();
-            wsum += w;
-            mean += w * points[j as usize].coords;
-        }
-        mean /= wsum;
-        let mut scatter = Matrix3::zeros();
-        for &(d2, j) in &neighbours {
-            let w = (-d2 / (s * s)).exp();
-            let o = points[j as usize].coords - mean;
-            scatter += w * o * o.transpose();
-        }
-        scatter /= wsum;
-        out.push(project_psd(&(scatter - sensor[i])));
-    }
+    let out = points
+        .par_iter()
+        .zip(sensor)
+        .map_init(
+            || (BvhWorkspace::default(), Vec::with_capacity(k + 1)),
+            |(workspace, neighbours), (x, sensor_i)| {
+                bvh.nearest_k(points, x, k + 1, workspace, neighbours);
+                let d_k = neighbours.last().map_or(0.0, |&(d2, _)| d2.sqrt());
+                if d_k <= 0.0 {
+                    return Matrix3::zeros();
+                }
+                let s = settings.weight_scale * d_k;
+                let mut wsum = 0.0;
+                let mut mean = Vector3::zeros();
+                for &(d2, j) in neighbours.iter() {
+                    let w = (-d2 / (s * s)).exp();
+                    wsum += w;
+                    mean += w * points[j as usize].coords;
+                }
+                mean /= wsum;
+                let mut scatter = Matrix3::zeros();
+                for &(d2, j) in neighbours.iter() {
+                    let w = (-d2 / (s * s)).exp();
+                    let o = points[j as usize].coords - mean;
+                    scatter += w * o * o.transpose();
+                }
+                scatter /= wsum;
+                project_psd(&(scatter - sensor_i))
+            },
+        )
+        .collect();
     Ok(out)
 }
 
