@@ -48,6 +48,9 @@ struct Spacing {
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
 const SPACING_NEIGHBOURS: usize = 6;
 
+/// Above this many points the spacing comes from the filters' hashed grid.
+const GRID_KNN_MIN_POINTS: usize = 4096;
+
 impl Clone for PointCloud {
     fn clone(&self) -> Self {
         let bvh = OnceLock::new();
@@ -246,22 +249,30 @@ impl PointCloud {
         self.spacing.get_or_init(|| {
             let bvh = self.bvh();
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
-            let per_point: Vec<Real> = self
-                .points
-                .par_iter()
-                .map_init(
-                    || {
-                        (
-                            crate::bvh::BvhWorkspace::default(),
-                            Vec::with_capacity(k + 1),
-                        )
-                    },
-                    |(ws, nn), p| {
-                        bvh.nearest_k(&self.points, p, k + 1, ws, nn);
-                        nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
-                    },
-                )
-                .collect();
+            let per_point: Vec<Real> = if self.points.len() > GRID_KNN_MIN_POINTS {
+                // The hashed grid of the filters: exact, and much cheaper than the
+                // tree on large clouds (the distance to the k-th neighbour does
+                // not depend on how ties are broken).
+                crate::filter::knn_map(&self.points, k, |_, nb| {
+                    nb.iter().fold(0.0, |m: Real, &(d2, _)| m.max(d2)).sqrt()
+                })
+            } else {
+                self.points
+                    .par_iter()
+                    .map_init(
+                        || {
+                            (
+                                crate::bvh::BvhWorkspace::default(),
+                                Vec::with_capacity(k + 1),
+                            )
+                        },
+                        |(ws, nn), p| {
+                            bvh.nearest_k(&self.points, p, k + 1, ws, nn);
+                            nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
+                        },
+                    )
+                    .collect()
+            };
             let per_node = bvh.node_max(&per_point);
             Spacing {
                 per_point,
@@ -322,5 +333,32 @@ impl PointCloud {
         let mut c = self.clone();
         c.transform(pose);
         c
+    }
+}
+
+#[cfg(test)]
+mod spacing_tests {
+    use super::*;
+    use crate::sample::{add_noise, box_surface};
+
+    /// The grid path (large clouds) and the tree path give the same spacing.
+    #[test]
+    fn grid_and_tree_spacing_agree() {
+        let pts = add_noise(
+            &box_surface(&Point3::origin(), &crate::math::Vector3::new(0.3, 0.2, 0.1), 0.004),
+            0.001,
+            3,
+        );
+        assert!(pts.len() > GRID_KNN_MIN_POINTS);
+        let cloud = PointCloud::from_sigma(pts.clone(), 0.001).unwrap();
+        let grid = cloud.spacing().to_vec();
+        let bvh = cloud.bvh();
+        let mut ws = crate::bvh::BvhWorkspace::default();
+        let mut nn = Vec::new();
+        for (i, p) in pts.iter().enumerate() {
+            bvh.nearest_k(&pts, p, SPACING_NEIGHBOURS + 1, &mut ws, &mut nn);
+            let tree = nn.last().unwrap().0.sqrt();
+            assert_eq!(grid[i], tree, "point {i}");
+        }
     }
 }

@@ -43,6 +43,18 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::math::Point3;
 
+/// For every point of a non-empty, finite cloud (fewer than 2^32 points),
+/// `f(i, neighbours)` with its `k` nearest *other* points as `(squared
+/// distance, index)` in no particular order; in parallel, results in point
+/// order. The exact k-NN of the filters' hashed grid, for other stages.
+pub(crate) fn knn_map<T, F>(points: &[Point3], k: usize, f: F) -> Vec<T>
+where
+    T: Send,
+    F: Fn(usize, &[(f64, u32)]) -> T + Sync,
+{
+    grid::for_each_knn(points, k, f)
+}
+
 /// Checks that a filter's input cloud is non-empty, indexable by `u32` and finite.
 pub(crate) fn check_points(filter: &str, points: &[Point3]) -> Result<()> {
     if points.is_empty() {
