@@ -345,7 +345,11 @@ mod spacing_tests {
     #[test]
     fn grid_and_tree_spacing_agree() {
         let pts = add_noise(
-            &box_surface(&Point3::origin(), &crate::math::Vector3::new(0.3, 0.2, 0.1), 0.004),
+            &box_surface(
+                &Point3::origin(),
+                &crate::math::Vector3::new(0.3, 0.2, 0.1),
+                0.004,
+            ),
             0.001,
             3,
         );
