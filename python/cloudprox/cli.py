@@ -356,7 +356,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     console = _console()
     console.print(f"[bold]{info['path']}[/bold]: {info['kind']} ({info['format'].upper()})")
     for key, value in info.items():
-        if key in ("path", "kind", "format"):
+        if key in ("path", "kind", "format") or (key == "warnings" and not value):
             continue
         if key == "bounds":
             lo, hi = value
@@ -376,6 +376,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
             value = "origin (" + ", ".join(f"{row[3]:.4g}" for row in value[:3]) + ")"
         elif key == "fields":
             value = " ".join(value)
+        elif isinstance(value, float):
+            value = f"{value:.4g}"
         console.print(f"  {key.replace('_', ' ')}: {value}")
     return 0
 
