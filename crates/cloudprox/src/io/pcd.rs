@@ -371,6 +371,17 @@ fn layout(h: &Header, name: &str) -> Result<Layout> {
     Ok(Layout { xyz, normals, covs })
 }
 
+/// Where each of a run of consecutive items of these lengths starts.
+fn starts(lengths: impl Iterator<Item = usize>) -> Vec<usize> {
+    lengths
+        .scan(0, |o, len| {
+            let at = *o;
+            *o += len;
+            Some(at)
+        })
+        .collect()
+}
+
 fn push_point(b: &mut CloudDataBuilder, l: &Layout, index: usize, v: &dyn Fn(usize) -> f64) {
     let p = Point3::new(v(l.xyz[0]), v(l.xyz[1]), v(l.xyz[2]));
     let n = l.normals.map(|n| Vector3::new(v(n[0]), v(n[1]), v(n[2])));
@@ -419,15 +430,7 @@ pub fn read_pcd(bytes: &[u8], name: &str) -> Result<CloudData> {
         .try_fold(0usize, |s, f| s.checked_add(f.size.checked_mul(f.count)?))
         .ok_or_else(|| err(name, "point size overflows"))?;
     // Byte offset of each field inside a point record.
-    let offsets: Vec<usize> = h
-        .fields
-        .iter()
-        .scan(0, |o, f| {
-            let at = *o;
-            *o += f.size * f.count;
-            Some(at)
-        })
-        .collect();
+    let offsets = starts(h.fields.iter().map(|f| f.size * f.count));
     let total = || {
         h.points.checked_mul(step).ok_or_else(|| {
             err(
@@ -529,15 +532,7 @@ fn read_ascii(
         ));
     }
     // Column of each field's first value.
-    let first: Vec<usize> = h
-        .fields
-        .iter()
-        .scan(0, |o, f| {
-            let at = *o;
-            *o += f.count;
-            Some(at)
-        })
-        .collect();
+    let first = starts(h.fields.iter().map(|f| f.count));
     // Whether each column is an F4 field: those values are f32, as in binary data.
     let single: Vec<bool> = h
         .fields
