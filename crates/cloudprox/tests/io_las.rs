@@ -1,6 +1,8 @@
 //! LAS and LAZ: files written with the `las` crate read back exactly; corrupt
 //! and truncated files are format errors.
 
+mod common;
+
 use std::io::Cursor;
 
 use cloudprox::io::las::read_las;
@@ -238,16 +240,9 @@ fn no_prefix_or_bit_flip_panics() {
         (write_file((1, 2), 3, true), "c.laz"),
         (write_file((1, 4), 7, true), "d.laz"),
     ] {
-        for cut in 0..bytes.len() {
-            let _ = read_las(&bytes[..cut], name);
-        }
-        for i in 0..bytes.len() {
-            for bit in [0, 4, 7] {
-                let mut f = bytes.clone();
-                f[i] ^= 1 << bit;
-                let _ = read_las(&f, name);
-            }
-        }
+        common::for_each_corruption(&bytes, &[0, 4, 7], |f| {
+            let _ = read_las(f, name);
+        });
     }
 }
 

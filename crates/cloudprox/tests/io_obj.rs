@@ -1,5 +1,7 @@
 //! OBJ: reading every corner form, writing, corrupt inputs.
 
+mod common;
+
 use cloudprox::io::obj::{read_obj_mesh, write_obj_mesh};
 use cloudprox::io::{read_mesh_bytes, MeshData, MeshFormat};
 use cloudprox::math::Point3;
@@ -174,24 +176,9 @@ fn errors_name_the_line() {
 
 #[test]
 fn no_prefix_or_bit_flip_panics() {
-    let file = CUBE.as_bytes().to_vec();
-    for cut in 0..file.len() {
-        let _ = read_obj_mesh(&file[..cut], "t.obj");
-    }
-    for i in 0..file.len() {
-        for bit in [0, 2, 5, 7] {
-            let mut f = file.clone();
-            f[i] ^= 1 << bit;
-            let _ = read_obj_mesh(&f, "t.obj");
-        }
-    }
-    let mut x: u32 = 99;
-    let garbage: Vec<u8> = (0..3000)
-        .map(|_| {
-            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
-            (x >> 24) as u8
-        })
-        .collect();
-    assert!(read_obj_mesh(&garbage, "t.obj").is_err());
+    common::for_each_corruption(CUBE.as_bytes(), &[0, 2, 5, 7], |f| {
+        let _ = read_obj_mesh(f, "t.obj");
+    });
+    assert!(read_obj_mesh(&common::garbage(3000, 99), "t.obj").is_err());
     let _ = read_obj_mesh(b"f -9223372036854775808 1 2\nv 0 0 0\n", "t.obj");
 }

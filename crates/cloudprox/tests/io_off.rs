@@ -1,5 +1,7 @@
 //! OFF: reading the variants, writing, corrupt inputs.
 
+mod common;
+
 use cloudprox::io::off::{read_off_mesh, write_off_mesh};
 use cloudprox::io::{read_mesh_bytes, MeshData, MeshFormat};
 use cloudprox::math::Point3;
@@ -207,23 +209,10 @@ fn errors_name_the_line() {
 #[test]
 fn no_prefix_or_bit_flip_panics() {
     let file = PENTAGON.as_bytes().to_vec();
-    for cut in 0..file.len() {
-        let _ = read_off_mesh(&file[..cut], "t.off");
-    }
-    for i in 0..file.len() {
-        for bit in [0, 2, 5, 7] {
-            let mut f = file.clone();
-            f[i] ^= 1 << bit;
-            let _ = read_off_mesh(&f, "t.off");
-        }
-    }
-    let mut x: u32 = 7;
-    let garbage: Vec<u8> = (0..3000)
-        .map(|_| {
-            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
-            (x >> 24) as u8
-        })
-        .collect();
+    common::for_each_corruption(&file, &[0, 2, 5, 7], |f| {
+        let _ = read_off_mesh(f, "t.off");
+    });
+    let garbage = common::garbage(3000, 7);
     assert!(read_off_mesh(&garbage, "t.off").is_err());
     let mut off = b"OFF\n".to_vec();
     off.extend_from_slice(&garbage);

@@ -2,6 +2,8 @@
 //! hand-written files (organized with NaN holes, VIEWPOINT, v0.6 headers,
 //! descriptors, a hand-made LZF stream), corrupt inputs.
 
+mod common;
+
 use cloudprox::io::pcd::{read_pcd, write_pcd};
 use cloudprox::io::{CloudData, Encoding, Grid};
 use cloudprox::prelude::*;
@@ -525,16 +527,9 @@ fn prefixes_and_bit_flips_never_panic() {
         .collect();
     files.push(ORGANIZED.as_bytes().to_vec());
     for file in &files {
-        for cut in 0..file.len() {
-            let _ = read_pcd(&file[..cut], "f.pcd");
-        }
-        for byte in 0..file.len() {
-            for bit in 0..8 {
-                let mut f = file.clone();
-                f[byte] ^= 1 << bit;
-                let _ = read_pcd(&f, "f.pcd");
-            }
-        }
+        common::for_each_corruption(file, &[0, 1, 2, 3, 4, 5, 6, 7], |f| {
+            let _ = read_pcd(f, "f.pcd");
+        });
     }
 }
 

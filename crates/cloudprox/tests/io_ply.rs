@@ -1,6 +1,8 @@
 //! PLY reading and writing: round-trips, hand-written files of every variant,
 //! meshes, corrupt inputs.
 
+mod common;
+
 use cloudprox::io::ply::{read_ply, read_ply_mesh, write_ply, write_ply_mesh};
 use cloudprox::io::{CloudData, Encoding};
 use cloudprox::prelude::*;
@@ -462,17 +464,9 @@ fn prefixes_and_bit_flips_never_panic() {
         hand_binary(false),
     ];
     for file in &files {
-        for cut in 0..file.len() {
-            let _ = read_ply(&file[..cut], "f.ply");
-            let _ = read_ply_mesh(&file[..cut], "f.ply");
-        }
-        for byte in 0..file.len() {
-            for bit in 0..8 {
-                let mut f = file.clone();
-                f[byte] ^= 1 << bit;
-                let _ = read_ply(&f, "f.ply");
-                let _ = read_ply_mesh(&f, "f.ply");
-            }
-        }
+        common::for_each_corruption(file, &[0, 1, 2, 3, 4, 5, 6, 7], |f| {
+            let _ = read_ply(f, "f.ply");
+            let _ = read_ply_mesh(f, "f.ply");
+        });
     }
 }

@@ -1,5 +1,7 @@
 //! STL: ascii and binary reading, writing, detection, corrupt inputs.
 
+mod common;
+
 use cloudprox::io::stl::{read_stl_mesh, write_stl_mesh};
 use cloudprox::io::{read_mesh_bytes, Encoding, MeshData, MeshFormat};
 use cloudprox::math::Point3;
@@ -322,25 +324,12 @@ fn no_prefix_or_bit_flip_panics() {
     let ascii = write_stl_mesh(&awkward_mesh(), Encoding::Ascii).unwrap();
     let bin = write_stl_mesh(&awkward_mesh(), Encoding::BinaryLittleEndian).unwrap();
     for file in [&ascii, &bin] {
-        for cut in 0..file.len() {
-            let _ = read_stl_mesh(&file[..cut], "t.stl");
-        }
-        for i in 0..file.len() {
-            for bit in [0, 3, 7] {
-                let mut f = file.clone();
-                f[i] ^= 1 << bit;
-                let _ = read_stl_mesh(&f, "t.stl");
-            }
-        }
+        common::for_each_corruption(file, &[0, 3, 7], |f| {
+            let _ = read_stl_mesh(f, "t.stl");
+        });
     }
     // Garbage.
-    let mut x: u32 = 12345;
-    let garbage: Vec<u8> = (0..2000)
-        .map(|_| {
-            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
-            (x >> 24) as u8
-        })
-        .collect();
+    let garbage = common::garbage(2000, 12345);
     assert!(read_stl_mesh(&garbage, "t.stl").is_err());
     let mut solid = b"solid ".to_vec();
     solid.extend_from_slice(&garbage);

@@ -1,5 +1,7 @@
 //! XYZ / CSV reading and writing.
 
+mod common;
+
 use cloudprox::io::xyz::{read_xyz, write_xyz};
 use cloudprox::io::CloudData;
 use cloudprox::prelude::*;
@@ -153,15 +155,8 @@ fn prefixes_and_bit_flips_never_panic() {
         write_xyz(&sample_cloud(), b' ').unwrap(),
     ];
     for file in &files {
-        for cut in 0..file.len() {
-            let _ = read_xyz(&file[..cut], "f.xyz");
-        }
-        for byte in 0..file.len() {
-            for bit in 0..8 {
-                let mut f = file.clone();
-                f[byte] ^= 1 << bit;
-                let _ = read_xyz(&f, "f.xyz");
-            }
-        }
+        common::for_each_corruption(file, &[0, 1, 2, 3, 4, 5, 6, 7], |f| {
+            let _ = read_xyz(f, "f.xyz");
+        });
     }
 }

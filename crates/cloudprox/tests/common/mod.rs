@@ -45,3 +45,30 @@ pub fn plates() -> (PointCloud, PointCloud) {
 pub fn plate_pose(gap: f64) -> Pose {
     Pose::translation(0.0, 0.0, 0.02 + gap)
 }
+
+/// Feeds every prefix of `file`, and `file` with each of `bits` flipped in every
+/// byte, to `read` (the readers' no-panic tests: `read` ignores the result).
+pub fn for_each_corruption(file: &[u8], bits: &[u32], mut read: impl FnMut(&[u8])) {
+    for cut in 0..file.len() {
+        read(&file[..cut]);
+    }
+    let mut f = file.to_vec();
+    for i in 0..file.len() {
+        for &bit in bits {
+            f[i] ^= 1 << bit;
+            read(&f);
+            f[i] ^= 1 << bit;
+        }
+    }
+}
+
+/// `len` pseudo-random bytes (a linear congruential generator from `seed`).
+pub fn garbage(len: usize, seed: u32) -> Vec<u8> {
+    let mut x = seed;
+    (0..len)
+        .map(|_| {
+            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
+            (x >> 24) as u8
+        })
+        .collect()
+}
