@@ -347,3 +347,16 @@ def test_gripper_stl_against_a_las_scan(capsys, example, tmp_path) -> None:
     assert doc["state"] == "collision"
     assert doc["b"]["points_read"] == len(pts)
     assert "classification" in doc["b"]["fields"]
+
+
+def test_dropped_mesh_faces_are_reported(capsys, npy_files, tmp_path) -> None:
+    obj = tmp_path / "tet.obj"
+    obj.write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 1 2\n"
+    )
+    code, out, err = run(capsys, "collide", str(obj), npy_files["a"], "--sigma", "0.002", "--json")
+    assert code == 0, err
+    assert json.loads(out)["a"]["dropped_faces"] == 1
+    code, out, err = run(capsys, "info", str(obj), "--json")
+    assert code == 0, err
+    assert "dropped 1 degenerate face" in json.loads(out)["warnings"][0]

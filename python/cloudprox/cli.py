@@ -238,9 +238,10 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     style = {"free": "green", "contact": "yellow", "collision": "red"}[result.state]
     for name, side in zip("AB", sides, strict=True):
         if side.mesh is not None:
+            dropped = f", {side.dropped_faces} degenerate dropped" if side.dropped_faces else ""
             console.print(
                 f"{name}: {side.path} (mesh: {len(side.mesh.vertices)} vertices, "
-                f"{len(side.mesh.faces)} faces)"
+                f"{len(side.mesh.faces)} faces{dropped})"
             )
         else:
             assert side.cloud is not None
@@ -300,10 +301,8 @@ def file_info(path: str) -> dict[str, Any]:
     Meshes: vertices, faces (dropped degenerate ones), bounds, area, volume,
     whether closed.
     """
-    import warnings
-
     from cloudprox import io
-    from cloudprox.pipeline import _is_mesh_file
+    from cloudprox.pipeline import is_mesh_file, read_mesh_file
 
     p = Path(path)
     if not p.exists():
@@ -311,16 +310,18 @@ def file_info(path: str) -> dict[str, Any]:
     if p.is_dir():
         raise CliError(f"{path} is a directory, expected a point-cloud or mesh file")
     info: dict[str, Any] = {"path": path, "format": p.suffix.lower().lstrip(".")}
-    if _is_mesh_file(path):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            mesh = io.read_mesh(path)
+    if is_mesh_file(path):
+        mesh, dropped = read_mesh_file(path)
         lo, hi = mesh.bounds()
         info |= {
             "kind": "mesh",
             "vertices": len(mesh.vertices),
             "faces": len(mesh.faces),
-            "warnings": [str(w.message) for w in caught],
+            "warnings": (
+                [f"{path}: dropped {dropped} degenerate face(s) that repeat a vertex"]
+                if dropped
+                else []
+            ),
             "bounds": [lo.tolist(), hi.tolist()],
             "area_m2": mesh.area,
             "closed": mesh.is_closed,

@@ -17,7 +17,6 @@ A cloud side goes through
 from __future__ import annotations
 
 import os
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,6 +26,7 @@ import numpy.typing as npt
 
 from cloudprox import filters, io
 from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera
+from cloudprox._native import read_mesh as _native_read_mesh
 
 __all__ = [
     "MESH_EXTENSIONS",
@@ -34,10 +34,12 @@ __all__ = [
     "LoadedSide",
     "PipelineError",
     "SensorSpec",
+    "is_mesh_file",
     "load_side",
     "parse_filter",
     "parse_pose",
     "parse_vector",
+    "read_mesh_file",
     "sensor_spec",
 ]
 
@@ -90,7 +92,7 @@ class SensorSpec:
             return None
         if self.origin is not None:
             return self.model.covariances(points, origin=self.origin)
-        pose = self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
+        pose = self._pose(scan)
         if pose is None:
             raise PipelineError(
                 f"{scan.path} records no sensor viewpoint: give --origin or --sensor-pose "
@@ -102,8 +104,12 @@ class SensorSpec:
         """Return where the sensor sits (for the shadow filter), if known."""
         if self.origin is not None:
             return self.origin
-        pose = self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
+        pose = self._pose(scan)
         return None if pose is None else np.asarray(pose)[:3, 3]
+
+    def _pose(self, scan: io.CloudFile) -> FloatArray | None:
+        """Return the sensor pose given, else the file's ``VIEWPOINT``, else ``None``."""
+        return self.sensor_pose if self.sensor_pose is not None else scan.sensor_pose
 
 
 @dataclass(frozen=True)
@@ -168,6 +174,7 @@ class LoadedSide:
     cloud: PointCloud | None = None
     mesh: Mesh | None = None
     read_points: int = 0
+    dropped_faces: int = 0
     skipped: int = 0
     filters: list[dict[str, Any]] = field(default_factory=list)
     fields: list[str] = field(default_factory=list)
@@ -183,7 +190,11 @@ class LoadedSide:
         """Plain-JSON description."""
         out: dict[str, Any] = {"path": self.path, "kind": self.kind}
         if self.mesh is not None:
-            out |= {"vertices": len(self.mesh.vertices), "faces": len(self.mesh.faces)}
+            out |= {
+                "vertices": len(self.mesh.vertices),
+                "faces": len(self.mesh.faces),
+                "dropped_faces": self.dropped_faces,
+            }
         if self.cloud is not None:
             out |= {
                 "points_read": self.read_points,
@@ -195,7 +206,8 @@ class LoadedSide:
         return out
 
 
-def _is_mesh_file(path: str) -> bool:
+def is_mesh_file(path: str) -> bool:
+    """Whether ``path`` is read as a mesh: STL, OBJ, OFF, or a PLY with faces."""
     suffix = Path(path).suffix.lower()
     if suffix in MESH_EXTENSIONS:
         return True
@@ -206,12 +218,9 @@ def _is_mesh_file(path: str) -> bool:
     return b"\nelement face " in head.split(b"end_header", 1)[0]
 
 
-def _read_mesh_quietly(path: str) -> tuple[Mesh, int]:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        mesh = io.read_mesh(path)
-    dropped = sum(1 for w in caught if issubclass(w.category, io.DegenerateFacesWarning))
-    return mesh, dropped
+def read_mesh_file(path: str) -> tuple[Mesh, int]:
+    """Read a mesh file; also return the number of degenerate faces dropped (no warning)."""
+    return _native_read_mesh(path)
 
 
 def _apply_filter(
@@ -250,7 +259,7 @@ def _apply_filter(
             points, origin, pixels=pixels, grid_shape=grid, min_angle_deg=angle
         )
     else:  # self
-        mesh, _ = _read_mesh_quietly(step.args[0])
+        mesh, _ = read_mesh_file(step.args[0])
         padding = _float(step.args[1], "self padding") if len(step.args) > 1 else 0.01
         pose = parse_pose(step.args[2], "self pose") if len(step.args) > 2 else np.eye(4)
         keep = filters.SelfFilter([(mesh, pose)], padding).apply(points)
@@ -273,9 +282,9 @@ def load_side(
         raise FileNotFoundError(f"{path}: no such file")
     if os.path.isdir(path):
         raise PipelineError(f"{path} is a directory, expected a point-cloud or mesh file")
-    if _is_mesh_file(path):
-        mesh, _ = _read_mesh_quietly(path)
-        return LoadedSide(path, "mesh", mesh=mesh)
+    if is_mesh_file(path):
+        mesh, dropped = read_mesh_file(path)
+        return LoadedSide(path, "mesh", mesh=mesh, dropped_faces=dropped)
     scan = io.read_point_cloud(path)
     side = LoadedSide(path, "cloud", read_points=len(scan) + scan.skipped, skipped=scan.skipped)
     side.fields = scan.fields
