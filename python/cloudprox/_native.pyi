@@ -58,6 +58,7 @@ _FloatArray = npt.NDArray[np.float64]
 _IntArray = npt.NDArray[np.int64]
 _SurfaceName = Literal["linear", "quadric"]
 _AggregationName = Literal["surface", "max", "union", "independent"]
+_ModelName = Literal["elements", "points"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
 _SolverName = Literal["barrier", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
@@ -447,6 +448,8 @@ def collide(
     solver: _SolverName | None = None,
     use_hierarchy: bool | None = None,
     mesh_spacing: float | None = None,
+    model: _ModelName | None = None,
+    decide_only: bool | None = None,
 ) -> CollisionResult:
     """Probabilistic collision query between two noisy point clouds.
 
@@ -505,6 +508,20 @@ def collide(
         Sampling spacing of a mesh side (metres; default: half the cloud's median
         spacing, its distance to the 6th nearest neighbour). A ``Mesh`` keeps its
         last samplings, so repeated queries do not sample it again.
+    model : {"points", "elements"}, optional
+        What is classified (default ``"points"``): every point (the paper's
+        method), or the cloud's *surface elements*: groups of points that fit a
+        smooth surface within their noise, built once per cloud, each standing
+        for its fitted surface with the covariance of the fit. With
+        ``"elements"``, ``P`` is the largest probability that the fitted
+        surfaces of two facing elements cross, and near regions hold tens of
+        samples at any noise level; per-point probabilities are still Eq. 3 of
+        each point. ``aggregation="surface"`` belongs to ``"points"``.
+    decide_only : bool, optional
+        Return as soon as the state is decided (default ``False``): no per-point
+        probabilities or separation estimates (NaN), and with ``max`` the query
+        stops at the first patch that reaches ``threshold_collision``. The state
+        is that of the full query.
 
     Returns
     -------
@@ -539,6 +556,8 @@ def collide_many(
     solver: _SolverName | None = None,
     use_hierarchy: bool | None = None,
     mesh_spacing: float | None = None,
+    model: _ModelName | None = None,
+    decide_only: bool | None = None,
 ) -> list[CollisionResult]:
     """Run :func:`collide` for many poses of ``a``, in parallel.
 
@@ -550,7 +569,7 @@ def collide_many(
         Poses of ``a``.
     pose_b : array_like, shape (4, 4), optional
         Pose of ``b``; ``None`` is the identity.
-    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy, mesh_spacing
+    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy, mesh_spacing, model, decide_only
         As in :func:`collide`.
 
     Returns
@@ -568,7 +587,7 @@ def default_options() -> dict[str, str | float | int | bool]:
     dict
         ``surface``, ``aggregation``, ``threshold_collision``, ``threshold_free``,
         ``prune_epsilon``, ``region_max_points``, ``near_context``, ``lambda_``, ``robust_eta``,
-        ``robust_model``, ``solver`` and ``use_hierarchy``.
+        ``robust_model``, ``solver``, ``use_hierarchy``, ``model`` and ``decide_only``.
     """
 
 def option_names() -> dict[str, tuple[str, ...]]:
@@ -577,7 +596,7 @@ def option_names() -> dict[str, tuple[str, ...]]:
     Returns
     -------
     dict
-        ``surface``, ``aggregation``, ``robust_model`` and ``solver``, each a tuple of
+        ``surface``, ``aggregation``, ``robust_model``, ``solver`` and ``model``, each a tuple of
         names.
     """
 

@@ -20,7 +20,7 @@ use crate::side::resolve_pair;
     a, b, pose_a=None, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
-    solver=None, use_hierarchy=None, mesh_spacing=None
+    solver=None, use_hierarchy=None, mesh_spacing=None, model=None, decide_only=None
 ))]
 pub fn collide(
     py: Python<'_>,
@@ -41,6 +41,8 @@ pub fn collide(
     solver: Option<String>,
     use_hierarchy: Option<bool>,
     mesh_spacing: Option<f64>,
+    model: Option<String>,
+    decide_only: Option<bool>,
 ) -> PyResult<PyCollisionResult> {
     let request = RequestOptions {
         surface,
@@ -55,6 +57,8 @@ pub fn collide(
         robust_model,
         solver,
         use_hierarchy,
+        model,
+        decide_only,
     }
     .build(py)?;
     let pose_a = pose_from(py, pose_a, "pose_a")?;
@@ -74,7 +78,7 @@ pub fn collide(
     a, b, poses_a, pose_b=None, *, surface=None, aggregation=None,
     threshold_collision=None, threshold_free=None, prune_epsilon=None,
     region_max_points=None, near_context=None, lambda_=None, robust_eta=None, robust_model=None,
-    solver=None, use_hierarchy=None, mesh_spacing=None
+    solver=None, use_hierarchy=None, mesh_spacing=None, model=None, decide_only=None
 ))]
 pub fn collide_many(
     py: Python<'_>,
@@ -95,6 +99,8 @@ pub fn collide_many(
     solver: Option<String>,
     use_hierarchy: Option<bool>,
     mesh_spacing: Option<f64>,
+    model: Option<String>,
+    decide_only: Option<bool>,
 ) -> PyResult<Vec<PyCollisionResult>> {
     let request = RequestOptions {
         surface,
@@ -109,6 +115,8 @@ pub fn collide_many(
         robust_model,
         solver,
         use_hierarchy,
+        model,
+        decide_only,
     }
     .build(py)?;
     let poses_a = poses_from(poses_a, "poses_a")?;

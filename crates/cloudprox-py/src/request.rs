@@ -6,7 +6,7 @@
 
 use cloudprox::classify::{SocpSolver, Surface};
 use cloudprox::probability::Aggregation;
-use cloudprox::query::CollisionRequest;
+use cloudprox::query::{CollisionRequest, QueryModel};
 use cloudprox::uncertainty::RobustModel;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -20,6 +20,7 @@ const AGGREGATIONS: [Aggregation; 4] = [
     Aggregation::Union,
     Aggregation::Independent,
 ];
+const MODELS: [QueryModel; 2] = [QueryModel::Elements, QueryModel::Points];
 const ROBUST_MODELS: [RobustModel; 2] = [RobustModel::Gaussian, RobustModel::Chebyshev];
 const SOLVERS: [SocpSolver; 2] = [SocpSolver::Barrier, SocpSolver::Clarabel];
 
@@ -69,6 +70,8 @@ pub struct RequestOptions {
     pub robust_model: Option<String>,
     pub solver: Option<String>,
     pub use_hierarchy: Option<bool>,
+    pub model: Option<String>,
+    pub decide_only: Option<bool>,
 }
 
 impl RequestOptions {
@@ -112,6 +115,12 @@ impl RequestOptions {
         if let Some(v) = self.use_hierarchy {
             r.use_hierarchy = v;
         }
+        if let Some(s) = &self.model {
+            r.model = parse_name(py, "model", s, &MODELS, QueryModel::name)?;
+        }
+        if let Some(v) = self.decide_only {
+            r.decide_only = v;
+        }
         r.validate().or_py(py)?;
         Ok(r)
     }
@@ -136,6 +145,8 @@ pub fn default_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("robust_model", RobustModel::name(r.classify.robust_model))?;
     d.set_item("solver", r.classify.solver.name())?;
     d.set_item("use_hierarchy", r.use_hierarchy)?;
+    d.set_item("model", r.model.name())?;
+    d.set_item("decide_only", r.decide_only)?;
     Ok(d)
 }
 
@@ -153,5 +164,6 @@ pub fn option_names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         PyTuple::new(py, ROBUST_MODELS.map(RobustModel::name))?,
     )?;
     d.set_item("solver", PyTuple::new(py, SOLVERS.map(SocpSolver::name))?)?;
+    d.set_item("model", PyTuple::new(py, MODELS.map(QueryModel::name))?)?;
     Ok(d)
 }

@@ -4,7 +4,7 @@
 //!
 //! Environment overrides for experiments: `LAMBDA` (slack weight), `ETA` (robust
 //! confidence), `RMAX` (largest patch), `CTX` (near context in spacings), `DISC=1`
-//! (add the discretization error).
+//! (add the discretization error), `MODEL` (`elements` or `points`).
 
 use cloudprox::prelude::*;
 use cloudprox::sample::{add_noise, box_surface, sphere};
@@ -35,6 +35,12 @@ fn main() {
         )
         .region_max_points(env("RMAX", 2000.0) as usize)
         .near_context(env("CTX", 2.0))
+        .model(
+            std::env::var("MODEL")
+                .ok()
+                .and_then(|m| QueryModel::from_name(&m))
+                .unwrap_or_default(),
+        )
         .build()
         .unwrap();
     let disc = env("DISC", 0.0) > 0.0;

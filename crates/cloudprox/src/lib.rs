@@ -17,6 +17,7 @@
 //! |---|---|
 //! | points, covariances, poses | [`cloud`] |
 //! | noise models, discretization error, robustness radius | [`uncertainty`] |
+//! | surface elements: the surfaces the points sample, at the resolution the data supports | [`element`] |
 //! | bounding volume hierarchy with noise-inflated pruning | [`bvh`] |
 //! | robust separating surface (SOCP) | [`classify`] |
 //! | per-point and pair probability, thresholds, state | [`probability`] |
@@ -50,6 +51,7 @@
 pub mod bvh;
 pub mod classify;
 pub mod cloud;
+pub mod element;
 pub mod error;
 pub mod filter;
 pub mod io;
@@ -75,7 +77,7 @@ pub mod prelude {
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
         collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
-        CollisionResult, ContactRegion, MeshSampling, QueryStats,
+        CollisionResult, ContactRegion, MeshSampling, QueryModel, QueryStats,
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{

@@ -53,6 +53,7 @@ __all__ = [
     "Draw",
     "MethodAnswer",
     "cloudprox_answer",
+    "variant_name",
     "collision_map_answer",
     "nn_gap_answer",
     "reconstruct_answer",
@@ -190,18 +191,34 @@ def _world(points: FloatArray, pose: FloatArray) -> FloatArray:
     return points @ pose[:3, :3].T + pose[:3, 3]
 
 
-def cloudprox_answer(draw: Draw, poses: FloatArray, surface: str, aggregation: str) -> MethodAnswer:
+def cloudprox_answer(
+    draw: Draw, poses: FloatArray, surface: str, aggregation: str, model: str = "points"
+) -> MethodAnswer:
     """Answer every pose with cloudprox (``collide_many``, in parallel).
 
-    Default settings but for the surface family and the aggregation.
+    Default settings but for the surface family, the aggregation and the model
+    (``"points"``, the paper's, or ``"elements"``, the surface elements).
     """
     piano, room = draw.clouds()
-    results = collide_many(piano, room, poses, surface=surface, aggregation=aggregation)
+    results = collide_many(
+        piano, room, poses, surface=surface, aggregation=aggregation, model=model
+    )
     return MethodAnswer(
         np.array([r.probability for r in results]),
         np.array([r.state for r in results]),
         np.array([r.stats["time_seconds"] for r in results]),
     )
+
+
+def variant_name(model: str, surface: str, aggregation: str) -> str:
+    """Return the row name of a cloudprox variant.
+
+    ``"cloudprox quadric max"`` for the points model (the paper's, with its
+    aggregation), ``"cloudprox elements quadric"`` for the surface elements.
+    """
+    if model == "elements":
+        return f"cloudprox elements {surface}"
+    return f"cloudprox {surface} {aggregation}"
 
 
 def nn_gap_answer(draw: Draw, poses: FloatArray) -> MethodAnswer:

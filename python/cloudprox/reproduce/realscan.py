@@ -328,7 +328,7 @@ def _grid(frame: DepthFrame, offset: int) -> npt.NDArray[np.bool_]:
 def run_scan(
     n_poses: int,
     seed: int,
-    variants: tuple[tuple[str, str], ...],
+    variants: tuple[tuple[str, str, str], ...],
     tick: Callable[[str, int], None],
 ) -> ScanResult:
     """Run every method on the Kinect frame with ``n_poses`` gripper poses.
@@ -362,11 +362,10 @@ def run_scan(
         draws.append(m.Draw(g_pts, g_cov, pts, kinect_covariances(pts, focal)))
     spacing = m.sampling_spacing(draws[0].room_points)
     answers: dict[str, list[m.MethodAnswer]] = {}
-    for surface, agg in variants:
-        answers[f"cloudprox {surface} {agg}"] = [
-            m.cloudprox_answer(d, q.poses, surface, agg) for d in draws
-        ]
-        tick(f"kinect: cloudprox {surface} {agg}", 1)
+    for model, surface, agg in variants:
+        key = m.variant_name(model, surface, agg)
+        answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model) for d in draws]
+        tick(f"kinect: {key}", 1)
     answers["nn-gap"] = [m.nn_gap_answer(d, q.poses) for d in draws]
     answers["collision-map"] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
     answers["spheres"] = [

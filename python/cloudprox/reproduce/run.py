@@ -39,17 +39,25 @@ __all__ = ["Claim", "Config", "Summary", "check_claims", "run"]
 #: The method whose claims are checked, and the baselines.
 OURS = "cloudprox quadric surface"
 NN, MAP, SPHERES, RECON = "nn-gap", "collision-map", "spheres", "reconstruct"
-#: cloudprox variants: (surface family, aggregation).
+#: The surface-element model's row.
+ELEMENTS = "cloudprox elements quadric"
+#: cloudprox variants: (model, surface family, aggregation).
 VARIANTS = (
-    ("quadric", "surface"),
-    ("quadric", "max"),
-    ("quadric", "union"),
-    ("quadric", "independent"),
-    ("linear", "surface"),
-    ("linear", "max"),
+    ("elements", "quadric", "max"),
+    ("points", "quadric", "surface"),
+    ("points", "quadric", "max"),
+    ("points", "quadric", "union"),
+    ("points", "quadric", "independent"),
+    ("points", "linear", "surface"),
+    ("points", "linear", "max"),
 )
 #: cloudprox variants run on the real scan.
-SCAN_VARIANTS = (("quadric", "surface"), ("quadric", "max"), ("linear", "surface"))
+SCAN_VARIANTS = (
+    ("elements", "quadric", "max"),
+    ("points", "quadric", "surface"),
+    ("points", "quadric", "max"),
+    ("points", "linear", "surface"),
+)
 #: The real scan's level name.
 KINECT = "kinect"
 
@@ -283,9 +291,9 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             draws.append(d)
         tick(f"{name}: noise draws", 1)
         answers: dict[str, list[m.MethodAnswer]] = {}
-        for surface, agg in VARIANTS:
-            key = f"cloudprox {surface} {agg}"
-            answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg) for d in draws]
+        for model, surface, agg in VARIANTS:
+            key = m.variant_name(model, surface, agg)
+            answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model) for d in draws]
             tick(f"{name}: {key}", 1)
         answers[NN] = [m.nn_gap_answer(d, q.poses) for d in draws]
         answers[MAP] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
@@ -305,7 +313,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             rows.extend(
                 _rows(name, np.full(len(q.poses), sigma), q.signed_distance, method, sc, st, sec)
             )
-        shown = {k2: scores[k2] for k2 in (OURS, "cloudprox quadric max", NN)}
+        shown = {k2: scores[k2] for k2 in (ELEMENTS, OURS, "cloudprox quadric max", NN)}
         fig_p.append((f"noise {name} (σ = {1e3 * sigma:.1f} mm)", sigma, q.signed_distance, shown))
         near = np.abs(q.signed_distance) <= NEAR_SIGMA * sigma
         fig_roc.append(
@@ -348,7 +356,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             scan.scores[OURS][0],
             out / "kinect_scene.png",
         )
-        shown = {k2: scan.scores[k2] for k2 in (OURS, "cloudprox quadric max", NN)}
+        shown = {k2: scan.scores[k2] for k2 in (ELEMENTS, OURS, "cloudprox quadric max", NN)}
         fig_p.append(("real Kinect frame, Panda gripper (approx. truth)", 1.0, unit, shown))
         near = np.abs(unit) <= NEAR_SIGMA
         fig_roc.append(
@@ -382,7 +390,15 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
         )
         w.writerows(rows)
     figures.plot_probability_vs_distance(fig_p, out / "p_vs_distance.png")
-    methods_shown = [OURS, "cloudprox quadric max", "cloudprox linear surface", NN, MAP, SPHERES]
+    methods_shown = [
+        ELEMENTS,
+        OURS,
+        "cloudprox quadric max",
+        "cloudprox linear surface",
+        NN,
+        MAP,
+        SPHERES,
+    ]
     methods_shown += [RECON] if with_reconstruction else []
     flip_levels = list(summary.sigmas) + ([KINECT] if summary.scan_facts else [])
     figures.plot_flip_rates(

@@ -5,6 +5,7 @@ use std::sync::OnceLock;
 use rayon::prelude::*;
 
 use crate::bvh::{Bvh, BvhSettings};
+use crate::element::{ElementSettings, SurfaceElements};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
 use crate::uncertainty::{
@@ -36,6 +37,8 @@ pub struct PointCloud {
     bvh_settings: BvhSettings,
     bvh: OnceLock<Bvh>,
     spacing: OnceLock<Spacing>,
+    element_settings: ElementSettings,
+    elements: OnceLock<Box<SurfaceElements>>,
 }
 
 /// Sampling spacing per point and its maximum per hierarchy node.
@@ -61,6 +64,10 @@ impl Clone for PointCloud {
         if let Some(sp) = self.spacing.get() {
             let _ = spacing.set(sp.clone());
         }
+        let elements = OnceLock::new();
+        if let Some(e) = self.elements.get() {
+            let _ = elements.set(e.clone());
+        }
         Self {
             points: self.points.clone(),
             covariances: self.covariances.clone(),
@@ -71,6 +78,8 @@ impl Clone for PointCloud {
             bvh_settings: self.bvh_settings,
             bvh,
             spacing,
+            element_settings: self.element_settings,
+            elements,
         }
     }
 }
@@ -138,7 +147,47 @@ impl PointCloud {
             bvh_settings: BvhSettings::default(),
             bvh: OnceLock::new(),
             spacing: OnceLock::new(),
+            element_settings: ElementSettings::default(),
+            elements: OnceLock::new(),
         }
+    }
+
+    /// A cloud from total and sensor covariances that are already valid (the
+    /// samples of surface elements).
+    pub(crate) fn from_total_and_sensor(
+        points: Vec<Point3>,
+        total: Vec<Matrix3>,
+        sensor: Vec<Matrix3>,
+    ) -> Self {
+        let mut c = Self::from_parts(points, sensor);
+        c.sensor = Some(std::mem::replace(&mut c.covariances, total));
+        c.sigma_max = c.covariances.iter().map(max_std).collect();
+        c
+    }
+
+    /// The cloud's surface elements (see [`crate::element`]), built on first
+    /// call in the cloud's own frame and kept until the points move.
+    pub fn elements(&self) -> &SurfaceElements {
+        self.elements.get_or_init(|| {
+            Box::new(
+                SurfaceElements::build(self, &self.element_settings)
+                    .expect("element settings are validated when set"),
+            )
+        })
+    }
+
+    /// How the surface elements are built; existing ones are dropped and
+    /// rebuilt lazily.
+    pub fn set_element_settings(&mut self, settings: ElementSettings) -> Result<()> {
+        settings.validate()?;
+        self.element_settings = settings;
+        self.elements = OnceLock::new();
+        Ok(())
+    }
+
+    /// The settings the surface elements are built with.
+    pub fn element_settings(&self) -> &ElementSettings {
+        &self.element_settings
     }
 
     /// Adds the k-nearest-neighbour discretization covariance to every point's
@@ -157,6 +206,7 @@ impl PointCloud {
             *c += d;
         }
         self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.elements = OnceLock::new();
         Ok(self)
     }
 
@@ -181,6 +231,7 @@ impl PointCloud {
             *c += d;
         }
         self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.elements = OnceLock::new();
         Ok(self)
     }
 
@@ -306,6 +357,7 @@ impl PointCloud {
             bvh.refit(&self.points, &self.sensor_sigma_max)?;
         }
         self.spacing = OnceLock::new();
+        self.elements = OnceLock::new();
         Ok(())
     }
 
@@ -326,6 +378,7 @@ impl PointCloud {
         }
         self.bvh = OnceLock::new();
         self.spacing = OnceLock::new();
+        self.elements = OnceLock::new();
     }
 
     /// A copy moved by `pose` (see [`PointCloud::transform`]).

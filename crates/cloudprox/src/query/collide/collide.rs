@@ -3,17 +3,21 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{train, Classification, Separator, SocpSolver, SolveStatus};
+use crate::classify::{Separator, SocpSolver, SolveStatus};
 use crate::cloud::PointCloud;
+use crate::element::SurfaceElements;
 use crate::error::Result;
-use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{
-    crossing_probabilities, point_probability, surface_probability, Aggregation,
+    crossing_probabilities, element_crossing_probabilities, normal_quantile, point_probability,
+    surface_probability, Aggregation, ElementSide,
 };
-use crate::query::collide::region::{
-    cut, near_points, near_points_brute_force, near_regions, split_patches, Patch, SAMPLING_MARGIN,
+use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
+use crate::query::collide::near::near_set;
+use crate::query::collide::region::{cut, split_patches, Patch};
+use crate::query::collide::{
+    CollisionRequest, CollisionResult, ContactRegion, QueryModel, QueryStats,
 };
-use crate::query::collide::{CollisionRequest, CollisionResult, ContactRegion, QueryStats};
 use crate::uncertainty::directional_std_of;
 use crate::Real;
 
@@ -71,72 +75,33 @@ pub(crate) fn collide_with_workspace(
     request.validate()?;
     let start = Instant::now();
     let mut stats = QueryStats::default();
-    // Pose of A in B's frame.
+    // Pose of A in B's frame: all the work happens in B's frame.
     let rel = pose_b.inverse() * pose_a;
-    // Near points, in two stages. First the noise and the sampling alone: two
-    // surfaces sampled at spacing h can meet with no two samples closer than
-    // about h/2, so a pair is near when the noise reaches across its distance
-    // less half a spacing (the "core" points). If no pair is, the clouds are free
-    // and the query ends here. Otherwise again with the context margin, so the
-    // classifier sees the surface around the core.
-    let ctx = request.near_context.max(SAMPLING_MARGIN);
-    let eps = request.prune_epsilon;
-    let (components, core): (Vec<Patch>, (Vec<bool>, Vec<bool>)) = if request.use_hierarchy {
-        let (ma, mb) = (margins(a, SAMPLING_MARGIN), margins(b, SAMPLING_MARGIN));
-        let mut t = a
-            .bvh()
-            .traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
-        let core = near_points(&t.leaf_pairs, &rel, a, b, eps, SAMPLING_MARGIN);
-        let any_near = core.0.iter().any(|&k| k);
-        let mut keep = core.clone();
-        if any_near && ctx > SAMPLING_MARGIN {
-            let (ma, mb) = (margins(a, ctx), margins(b, ctx));
-            t = a
-                .bvh()
-                .traverse_pairs(b.bvh(), &rel, eps, &ma, &mb, workspace);
-            keep = near_points(&t.leaf_pairs, &rel, a, b, eps, ctx);
-        }
-        stats.node_pairs_visited = t.node_pairs_visited;
-        stats.leaf_pairs = t.leaf_pairs.len();
-        stats.pruned_bound = t.pruned_bound;
-        if !any_near {
-            t.leaf_pairs.clear();
-        }
-        let regions = near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep.0, &keep.1);
-        (regions, core)
-    } else {
-        // The brute-force reference: the same near-point rule on every point pair,
-        // all near points in one region.
-        let core = near_points_brute_force(&rel, a, b, eps, SAMPLING_MARGIN);
-        let mut keep = core.clone();
-        if keep.0.iter().any(|&k| k) && ctx > SAMPLING_MARGIN {
-            keep = near_points_brute_force(&rel, a, b, eps, ctx);
-        }
-        let pick =
-            |k: &[bool]| -> Vec<u32> { (0..k.len() as u32).filter(|&i| k[i as usize]).collect() };
-        let region = Patch {
-            component: 0,
-            a: pick(&keep.0),
-            b: pick(&keep.1),
-        };
-        let regions = if region.a.is_empty() || region.b.is_empty() {
-            Vec::new()
-        } else {
-            vec![region]
-        };
-        (regions, core)
+    // The samples: the points, or the samples of the surface elements.
+    let elements = match request.model {
+        QueryModel::Points => None,
+        QueryModel::Elements => Some((a.elements(), b.elements())),
     };
-    stats.near_regions = components.len();
+    let (sa, sb) = match elements {
+        None => (a, b),
+        Some((ea, eb)) => (ea.samples(), eb.samples()),
+    };
+    let near = near_set(&rel, sa, sb, request, workspace, &mut stats);
+    let core = &near.core;
+    stats.near_regions = near.regions.len();
 
     let mut probabilities_a = vec![0.0; a.len()];
     let mut probabilities_b = vec![0.0; b.len()];
-    // What the aggregation reads per point: p_i, or the surface probability q_i.
-    let mut inputs_a = vec![0.0; a.len()];
-    let mut inputs_b = vec![0.0; b.len()];
+    // What the aggregation reads per sample: p_i, the surface probability q_i,
+    // or the pair crossing probability.
+    let mut inputs_a = vec![0.0; sa.len()];
+    let mut inputs_b = vec![0.0; sb.len()];
     let mut regions = Vec::new();
-    for component in components {
-        let (pa, ca) = in_frame(&rel, a, &component.a);
-        let (pb, cb) = in_frame(&Pose::identity(), b, &component.b);
+    let stop_early = request.decide_only
+        && matches!(request.aggregation, Aggregation::Max | Aggregation::Surface);
+    'regions: for component in near.regions {
+        let (pa, ca) = in_frame(&rel, sa, &component.a);
+        let (pb, cb) = in_frame(&Pose::identity(), sb, &component.b);
         let local = Patch {
             component: component.component,
             a: (0..component.a.len() as u32).collect(),
@@ -157,10 +122,19 @@ pub(crate) fn collide_with_workspace(
             covs.extend(covsb);
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
-            let spacing = patch_median(&ia, a.spacing(), &ib, b.spacing());
-            let sigma = patch_median(&ia, a.sigma_max(), &ib, b.sigma_max());
-            let fit = fit_patch(&pts, &covs, na, &axis, spacing, sigma, request)?;
-            // A context point (beyond the noise's reach of the other cloud) that
+            let spacing = patch_median(&ia, sa.spacing(), &ib, sb.spacing());
+            let sigma = patch_median(&ia, sa.sigma_max(), &ib, sb.sigma_max());
+            let fit = fit_patch(
+                &pts,
+                &covs,
+                na,
+                &axis,
+                spacing,
+                sigma,
+                request,
+                !request.decide_only,
+            )?;
+            // A context sample (beyond the noise's reach of the other cloud) that
             // the surface puts on the wrong side shows a surface too rigid for the
             // patch (a wrapped or saddle-shaped contact): cut it and fit the halves.
             let misfit = ia
@@ -178,34 +152,35 @@ pub(crate) fn collide_with_workspace(
                     continue;
                 }
             }
-            for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
-                probabilities_a[i as usize] = p;
-            }
-            for (&i, &p) in ib.iter().zip(&fit.probabilities[na..]) {
-                probabilities_b[i as usize] = p;
-            }
             let sep = &fit.classification.separator;
-            let (qa, qb) = if request.aggregation == Aggregation::Surface {
-                let (own_a, own_b) = (&pts[..na], &pts[na..]);
-                let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
-                let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
-                    q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
-                };
-                (
-                    either(
-                        surface_probabilities(sep, own_a, cov_a, 1.0),
-                        crossing_probabilities(own_a, cov_a, own_b, cov_b),
-                    ),
-                    either(
-                        surface_probabilities(sep, own_b, cov_b, -1.0),
-                        crossing_probabilities(own_b, cov_b, own_a, cov_a),
-                    ),
-                )
-            } else {
-                (
+            let (own_a, own_b) = (&pts[..na], &pts[na..]);
+            let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
+            let (qa, qb) = match (request.model, request.aggregation) {
+                (QueryModel::Elements, _) => {
+                    let (ea, eb) = elements.expect("the elements model has elements");
+                    let id = Pose::identity();
+                    let reach = -normal_quantile(0.5 * request.prune_epsilon);
+                    element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
+                }
+                (QueryModel::Points, Aggregation::Surface) => {
+                    let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
+                        q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
+                    };
+                    (
+                        either(
+                            surface_probabilities(sep, own_a, cov_a, 1.0),
+                            crossing_probabilities(own_a, cov_a, own_b, cov_b),
+                        ),
+                        either(
+                            surface_probabilities(sep, own_b, cov_b, -1.0),
+                            crossing_probabilities(own_b, cov_b, own_a, cov_a),
+                        ),
+                    )
+                }
+                (QueryModel::Points, _) => (
                     fit.probabilities[..na].to_vec(),
                     fit.probabilities[na..].to_vec(),
-                )
+                ),
             };
             for (&i, &q) in ia.iter().zip(&qa) {
                 inputs_a[i as usize] = q;
@@ -225,12 +200,37 @@ pub(crate) fn collide_with_workspace(
             );
             stats.solver_fallbacks +=
                 usize::from(fit.classification.status == SolveStatus::Fallback);
+            // The patch's points: the samples themselves, or the points of the
+            // elements they stand for; each with its Eq. 3 probability against
+            // the patch's surface.
+            let (indices_a, indices_b) = match elements {
+                None => {
+                    if !request.decide_only {
+                        for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
+                            probabilities_a[i as usize] = p;
+                        }
+                        for (&i, &p) in ib.iter().zip(&fit.probabilities[na..]) {
+                            probabilities_b[i as usize] = p;
+                        }
+                    }
+                    (ia, ib)
+                }
+                Some((ea, eb)) => {
+                    let (ia, ib) = (element_points(ea, &ia), element_points(eb, &ib));
+                    if !request.decide_only {
+                        point_probabilities(sep, &rel, a, &ia, 1.0, &mut probabilities_a);
+                        let id = Pose::identity();
+                        point_probabilities(sep, &id, b, &ib, -1.0, &mut probabilities_b);
+                    }
+                    (ia, ib)
+                }
+            };
             let mut separator = fit.classification.separator;
             separator.frame = *pose_b;
             regions.push(ContactRegion {
                 component: patch.component,
-                indices_a: ia,
-                indices_b: ib,
+                indices_a,
+                indices_b,
                 point: pose_b * fit.point,
                 normal: pose_b.rotation * fit.normal,
                 separation: fit.separation,
@@ -240,6 +240,9 @@ pub(crate) fn collide_with_workspace(
                 status: fit.classification.status,
                 iterations: fit.classification.iterations,
             });
+            if stop_early && patch_probability >= request.thresholds.collision {
+                break 'regions;
+            }
         }
     }
     stats.patches = regions.len();
@@ -256,6 +259,86 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
+}
+
+/// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
+/// in the separator's frame; `ib` of B's), that the fitted surface of the
+/// element it stands for crosses the other side's
+/// ([`element_crossing_probabilities`]).
+#[allow(clippy::too_many_arguments)]
+fn element_crossings<'a>(
+    ea: &'a SurfaceElements,
+    ia: &[u32],
+    pose_a: &Pose,
+    eb: &'a SurfaceElements,
+    ib: &[u32],
+    pose_b: &Pose,
+    sep: &Separator,
+    reach_sds: Real,
+) -> (Vec<Real>, Vec<Real>) {
+    let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
+    let side = |els: &'a SurfaceElements, unique: &[u32], pose: &Pose, label: Real| ElementSide {
+        elements: unique
+            .iter()
+            .map(|&e| &els.elements()[e as usize])
+            .collect(),
+        pose: *pose,
+        label,
+    };
+    let (sa, sb) = (side(ea, &ua, pose_a, 1.0), side(eb, &ub, pose_b, -1.0));
+    let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
+    let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
+    let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
+        let owner = els.sample_owner();
+        idx.iter()
+            .map(|&s| {
+                q[unique
+                    .binary_search(&owner[s as usize])
+                    .expect("owner listed")]
+            })
+            .collect::<Vec<Real>>()
+    };
+    (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
+}
+
+/// The elements (sorted, each once) that the samples `samples` stand for.
+fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
+    let owner = elements.sample_owner();
+    let mut unique: Vec<u32> = samples.iter().map(|&s| owner[s as usize]).collect();
+    unique.sort_unstable();
+    unique.dedup();
+    unique
+}
+
+/// The point indices of the elements that the samples `samples` stand for, each
+/// element once, in the order of first appearance.
+fn element_points(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
+    unique_owners(elements, samples)
+        .iter()
+        .flat_map(|&e| elements.element_points(e).iter().copied())
+        .collect()
+}
+
+/// Eq. 3 of each point `idx` of `cloud` (moved by `pose` into the separator's
+/// frame) against `sep`, with label `label`; the larger of it and what `out`
+/// already holds (a point can be in several patches).
+fn point_probabilities(
+    sep: &Separator,
+    pose: &Pose,
+    cloud: &PointCloud,
+    idx: &[u32],
+    label: Real,
+    out: &mut [Real],
+) {
+    let r = pose.rotation.to_rotation_matrix();
+    let r = r.matrix();
+    for &i in idx {
+        let i = i as usize;
+        let x = pose * cloud.points()[i];
+        let cov = r * cloud.covariances()[i] * r.transpose();
+        let (f, g) = sep.value_and_gradient_local(&x);
+        out[i] = out[i].max(point_probability(f, &g, &cov, label));
+    }
 }
 
 /// The values of the `(point index, value)` pairs whose point is a core point.
@@ -334,11 +417,6 @@ fn patch_median(ia: &[u32], of_a: &[Real], ib: &[u32], of_b: &[Real]) -> Real {
     *v.select_nth_unstable_by(mid, Real::total_cmp).1
 }
 
-/// Per-node margins of `spacings` sampling spacings.
-fn margins(cloud: &PointCloud, spacings: Real) -> Vec<Real> {
-    cloud.node_spacing().iter().map(|s| s * spacings).collect()
-}
-
 /// Points `idx` of `cloud` and their covariances, moved by `pose`.
 fn in_frame(pose: &Pose, cloud: &PointCloud, idx: &[u32]) -> (Vec<Point3>, Vec<Matrix3>) {
     let r = pose.rotation.to_rotation_matrix();
@@ -352,150 +430,4 @@ fn in_frame(pose: &Pose, cloud: &PointCloud, idx: &[u32]) -> (Vec<Point3>, Vec<M
             )
         })
         .unzip()
-}
-
-/// A classified patch, in the frame its points were given in.
-struct PatchFit {
-    classification: Classification,
-    /// Per-point probabilities, A's points first.
-    probabilities: Vec<Real>,
-    point: Point3,
-    normal: Vector3,
-    separation: Real,
-}
-
-/// Trains the surface for `pts` (the first `na` from A) and derives the per-point
-/// probabilities (Eq. 3), the contact point, normal and separation estimate.
-fn fit_patch(
-    pts: &[Point3],
-    covs: &[Matrix3],
-    na: usize,
-    axis: &Vector3,
-    spacing: Real,
-    sigma: Real,
-    request: &CollisionRequest,
-) -> Result<PatchFit> {
-    let labels: Vec<Real> = (0..pts.len())
-        .map(|i| if i < na { 1.0 } else { -1.0 })
-        .collect();
-    let classification = train(pts, covs, &labels, &request.classify)?;
-    let sep = &classification.separator;
-    let mut probabilities = Vec::with_capacity(pts.len());
-    let mut margins = Vec::with_capacity(pts.len());
-    for ((x, cov), &c) in pts.iter().zip(covs).zip(&labels) {
-        let (f, g) = sep.value_and_gradient_local(x);
-        probabilities.push(point_probability(f, &g, cov, c));
-        let gn = g.norm();
-        margins.push(if gn > 0.0 { c * f / gn } else { c * f });
-    }
-    // The contact point: between the point of each side closest to (or deepest
-    // across) the surface, projected onto it.
-    let deepest = |range: std::ops::Range<usize>| -> Point3 {
-        let k = range
-            .clone()
-            .min_by(|&i, &j| margins[i].total_cmp(&margins[j]))
-            .unwrap_or(range.start);
-        pts[k]
-    };
-    let mid = nalgebra::center(&deepest(0..na), &deepest(na..pts.len()));
-    let point = sep.project(&mid);
-    let (_, g) = sep.value_and_gradient_local(&point);
-    let normal = if g.norm() > 0.0 {
-        -g.normalize()
-    } else {
-        (mean(&pts[na..]) - mean(&pts[..na])).normalize()
-    };
-    // The separation is measured along the near region's axis (unlike the trained
-    // surface's normal, it stays meaningful when the clouds interpenetrate and the
-    // surface cannot separate them), on lines through up to 64 of the patch's
-    // points; the smallest is where the surfaces come closest or cross deepest.
-    // Only points within two sampling spacings (the patch's median) of a line
-    // count for it, and a line needs 3 of each side.
-    let radius = 2.0 * spacing;
-    // Along a line, one cloud may show several surfaces (both faces of a thin
-    // plate): offsets further apart than this belong to different surfaces.
-    let split = (4.0 * sigma).max(0.5 * spacing);
-    let stride = pts.len().div_ceil(64).max(1);
-    let separation = pts
-        .iter()
-        .step_by(stride)
-        .filter_map(|x| {
-            let sb = axial_offset(&pts[na..], x, axis, radius, -1.0, split)?;
-            let sa = axial_offset(&pts[..na], x, axis, radius, 1.0, split)?;
-            Some(sb - sa)
-        })
-        .reduce(Real::min)
-        .unwrap_or_else(|| {
-            let inf = Real::INFINITY;
-            axial_offset(&pts[na..], &mid, axis, inf, -1.0, split).unwrap_or(0.0)
-                - axial_offset(&pts[..na], &mid, axis, inf, 1.0, split).unwrap_or(0.0)
-        });
-    Ok(PatchFit {
-        classification,
-        probabilities,
-        point,
-        normal,
-        separation,
-    })
-}
-
-/// Unit eigenvector of the smallest eigenvalue of the points' scatter, oriented
-/// along `towards`.
-fn least_spread_axis(pts: &[Point3], towards: &Vector3) -> Vector3 {
-    let c = mean(pts);
-    let mut scatter = Matrix3::zeros();
-    for p in pts {
-        let d = p.coords - c;
-        scatter += d * d.transpose();
-    }
-    let eig = scatter.symmetric_eigen();
-    let axis = eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned();
-    if axis.dot(towards) < 0.0 {
-        -axis
-    } else {
-        axis
-    }
-}
-
-fn mean(p: &[Point3]) -> Vector3 {
-    p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
-}
-
-/// Where one side's surface crosses the line through `point` along `axis`: among
-/// the side's 12 points nearest that line (within `radius` of it), sorted by
-/// their offset along `axis` starting from the end that faces the other cloud
-/// (`facing = +1`: the largest offsets first), the median of the leading run of
-/// offsets less than `split` apart, i.e. of the surface nearest the other cloud;
-/// `None` with fewer than 3 points near the line or 2 in that run. Medians keep
-/// the estimate unbiased by the noise on a flat contact.
-fn axial_offset(
-    pts: &[Point3],
-    point: &Point3,
-    axis: &Vector3,
-    radius: Real,
-    facing: Real,
-    split: Real,
-) -> Option<Real> {
-    let r2 = radius * radius;
-    let mut by_lateral: Vec<(Real, Real)> = pts
-        .iter()
-        .filter_map(|x| {
-            let d = x - point;
-            let along = d.dot(axis);
-            let lat = (d - axis * along).norm_squared();
-            (lat <= r2).then_some((lat, along))
-        })
-        .collect();
-    if by_lateral.len() < 3 {
-        return None;
-    }
-    let k = 12.min(by_lateral.len());
-    by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
-    along.sort_by(|a, b| b.total_cmp(a));
-    let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
-    if run < 2 {
-        return None;
-    }
-    Some(facing * along[run / 2])
 }

@@ -1,17 +1,24 @@
 //! The probabilistic collision query between two noisy point clouds.
 //!
-//! 1. traverse the two hierarchies under the relative pose, pruning node pairs
-//!    whose crossing bound is below `prune_epsilon` ([`crate::bvh`]);
-//! 2. merge the kept leaf pairs into connected near regions, and split large
-//!    regions into patches along the contact ([`region`]);
-//! 3. train a robust separating surface per patch ([`crate::classify`]);
-//! 4. per-point probabilities by Eq. 3, aggregated into `P` and a state
-//!    ([`crate::probability`]).
+//! 0. the samples: each cloud's surface elements ([`crate::element`], the
+//!    default model) or its points (the paper's), see [`QueryModel`];
+//! 1. the near set: traverse the two hierarchies under the relative pose,
+//!    pruning node pairs whose crossing bound is below `prune_epsilon`
+//!    ([`crate::bvh`]), and keep the samples within the noise's reach of the
+//!    other cloud, with context around them (`near.rs`);
+//! 2. merge them into connected near regions, and split large regions into
+//!    patches along the contact ([`region`]);
+//! 3. train a robust separating surface per patch ([`crate::classify`]), and
+//!    estimate the contact point, normal and separation (`contact.rs`);
+//! 4. probabilities: per sample and per point by Eq. 3, and the pair's `P`
+//!    from them ([`crate::probability`]), with a state.
 
 #[allow(clippy::module_inception)]
 mod collide;
 mod collide_many;
 mod collide_mesh_cloud;
+mod contact;
+mod near;
 pub mod region;
 mod request;
 mod result;
@@ -21,5 +28,5 @@ pub use collide_many::collide_many;
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
 };
-pub use request::{CollisionRequest, CollisionRequestBuilder};
+pub use request::{CollisionRequest, CollisionRequestBuilder, QueryModel};
 pub use result::{CollisionResult, ContactRegion, QueryStats};

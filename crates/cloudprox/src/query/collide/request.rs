@@ -5,10 +5,50 @@ use crate::error::{Error, Result};
 use crate::probability::{Aggregation, Thresholds};
 use crate::Real;
 
+/// What a query classifies and aggregates: the points themselves (the paper's
+/// method) or the surface elements they sample ([`crate::element`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum QueryModel {
+    /// Surface elements: each cloud's points grouped, once per cloud, into
+    /// pieces of surface that fit a plane within their noise; the classifier
+    /// trains on the elements' samples (their means and extents, with the
+    /// covariance of the fitted plane), so a near region holds tens of samples
+    /// at any noise level, and `P` is the probability that the sampled surfaces
+    /// cross ([`crate::probability::pair_crossing_probabilities`]). Per-point
+    /// probabilities (Eq. 3 with each point's own covariance against the trained
+    /// surface) are still reported.
+    Elements,
+    /// Every point is a sample of the classifier and a candidate for `P` (the
+    /// paper's method, with the aggregations [`Aggregation`]).
+    #[default]
+    Points,
+}
+
+impl QueryModel {
+    /// Parses `"elements"` or `"points"`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "elements" => Some(QueryModel::Elements),
+            "points" => Some(QueryModel::Points),
+            _ => None,
+        }
+    }
+
+    /// The lowercase name, as [`QueryModel::from_name`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            QueryModel::Elements => "elements",
+            QueryModel::Points => "points",
+        }
+    }
+}
+
 /// Options of [`crate::query::collide`]. Build with [`CollisionRequestBuilder`] or
 /// take [`CollisionRequest::default`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CollisionRequest {
+    /// What is classified: surface elements or points (see [`QueryModel`]).
+    pub model: QueryModel,
     /// How separating surfaces are trained.
     pub classify: ClassifySettings,
     /// How per-point probabilities become `P` (default [`Aggregation::Max`]).
@@ -35,11 +75,18 @@ pub struct CollisionRequest {
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
     /// patches). The brute-force reference.
     pub use_hierarchy: bool,
+    /// Return as soon as the state is decided (default `false`): no per-point
+    /// probabilities, no separation estimates, and with the `max` aggregation the
+    /// query stops at the first patch whose probability reaches the collision
+    /// threshold. The state (and, when no patch is skipped, `P`) is that of the
+    /// full query.
+    pub decide_only: bool,
 }
 
 impl Default for CollisionRequest {
     fn default() -> Self {
         Self {
+            model: QueryModel::default(),
             classify: ClassifySettings::default(),
             aggregation: Aggregation::Max,
             thresholds: Thresholds::default(),
@@ -47,6 +94,7 @@ impl Default for CollisionRequest {
             near_context: 2.0,
             region_max_points: 2000,
             use_hierarchy: true,
+            decide_only: false,
         }
     }
 }
@@ -73,6 +121,11 @@ impl CollisionRequest {
                 self.near_context
             )));
         }
+        if self.model == QueryModel::Elements && self.aggregation == Aggregation::Surface {
+            return Err(Error::invalid(
+                "aggregation 'surface' belongs to model 'points' (the elements model aggregates surface crossings already)",
+            ));
+        }
         if self.region_max_points < 8 {
             return Err(Error::invalid(format!(
                 "region_max_points must be >= 8, got {}",
@@ -90,6 +143,16 @@ pub struct CollisionRequestBuilder {
 }
 
 impl CollisionRequestBuilder {
+    /// What is classified: surface elements or points.
+    pub fn model(mut self, model: QueryModel) -> Self {
+        self.inner.model = model;
+        self
+    }
+    /// Whether to return as soon as the state is decided.
+    pub fn decide_only(mut self, yes: bool) -> Self {
+        self.inner.decide_only = yes;
+        self
+    }
     /// Classifier settings.
     pub fn classify(mut self, settings: ClassifySettings) -> Self {
         self.inner.classify = settings;

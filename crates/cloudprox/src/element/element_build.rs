@@ -1,0 +1,119 @@
+//! Top-down construction of a cloud's surface elements.
+
+use crate::cloud::PointCloud;
+use crate::element::element_fit::{fit_element, Fit, SplitRule, MIN_PLANE_POINTS};
+use crate::element::element_merge::merge_neighbours;
+use crate::element::element_samples::element_samples;
+use crate::element::{ElementSettings, SurfaceElement, SurfaceElements};
+use crate::error::Result;
+use crate::math::Vector3;
+
+impl SurfaceElements {
+    /// Groups `cloud`'s points into surface elements (see [`crate::element`]),
+    /// in the cloud's own frame. `O(n log n)` tests of `O(m)` each.
+    pub fn build(cloud: &PointCloud, settings: &ElementSettings) -> Result<Self> {
+        settings.validate()?;
+        let points = cloud.points();
+        let sensor = cloud.sensor_covariances();
+        let n = points.len();
+        let mut indices: Vec<u32> = (0..n as u32).collect();
+        let mut elements = Vec::new();
+        let mut stack = vec![(0usize, n)];
+        while let Some((first, count)) = stack.pop() {
+            let range = first..first + count;
+            if count >= MIN_PLANE_POINTS {
+                let fit = fit_element(
+                    points,
+                    sensor,
+                    &indices[range.clone()],
+                    first as u32,
+                    settings,
+                );
+                match fit {
+                    Fit::Element(e) => {
+                        elements.push(e);
+                        continue;
+                    }
+                    Fit::Split(rule) => {
+                        let slice = &mut indices[range];
+                        let mut k = match &rule {
+                            SplitRule::TwoSurfaces { .. } => {
+                                partition(slice, |i| rule.is_below(&points[i as usize]))
+                            }
+                            SplitRule::Median { .. } => 0,
+                        };
+                        if k == 0 || k == count {
+                            let (mean, axis) = match rule {
+                                SplitRule::Median { mean, axis } => (mean, axis),
+                                SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
+                            };
+                            let key = |i: u32| (points[i as usize] - mean).dot(&axis);
+                            k = count / 2;
+                            slice.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
+                        }
+                        stack.push((first + k, count - k));
+                        stack.push((first, k));
+                        continue;
+                    }
+                }
+            }
+            // Too few points for an element: each point stands for itself.
+            let total = cloud.covariances();
+            for j in range {
+                let i = indices[j] as usize;
+                elements.push(SurfaceElement {
+                    first: j as u32,
+                    count: 1,
+                    mean: points[i],
+                    normal: Vector3::z(),
+                    tangents: [Vector3::x(), Vector3::y()],
+                    extent: [[0.0; 2]; 2],
+                    probes: vec![[0.0; 2]],
+                    spacing: 0.0,
+                    cov_mean: total[i],
+                    height: [0.0; 3],
+                    height_cov: nalgebra::SMatrix::zeros(),
+                    common_var: 0.0,
+                });
+            }
+        }
+        // Repair what the median splits cut apart, then lay the groups out
+        // contiguously.
+        let groups: Vec<(Vec<u32>, SurfaceElement)> = elements
+            .into_iter()
+            .map(|e| {
+                let g = indices[e.first as usize..(e.first + e.count) as usize].to_vec();
+                (g, e)
+            })
+            .collect();
+        let groups = merge_neighbours(points, sensor, settings, groups);
+        let mut indices = Vec::with_capacity(n);
+        let mut elements = Vec::with_capacity(groups.len());
+        let spacing = cloud.spacing();
+        for (g, mut e) in groups {
+            e.first = indices.len() as u32;
+            e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
+            indices.extend_from_slice(&g);
+            elements.push(e);
+        }
+        let (samples, sample_owner) = element_samples(cloud, &elements, &indices);
+        Ok(SurfaceElements {
+            elements,
+            indices,
+            samples,
+            sample_owner,
+        })
+    }
+}
+
+/// Moves the entries for which `pred` holds to the front; returns their count.
+fn partition(slice: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
+    let mut k = 0;
+    for j in 0..slice.len() {
+        if pred(slice[j]) {
+            slice.swap(j, k);
+            k += 1;
+        }
+    }
+    k
+}

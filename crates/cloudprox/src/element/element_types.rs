@@ -1,0 +1,191 @@
+//! The types of the surface-element stage.
+
+use crate::cloud::PointCloud;
+use crate::error::{Error, Result};
+use nalgebra::{SMatrix, SVector};
+
+use crate::math::{Matrix3, Point3, Vector3};
+use crate::Real;
+
+/// How a cloud's points are grouped into surface elements.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementSettings {
+    /// Significance level of the residual and curvature tests (default 0.01): the
+    /// probability of splitting a group that does sample one flat surface with
+    /// the stated noise.
+    pub significance: Real,
+    /// The fewest points of an element (default 10; at least 7, the quadric fit
+    /// needs 6).
+    pub min_points: usize,
+    /// Correlation `rho` in `[0, 1]` of the sensor noise between the points of an
+    /// element (default 0, independent). The mean of `m` points then has the
+    /// covariance `(1 - rho) sum(Sigma_i) / m^2 + rho sum(Sigma_i) / m`: with
+    /// `rho = 1` averaging gains nothing (a depth camera's calibration error moves
+    /// a whole patch together).
+    pub noise_correlation: Real,
+}
+
+impl Default for ElementSettings {
+    fn default() -> Self {
+        Self {
+            significance: 0.01,
+            min_points: 10,
+            noise_correlation: 0.0,
+        }
+    }
+}
+
+impl ElementSettings {
+    /// Checks every field's domain.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.significance > 0.0 && self.significance < 0.5) {
+            return Err(Error::invalid(format!(
+                "element significance must be in (0, 0.5), got {}",
+                self.significance
+            )));
+        }
+        if self.min_points < 7 {
+            return Err(Error::invalid(format!(
+                "element min_points must be >= 7, got {}",
+                self.min_points
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.noise_correlation) {
+            return Err(Error::invalid(format!(
+                "noise_correlation must be in [0, 1], got {}",
+                self.noise_correlation
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A group of points that samples one smooth piece of surface within their
+/// noise, or a single point. In the cloud's own frame.
+///
+/// The surface is a plane over the points' principal plane: a point at
+/// tangential coordinates `(u, v)` from the mean lies at height
+/// `h(u, v) = height . (1, u, v)` along the normal, fitted by weighted least
+/// squares (elements are accepted only where curvature is not significant);
+/// the variance of the fitted height there is `x^T height_cov x + common_var`
+/// with `x = (1, u, v)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceElement {
+    /// Index of the element's first point in [`SurfaceElements::indices`].
+    pub first: u32,
+    /// Number of points.
+    pub count: u32,
+    /// The points' mean.
+    pub mean: Point3,
+    /// Unit normal of the points' principal plane (its sign is arbitrary).
+    pub normal: Vector3,
+    /// Unit tangents, the largest spread first.
+    pub tangents: [Vector3; 2],
+    /// The surface's range along each tangent, `[min, max]` from the mean:
+    /// `-+sqrt(3 (var - s^2))` with `var` the points' variance along the
+    /// tangent and `s^2` their noise's (a uniformly sampled strip of half width
+    /// `e`, each sample standing for its cell, has variance `e^2 / 3`).
+    pub extent: [[Real; 2]; 2],
+    /// Tangential coordinates where the fitted surface is probed in a query: up
+    /// to 25 of the points' own (the extremes along each tangent and a stride
+    /// over the rest), inside `extent`.
+    pub probes: Vec<[Real; 2]>,
+    /// The points' mean sampling spacing (distance to the 6th nearest
+    /// neighbour, see [`PointCloud::spacing`]).
+    pub spacing: Real,
+    /// Covariance of the mean (metres squared): `sum(Sigma_i) / m^2` for
+    /// independent noise.
+    pub cov_mean: Matrix3,
+    /// Coefficients of the fitted plane's height.
+    pub height: [Real; 3],
+    /// Covariance of `height` (the share of independent noise).
+    pub height_cov: SMatrix<Real, 3, 3>,
+    /// Variance added to every fitted height by noise correlated between the
+    /// points (see [`ElementSettings::noise_correlation`]).
+    pub common_var: Real,
+}
+
+impl SurfaceElement {
+    /// Whether the element is a single point kept as it is.
+    pub fn is_point(&self) -> bool {
+        self.count == 1
+    }
+
+    /// Standard deviation of the mean along the normal.
+    pub fn normal_std(&self) -> Real {
+        crate::uncertainty::directional_std_of(&self.cov_mean, &self.normal)
+    }
+
+    /// The point of the fitted surface over tangential coordinates `(u, v)`
+    /// and the variance of its height along the normal.
+    pub fn surface_point(&self, u: Real, v: Real) -> (Point3, Real) {
+        let x = SVector::<Real, 3>::new(1.0, u, v);
+        let h = x.dot(&SVector::<Real, 3>::from(self.height));
+        let var = x.dot(&(self.height_cov * x)) + self.common_var;
+        (
+            self.mean + self.tangents[0] * u + self.tangents[1] * v + self.normal * h,
+            var.max(0.0),
+        )
+    }
+
+    /// The covariance of a point of the fitted surface whose height variance is
+    /// `var`: `var` along the normal, the mean's covariance across it.
+    pub fn surface_covariance(&self, var: Real) -> Matrix3 {
+        let nn = self.normal * self.normal.transpose();
+        let across = Matrix3::identity() - nn;
+        across * self.cov_mean * across + nn * var
+    }
+
+    /// The tangential coordinates of the five samples that stand for the element
+    /// in a classifier: over the mean, and at the ends of its range along each
+    /// tangent.
+    pub fn sample_coordinates(&self) -> [(Real, Real); 5] {
+        let [[u0, u1], [v0, v1]] = self.extent;
+        [(0.0, 0.0), (u1, 0.0), (u0, 0.0), (0.0, v1), (0.0, v0)]
+    }
+}
+
+/// A cloud's surface elements and the samples that stand for them in queries.
+#[derive(Debug, Clone)]
+pub struct SurfaceElements {
+    pub(crate) elements: Vec<SurfaceElement>,
+    pub(crate) indices: Vec<u32>,
+    pub(crate) samples: PointCloud,
+    pub(crate) sample_owner: Vec<u32>,
+}
+
+impl SurfaceElements {
+    /// The elements.
+    pub fn elements(&self) -> &[SurfaceElement] {
+        &self.elements
+    }
+
+    /// The permutation of point indices that the elements' `first`/`count` refer to.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// The point indices of element `e`.
+    pub fn element_points(&self, e: u32) -> &[u32] {
+        let el = &self.elements[e as usize];
+        &self.indices[el.first as usize..(el.first + el.count) as usize]
+    }
+
+    /// The cloud of samples standing for the elements (five per multi-point
+    /// element: its mean and the four edges of its extent on the fitted plane,
+    /// each with the covariance of the plane's height there; the point itself for
+    /// a single-point element, with its own covariances).
+    pub fn samples(&self) -> &PointCloud {
+        &self.samples
+    }
+
+    /// The element each sample stands for.
+    pub fn sample_owner(&self) -> &[u32] {
+        &self.sample_owner
+    }
+
+    /// Number of elements of more than one point.
+    pub fn multi_point_count(&self) -> usize {
+        self.elements.iter().filter(|e| !e.is_point()).count()
+    }
+}

@@ -1,0 +1,56 @@
+//! Surface elements: the surfaces a cloud's points sample, at the resolution the
+//! data supports.
+//!
+//! `n` independent noisy samples of a flat patch locate it along its normal with
+//! standard deviation `sigma / sqrt(n)`, not `sigma`. A cloud's points are
+//! therefore grouped, once per cloud and in its own frame, into *surface
+//! elements*: groups that fit a plane within their own noise. The groups come from
+//! a top-down split (at the median along the largest principal axis, or between
+//! two surfaces where the points along the normal fall into two groups further
+//! apart than the noise, as the two faces of a thin plate do); a group is an
+//! element as soon as two statistical tests at the significance level
+//! [`ElementSettings::significance`] accept it:
+//!
+//! 1. **Residual test.** A quadric height field `h(u, v)` over the group's
+//!    principal plane is fitted by weighted least squares, each point weighted by
+//!    its sensor variance along the normal. The weighted residual sum follows a
+//!    chi-square law with `m - 6` degrees of freedom when the points sample one
+//!    smooth surface with the stated noise; two faces, an edge, a corner or an
+//!    outlier make it too large.
+//! 2. **Curvature test.** The quadric's three curvature coefficients, against
+//!    their covariance from the fit (a Wald statistic, chi-square with 3 degrees
+//!    of freedom): where curvature is significant the group is larger than the
+//!    surface's curvature scale at this noise, and is split. So elements are
+//!    large where the surface is flat or the noise is high, and shrink with
+//!    curvature and with falling noise; no threshold is tuned to a scene.
+//!
+//! An accepted element keeps its mean, normal and tangents, its extent, and the
+//! covariance of its mean (`sum(Sigma_i) / m^2` for independent noise;
+//! [`ElementSettings::noise_correlation`] for sensors whose noise is correlated
+//! between neighbouring points) and of its plane's slopes. Groups of fewer than
+//! [`ElementSettings::min_points`] points are too small to test curvature and
+//! get the plane's residual test alone (chi-square with `m - 3` degrees of
+//! freedom); groups of fewer than 4 points that still fail keep their points as
+//! they are (single-point elements): at sharp edges, corners and outliers the
+//! query falls back to the points.
+//!
+//! The median splits cut flat faces apart wherever an edge or a second face
+//! shared a group higher up; a bottom-up pass then merges neighbouring elements
+//! (and single points) whose union still passes both tests.
+//!
+//! An element keeps its fitted plane (weighted least squares over its
+//! principal plane: curvature was not significant) and the covariance of the
+//! fit, so any point of its surface comes with the variance of its height, the
+//! slopes' uncertainty included
+//! ([`SurfaceElement::surface_point`]). In a query it is represented by five
+//! samples of that surface ([`SurfaceElements::samples`]): over its mean and at
+//! the ends of its points' range along each tangent.
+
+mod element_build;
+mod element_fit;
+mod element_merge;
+mod element_samples;
+mod element_types;
+
+pub use element_fit::chi_square_quantile;
+pub use element_types::{ElementSettings, SurfaceElement, SurfaceElements};

@@ -1,0 +1,162 @@
+//! Contact regions: a patch's trained surface, per-sample margins and
+//! probabilities, and the contact point, normal and separation estimate.
+
+use crate::classify::{train, Classification};
+use crate::error::Result;
+use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
+use crate::probability::point_probability;
+use crate::query::collide::CollisionRequest;
+use crate::Real;
+
+/// A classified patch, in the frame its points were given in.
+pub(crate) struct PatchFit {
+    pub classification: Classification,
+    /// Per-point probabilities (Eq. 3), A's points first.
+    pub probabilities: Vec<Real>,
+    /// A point on the surface where the two sides come closest.
+    pub point: Point3,
+    /// The surface's unit normal there, from A towards B.
+    pub normal: Vector3,
+    /// The separation estimate (see [`crate::query::ContactRegion::separation`]);
+    /// not computed (NaN) when `contact` is false.
+    pub separation: Real,
+}
+
+/// Trains the surface for `pts` (the first `na` from A) and derives the per-point
+/// probabilities (Eq. 3), the contact point, normal and separation estimate.
+pub(crate) fn fit_patch(
+    pts: &[Point3],
+    covs: &[Matrix3],
+    na: usize,
+    axis: &Vector3,
+    spacing: Real,
+    sigma: Real,
+    request: &CollisionRequest,
+    contact: bool,
+) -> Result<PatchFit> {
+    let labels: Vec<Real> = (0..pts.len())
+        .map(|i| if i < na { 1.0 } else { -1.0 })
+        .collect();
+    let classification = train(pts, covs, &labels, &request.classify)?;
+    let sep = &classification.separator;
+    let mut probabilities = Vec::with_capacity(pts.len());
+    let mut margins = Vec::with_capacity(pts.len());
+    for ((x, cov), &c) in pts.iter().zip(covs).zip(&labels) {
+        let (f, g) = sep.value_and_gradient_local(x);
+        probabilities.push(point_probability(f, &g, cov, c));
+        let gn = g.norm();
+        margins.push(if gn > 0.0 { c * f / gn } else { c * f });
+    }
+    // The contact point: between the point of each side closest to (or deepest
+    // across) the surface, projected onto it.
+    let deepest = |range: std::ops::Range<usize>| -> Point3 {
+        let k = range
+            .clone()
+            .min_by(|&i, &j| margins[i].total_cmp(&margins[j]))
+            .unwrap_or(range.start);
+        pts[k]
+    };
+    let mid = nalgebra::center(&deepest(0..na), &deepest(na..pts.len()));
+    let point = sep.project(&mid);
+    let (_, g) = sep.value_and_gradient_local(&point);
+    let normal = if g.norm() > 0.0 {
+        -g.normalize()
+    } else {
+        (mean(&pts[na..]) - mean(&pts[..na])).normalize()
+    };
+    if !contact {
+        return Ok(PatchFit {
+            classification,
+            probabilities,
+            point,
+            normal,
+            separation: Real::NAN,
+        });
+    }
+    // The separation is measured along the near region's axis (unlike the trained
+    // surface's normal, it stays meaningful when the clouds interpenetrate and the
+    // surface cannot separate them), on lines through up to 64 of the patch's
+    // points; the smallest is where the surfaces come closest or cross deepest.
+    // Only points within two sampling spacings (the patch's median) of a line
+    // count for it, and a line needs 3 of each side.
+    let radius = 2.0 * spacing;
+    // Along a line, one cloud may show several surfaces (both faces of a thin
+    // plate): offsets further apart than this belong to different surfaces.
+    let split = (4.0 * sigma).max(0.5 * spacing);
+    let stride = pts.len().div_ceil(64).max(1);
+    let separation = pts
+        .iter()
+        .step_by(stride)
+        .filter_map(|x| {
+            let sb = axial_offset(&pts[na..], x, axis, radius, -1.0, split)?;
+            let sa = axial_offset(&pts[..na], x, axis, radius, 1.0, split)?;
+            Some(sb - sa)
+        })
+        .reduce(Real::min)
+        .unwrap_or_else(|| {
+            let inf = Real::INFINITY;
+            axial_offset(&pts[na..], &mid, axis, inf, -1.0, split).unwrap_or(0.0)
+                - axial_offset(&pts[..na], &mid, axis, inf, 1.0, split).unwrap_or(0.0)
+        });
+    Ok(PatchFit {
+        classification,
+        probabilities,
+        point,
+        normal,
+        separation,
+    })
+}
+
+/// Unit eigenvector of the smallest eigenvalue of the points' scatter, oriented
+/// along `towards`.
+pub(crate) fn least_spread_axis(pts: &[Point3], towards: &Vector3) -> Vector3 {
+    let axis = PrincipalAxes::of(pts.iter().copied()).least();
+    if axis.dot(towards) < 0.0 {
+        -axis
+    } else {
+        axis
+    }
+}
+
+pub(crate) fn mean(p: &[Point3]) -> Vector3 {
+    p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
+}
+
+/// Where one side's surface crosses the line through `point` along `axis`: among
+/// the side's 12 points nearest that line (within `radius` of it), sorted by
+/// their offset along `axis` starting from the end that faces the other cloud
+/// (`facing = +1`: the largest offsets first), the median of the leading run of
+/// offsets less than `split` apart, i.e. of the surface nearest the other cloud;
+/// `None` with fewer than 3 points near the line or 2 in that run. Medians keep
+/// the estimate unbiased by the noise on a flat contact.
+fn axial_offset(
+    pts: &[Point3],
+    point: &Point3,
+    axis: &Vector3,
+    radius: Real,
+    facing: Real,
+    split: Real,
+) -> Option<Real> {
+    let r2 = radius * radius;
+    let mut by_lateral: Vec<(Real, Real)> = pts
+        .iter()
+        .filter_map(|x| {
+            let d = x - point;
+            let along = d.dot(axis);
+            let lat = (d - axis * along).norm_squared();
+            (lat <= r2).then_some((lat, along))
+        })
+        .collect();
+    if by_lateral.len() < 3 {
+        return None;
+    }
+    let k = 12.min(by_lateral.len());
+    by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
+    along.sort_by(|a, b| b.total_cmp(a));
+    let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
+    if run < 2 {
+        return None;
+    }
+    Some(facing * along[run / 2])
+}

@@ -1,0 +1,250 @@
+//! The surface-element model of the collide query: calibration on plates,
+//! invariances, the hierarchy against brute force, decide-only, per-point
+//! probabilities.
+
+mod common;
+
+use cloudprox::prelude::*;
+use cloudprox::probability::{normal_cdf, point_probability};
+use cloudprox::sample::{add_noise, NormalRng};
+use common::{sphere_pose, spheres, SIGMA};
+
+fn elements() -> CollisionRequest {
+    CollisionRequest::builder()
+        .model(QueryModel::Elements)
+        .build()
+        .unwrap()
+}
+
+/// A slab: two noisy square faces of `k x k` points at spacing `h`, the face
+/// that meets the other slab at z = `a x + b y` and its far face at z = `back`
+/// (which says on which side the slab's body is).
+fn slab(k: usize, h: f64, tilt: (f64, f64), back: f64, sigma: f64, seed: u64) -> PointCloud {
+    let c = (k - 1) as f64 * h / 2.0;
+    let grid = move |i: usize, j: usize| (i as f64 * h - c, j as f64 * h - c);
+    let pts: Vec<Point3> = (0..k * k)
+        .map(|n| {
+            let (x, y) = grid(n / k, n % k);
+            Point3::new(x, y, tilt.0 * x + tilt.1 * y)
+        })
+        .chain((0..k * k).map(|n| {
+            let (x, y) = grid(n / k, n % k);
+            Point3::new(x, y, back)
+        }))
+        .collect();
+    PointCloud::from_sigma(add_noise(&pts, sigma, seed), sigma).unwrap()
+}
+
+/// Two slabs, B above A, whose facing faces are planes at an uncertain gap and
+/// relative tilt: the gap at the centre drawn uniformly in +-4 standard errors of
+/// its fit, the tilts from the spread of their fits. Collision is the truth
+/// when the faces cross anywhere over the square (a corner is below 0). Among
+/// the draws whose `P` falls in a bin, the share that truly collides matches the
+/// bin's mean `P`: `P` is the probability of the fitted surfaces crossing given
+/// the data.
+#[test]
+fn parallel_plates_probability_is_calibrated() {
+    let (k, h, sigma) = (12, 0.005, 0.001);
+    let c = (k - 1) as f64 * h / 2.0;
+    // Standard errors of the fitted facing faces' gap at the centre and of
+    // their relative slope.
+    let n = (k * k) as f64;
+    let se = sigma * (2.0 / n).sqrt();
+    let sum_u2 = n * h * h * ((k * k - 1) as f64) / 12.0;
+    let slope_se = sigma * (2.0 / sum_u2).sqrt();
+    let req = elements();
+    let mut rng = NormalRng::new(7);
+    let mut bins = [(0.0, 0.0, 0usize); 5];
+    let mut decided_wrong = 0;
+    let draws = 400;
+    for draw in 0..draws {
+        let gap = (rng.uniform() * 2.0 - 1.0) * 4.0 * se;
+        let tilt = (rng.normal() * slope_se, rng.normal() * slope_se);
+        let truth = [(-c, -c), (-c, c), (c, -c), (c, c)]
+            .iter()
+            .any(|&(x, y)| gap + tilt.0 * x + tilt.1 * y < 0.0);
+        let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1000 + draw);
+        let b = slab(k, h, tilt, 0.02, sigma, 5000 + draw);
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &Pose::translation(0.0, 0.0, gap),
+            &b,
+            &req,
+        )
+        .unwrap();
+        let p = r.probability;
+        let bin = ((p * 5.0) as usize).min(4);
+        bins[bin].0 += p;
+        bins[bin].1 += f64::from(u8::from(truth));
+        bins[bin].2 += 1;
+        if (r.state == CollisionState::Collision && !truth)
+            || (r.state == CollisionState::Free && truth)
+        {
+            decided_wrong += 1;
+        }
+    }
+    eprintln!("bins {bins:?} wrong {decided_wrong}");
+    for (i, &(sum_p, hits, count)) in bins.iter().enumerate() {
+        if count < 20 {
+            continue;
+        }
+        let (predicted, observed) = (sum_p / count as f64, hits / count as f64);
+        assert!(
+            (predicted - observed).abs() < 0.15,
+            "bin {i}: mean P {predicted:.3}, colliding share {observed:.3} of {count}"
+        );
+    }
+    // Decided states are wrong about as often as the thresholds allow.
+    assert!(
+        decided_wrong <= draws / 10,
+        "{decided_wrong} of {draws} decided wrongly"
+    );
+    // The faces are located far better than one point's noise: at +-8 standard
+    // errors of the gap (a third of sigma) the states are decided.
+    let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1);
+    let b = slab(k, h, (0.0, 0.0), 0.02, sigma, 2);
+    for (gap, state) in [
+        (8.0 * se, CollisionState::Free),
+        (-8.0 * se, CollisionState::Collision),
+    ] {
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &Pose::translation(0.0, 0.0, gap),
+            &b,
+            &req,
+        )
+        .unwrap();
+        assert_eq!(r.state, state, "gap {gap}: P = {}", r.probability);
+    }
+}
+
+#[test]
+fn spheres_are_decided_within_a_sigma_of_contact() {
+    let (a, b) = spheres(10000);
+    let req = elements();
+    let p = |k: f64| {
+        collide(&Pose::identity(), &a, &sphere_pose(k * SIGMA), &b, &req)
+            .unwrap()
+            .probability
+    };
+    let ps: Vec<f64> = [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 6.0].map(p).to_vec();
+    for w in ps.windows(2) {
+        assert!(w[1] <= w[0] + 0.05, "{ps:?}");
+    }
+    // With 10 000 points per sphere the surfaces are located to a fraction of
+    // sigma: one sigma either side of contact is decided (or nearly).
+    assert!(ps[0] > 0.999 && ps[1] > 0.99 && ps[2] > 0.9, "{ps:?}");
+    assert!(ps[5] < 0.1 && ps[6] < 0.01 && ps[7] < 1e-6, "{ps:?}");
+    // Touching counts as a collision; a sigma apart is not one.
+    assert!(ps[3] > 0.5 && ps[4] < 0.9, "{ps:?}");
+}
+
+#[test]
+fn rigid_motion_and_swapping_change_nothing() {
+    let (a, b) = spheres(3000);
+    let req = elements();
+    let t = Pose::new(Vector3::new(0.3, -0.4, 1.0), Vector3::new(1.0, 2.0, -0.5));
+    for gap in [-2.0, 0.0, 1.0, 3.0] {
+        let pb = sphere_pose(gap * SIGMA);
+        let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
+        let r1 = collide(&t, &a, &(t * pb), &b, &req).unwrap();
+        assert!((r0.probability - r1.probability).abs() < 1e-9, "gap {gap}");
+        let rs = collide(&pb, &b, &Pose::identity(), &a, &req).unwrap();
+        assert!(
+            (r0.probability - rs.probability).abs() < 1e-6,
+            "gap {gap}: {} vs swapped {}",
+            r0.probability,
+            rs.probability
+        );
+        assert_eq!(r0.state, rs.state);
+    }
+}
+
+#[test]
+fn hierarchy_agrees_with_brute_force() {
+    let (a, b) = spheres(1500);
+    let brute = CollisionRequest::builder()
+        .model(QueryModel::Elements)
+        .use_hierarchy(false)
+        .build()
+        .unwrap();
+    for gap in [-2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
+        let pb = sphere_pose(gap * SIGMA);
+        let fast = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
+        let slow = collide(&Pose::identity(), &a, &pb, &b, &brute).unwrap();
+        if fast.regions.len() <= 1 && slow.regions.len() <= 1 {
+            assert!(
+                (fast.probability - slow.probability).abs() < 1e-6,
+                "gap {gap}: {} vs {}",
+                fast.probability,
+                slow.probability
+            );
+        } else {
+            assert_eq!(fast.state, slow.state, "gap {gap}");
+        }
+    }
+}
+
+#[test]
+fn decide_only_gives_the_full_querys_state() {
+    let (a, b) = spheres(3000);
+    for model in [QueryModel::Elements, QueryModel::Points] {
+        let full = CollisionRequest::builder().model(model).build().unwrap();
+        let quick = CollisionRequest::builder()
+            .model(model)
+            .decide_only(true)
+            .build()
+            .unwrap();
+        for gap in [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 20.0] {
+            let pb = sphere_pose(gap * SIGMA);
+            let r = collide(&Pose::identity(), &a, &pb, &b, &full).unwrap();
+            let q = collide(&Pose::identity(), &a, &pb, &b, &quick).unwrap();
+            assert_eq!(r.state, q.state, "{model:?} gap {gap}");
+            assert!(q.probabilities_a.iter().all(|&p| p == 0.0));
+        }
+    }
+}
+
+#[test]
+fn per_point_probabilities_are_eq3_against_the_reported_surface() {
+    let (a, b) = spheres(3000);
+    let pb = sphere_pose(SIGMA);
+    let r = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
+    assert_eq!(r.regions.len(), 1);
+    let region = &r.regions[0];
+    assert!(!region.indices_a.is_empty() && !region.indices_b.is_empty());
+    for &i in &region.indices_a {
+        let x = a.points()[i as usize];
+        let (f, g) = region.separator.value_and_gradient(&x);
+        let p = point_probability(f, &g, &a.covariances()[i as usize], 1.0);
+        assert!((p - r.probabilities_a[i as usize]).abs() < 1e-9);
+    }
+    for &i in &region.indices_b {
+        let x = pb * b.points()[i as usize];
+        let rot = pb.rotation.to_rotation_matrix();
+        let cov = rot.matrix() * b.covariances()[i as usize] * rot.matrix().transpose();
+        let (f, g) = region.separator.value_and_gradient(&x);
+        let p = point_probability(f, &g, &cov, -1.0);
+        assert!((p - r.probabilities_b[i as usize]).abs() < 1e-9);
+    }
+    // The region holds tens of samples, not thousands of points.
+    assert!(r.stats.points_classified < 400, "{:?}", r.stats);
+    let _ = normal_cdf(0.0);
+}
+
+#[test]
+fn moved_points_give_the_elements_of_a_fresh_cloud() {
+    let (a, _) = spheres(2000);
+    let mut moved = a.clone();
+    let shifted: Vec<Point3> = a
+        .points()
+        .iter()
+        .map(|p| p + Vector3::new(0.01, 0.0, 0.0))
+        .collect();
+    let _ = moved.elements();
+    moved.set_points(shifted.clone()).unwrap();
+    let fresh = PointCloud::from_sigma(shifted, SIGMA).unwrap();
+    assert_eq!(moved.elements().elements(), fresh.elements().elements());
+}
