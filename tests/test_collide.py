@@ -273,8 +273,12 @@ def test_default_options_match_documented_defaults() -> None:
         "robust_model": "gaussian",
         "solver": "barrier",
         "use_hierarchy": True,
+        "model": cp.default_options()["model"],
+        "decide_only": False,
     }
+    assert cp.default_options()["model"] in ("elements", "points")
     names = cp.option_names()
+    assert set(names["model"]) == {"elements", "points"}
     assert names["surface"] == ("linear", "quadric")
     assert set(names["aggregation"]) == {"surface", "max", "union", "independent"}
     assert set(names["robust_model"]) == {"gaussian", "chebyshev"}
@@ -316,3 +320,40 @@ def test_surface_aggregation_sees_deep_interpenetration() -> None:
     b = cp.PointCloud(cp.add_noise(pts, 0.001, seed=2), sigma=0.001)
     assert cp.collide(a, b, pose_b=translation(0.1), aggregation="max").state == "collision"
     assert cp.collide(a, b, pose_b=translation(0.1), aggregation="surface").state == "collision"
+
+
+@pytest.mark.parametrize("model", ["elements", "points"])
+def test_decide_only_gives_the_full_state(spheres, model: str) -> None:
+    a, b = spheres
+    for gap in (-4.0, -1.0, 0.0, 1.0, 3.0, 8.0, 20.0):
+        full = cp.collide(a, b, pose_b=sphere_gap_pose(gap), model=model)
+        quick = cp.collide(a, b, pose_b=sphere_gap_pose(gap), model=model, decide_only=True)
+        assert quick.state == full.state, (model, gap, full.probability, quick.probability)
+        assert not quick.probabilities_a.any()
+
+
+def test_elements_model_classifies_tens_of_samples_and_reports_every_point(spheres) -> None:
+    a, b = spheres
+    pose_b = sphere_gap_pose(1.0)
+    el = cp.collide(a, b, pose_b=pose_b, model="elements")
+    pts = cp.collide(a, b, pose_b=pose_b, model="points")
+    assert 0 < el.stats["points_classified"] < pts.stats["points_classified"]
+    # Per-point probabilities are Eq. 3 of every point of the elements in the
+    # region, against the region's surface: the same points the region lists.
+    region = el.regions[0]
+    assert len(region.indices_a) > 0
+    assert el.probabilities_a[region.indices_a].max() > 0.0
+    outside = np.setdiff1d(np.arange(len(el.probabilities_a)), region.indices_a)
+    assert not el.probabilities_a[outside].any()
+    # Deep is collision, far is free, whatever the model.
+    deep = cp.collide(a, b, pose_b=sphere_gap_pose(-4.0), model="elements")
+    far = cp.collide(a, b, pose_b=sphere_gap_pose(10.0), model="elements")
+    assert (deep.state, far.state) == ("collision", "free")
+
+
+def test_elements_model_rejects_the_surface_aggregation(spheres) -> None:
+    a, b = spheres
+    with pytest.raises(cp.InvalidInputError, match="aggregation 'surface'"):
+        cp.collide(a, b, model="elements", aggregation="surface")
+    with pytest.raises(cp.InvalidInputError, match="unknown model 'surfels'"):
+        cp.collide(a, b, model="surfels")

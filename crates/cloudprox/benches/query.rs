@@ -1,7 +1,10 @@
 #![allow(missing_docs)]
-//! `collide` on two 10K-point noisy spheres: apart, near, interpenetrating.
+//! `collide` on two 10K-point noisy spheres: apart, near, interpenetrating;
+//! the paper's per-point model and the surface-element model, at two noise
+//! levels.
 //!
 //! `cargo bench -p cloudprox --bench query`
+//! (`-- collide_10k_elements` for the element model alone)
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -11,19 +14,22 @@ use cloudprox::prelude::*;
 #[path = "common.rs"]
 mod common;
 
-fn bench_collide(c: &mut Criterion) {
+const GAPS: [(&str, f64); 4] = [
+    ("apart_6sigma", 6.0),
+    ("apart_20sigma", 20.0),
+    ("near_1sigma", 1.0),
+    ("interpenetrating_3sigma", -3.0),
+];
+
+fn bench_points(c: &mut Criterion) {
     let (a, b) = common::spheres(10_000);
     let _ = (a.bvh(), b.bvh());
     let mut group = c.benchmark_group("collide_10k");
     group.sample_size(20);
-    for (name, gap) in [
-        ("apart_6sigma", 6.0),
-        ("apart_20sigma", 20.0),
-        ("near_1sigma", 1.0),
-        ("interpenetrating_3sigma", -3.0),
-    ] {
+    for (name, gap) in GAPS {
         for surface in [Surface::Quadric, Surface::Linear] {
             let req = CollisionRequest::builder()
+                .model(QueryModel::Points)
                 .classify(
                     ClassifySettings::builder()
                         .surface(surface)
@@ -41,5 +47,48 @@ fn bench_collide(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_collide);
+fn bench_elements(c: &mut Criterion) {
+    let mut group = c.benchmark_group("collide_10k_elements");
+    group.sample_size(20);
+    for sigma in [0.001, 0.005] {
+        let (a, b) = common::spheres_with_noise(10_000, sigma);
+        // Built once per cloud (not part of a query).
+        let _ = (a.elements().samples().bvh(), b.elements().samples().bvh());
+        for decide_only in [false, true] {
+            let req = CollisionRequest::builder()
+                .model(QueryModel::Elements)
+                .decide_only(decide_only)
+                .build()
+                .unwrap();
+            for (name, gap) in GAPS {
+                let pose = common::pose_at_noise(gap, sigma);
+                let tag = if decide_only { "/decide_only" } else { "" };
+                group.bench_function(format!("sigma_{}mm/{name}{tag}", sigma * 1e3), |bch| {
+                    bch.iter(|| {
+                        black_box(collide(&Pose::identity(), &a, &pose, &b, &req).unwrap())
+                    });
+                });
+            }
+        }
+    }
+    group.finish();
+}
+
+fn bench_element_build(c: &mut Criterion) {
+    let mut group = c.benchmark_group("elements_build_10k");
+    group.sample_size(10);
+    for sigma in [0.001, 0.005] {
+        let (a, _) = common::spheres_with_noise(10_000, sigma);
+        let _ = a.spacing();
+        let settings = cloudprox::element::ElementSettings::default();
+        group.bench_function(format!("sigma_{}mm", sigma * 1e3), |bch| {
+            bch.iter(|| {
+                black_box(cloudprox::element::SurfaceElements::build(&a, &settings).unwrap())
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_points, bench_elements, bench_element_build);
 criterion_main!(benches);

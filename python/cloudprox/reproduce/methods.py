@@ -53,13 +53,13 @@ __all__ = [
     "Draw",
     "MethodAnswer",
     "cloudprox_answer",
-    "variant_name",
     "collision_map_answer",
     "nn_gap_answer",
     "reconstruct_answer",
     "sampling_spacing",
     "sphere_union_answer",
     "states_from",
+    "variant_name",
 ]
 
 FloatArray = npt.NDArray[np.float64]

@@ -13,7 +13,7 @@ pub enum Surface {
     /// `phi(x) = (x, y, z, x^2, y^2, z^2, sqrt2 xy, sqrt2 xz, sqrt2 yz)`. The `sqrt2`
     /// makes `|w|^2 = |g|^2 + |Q|_F^2`, so the regularizer (and the solution) is
     /// invariant under rotations. Follows curved and wrapped contacts that one
-    /// plane per region cannot (DESIGN.md section 4); the default.
+    /// plane per region cannot (see `docs/architecture.md`); the default.
     #[default]
     Quadric,
 }

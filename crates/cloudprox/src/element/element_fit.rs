@@ -108,7 +108,9 @@ pub(crate) fn fit_element(
             return median();
         }
         return match weighted_fit(&local, plane_row) {
-            Some(f) if f.residual <= chi_square_quantile(m - 3, confidence) => {
+            Some(f)
+                if f.residual <= chi_square_quantile(m - 3, confidence) && spans_a_plane(&f) =>
+            {
                 Fit::Element(element(&pa, idx, sensor, &local, first, settings, &f))
             }
             _ => median(),
@@ -151,8 +153,10 @@ pub(crate) fn fit_element(
     // Curvature too small to detect: the element's surface is the plane (the
     // quadric's extra coefficients would only add their noise).
     match weighted_fit(&local, plane_row) {
-        Some(p) => Fit::Element(element(&pa, idx, sensor, &local, first, settings, &p)),
-        None => median(),
+        Some(p) if spans_a_plane(&p) => {
+            Fit::Element(element(&pa, idx, sensor, &local, first, settings, &p))
+        }
+        _ => median(),
     }
 }
 
@@ -196,6 +200,16 @@ fn weighted_fit<const D: usize>(
         cov: chol.inverse(),
         residual,
     })
+}
+
+/// The largest standard deviation of a fitted plane's slope: beyond it the
+/// points lie along a line (a strip one sample wide), around which any plane
+/// fits, and the plane's normal says nothing.
+const MAX_SLOPE_SD: Real = 0.5;
+
+/// Whether a fitted plane's slopes are determined (see [`MAX_SLOPE_SD`]).
+fn spans_a_plane(fit: &HeightFit<3>) -> bool {
+    fit.cov[(1, 1)].sqrt() <= MAX_SLOPE_SD && fit.cov[(2, 2)].sqrt() <= MAX_SLOPE_SD
 }
 
 fn plane_row(u: Real, v: Real) -> SVector<Real, 3> {

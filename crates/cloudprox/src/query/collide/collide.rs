@@ -9,8 +9,8 @@ use crate::element::SurfaceElements;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{
-    crossing_probabilities, element_crossing_probabilities, normal_quantile, point_probability,
-    surface_probability, Aggregation, ElementSide,
+    crossing_probabilities, element_crossing_probabilities, elements_within_reach, normal_quantile,
+    point_probability, surface_probability, Aggregation, ElementSide,
 };
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::near::near_set;
@@ -122,6 +122,15 @@ pub(crate) fn collide_with_workspace(
             covs.extend(covsb);
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
+            // Decide-only: where no element of either side faces the other
+            // within the noise's reach, the surfaces cannot cross, and no
+            // separating surface is needed to say so.
+            if let (true, Some((ea, eb))) = (request.decide_only, elements) {
+                let reach = -normal_quantile(0.5 * request.prune_epsilon);
+                if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
+                    continue;
+                }
+            }
             let spacing = patch_median(&ia, sa.spacing(), &ib, sb.spacing());
             let sigma = patch_median(&ia, sa.sigma_max(), &ib, sb.sigma_max());
             let fit = fit_patch(
@@ -266,26 +275,21 @@ pub(crate) fn collide_with_workspace(
 /// element it stands for crosses the other side's
 /// ([`element_crossing_probabilities`]).
 #[allow(clippy::too_many_arguments)]
-fn element_crossings<'a>(
-    ea: &'a SurfaceElements,
+fn element_crossings(
+    ea: &SurfaceElements,
     ia: &[u32],
     pose_a: &Pose,
-    eb: &'a SurfaceElements,
+    eb: &SurfaceElements,
     ib: &[u32],
     pose_b: &Pose,
     sep: &Separator,
     reach_sds: Real,
 ) -> (Vec<Real>, Vec<Real>) {
     let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
-    let side = |els: &'a SurfaceElements, unique: &[u32], pose: &Pose, label: Real| ElementSide {
-        elements: unique
-            .iter()
-            .map(|&e| &els.elements()[e as usize])
-            .collect(),
-        pose: *pose,
-        label,
-    };
-    let (sa, sb) = (side(ea, &ua, pose_a, 1.0), side(eb, &ub, pose_b, -1.0));
+    let (sa, sb) = (
+        element_side(ea, &ua, pose_a, 1.0),
+        element_side(eb, &ub, pose_b, -1.0),
+    );
     let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
     let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
     let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
@@ -299,6 +303,39 @@ fn element_crossings<'a>(
             .collect::<Vec<Real>>()
     };
     (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
+}
+
+/// Whether the elements of a patch's samples (`ia` of `ea` at `pose_a` in B's
+/// frame, `ib` of `eb`) face each other within `reach_sds` noise standard
+/// deviations ([`elements_within_reach`]).
+fn element_sides_within_reach(
+    ea: &SurfaceElements,
+    ia: &[u32],
+    pose_a: &Pose,
+    eb: &SurfaceElements,
+    ib: &[u32],
+    reach_sds: Real,
+) -> bool {
+    let sa = element_side(ea, &unique_owners(ea, ia), pose_a, 1.0);
+    let sb = element_side(eb, &unique_owners(eb, ib), &Pose::identity(), -1.0);
+    elements_within_reach(&sa, &sb, reach_sds)
+}
+
+/// The elements `unique` of `els` as one side of a patch.
+fn element_side<'a>(
+    els: &'a SurfaceElements,
+    unique: &[u32],
+    pose: &Pose,
+    label: Real,
+) -> ElementSide<'a> {
+    ElementSide {
+        elements: unique
+            .iter()
+            .map(|&e| &els.elements()[e as usize])
+            .collect(),
+        pose: *pose,
+        label,
+    }
 }
 
 /// The elements (sorted, each once) that the samples `samples` stand for.
