@@ -2,7 +2,7 @@
 
 use crate::bvh::{Aabb, Bvh, BvhNode, BvhSettings};
 use crate::error::{Error, Result};
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::math::{Point3, PrincipalAxes, Vector3};
 use crate::Real;
 
 impl Bvh {
@@ -83,23 +83,5 @@ impl Bvh {
 
 /// Unit eigenvector of the largest eigenvalue of the points' scatter matrix.
 fn principal_axis(points: &[Point3], idx: &[u32]) -> Vector3 {
-    let n = idx.len() as Real;
-    let mean = idx
-        .iter()
-        .map(|&i| points[i as usize].coords)
-        .sum::<Vector3>()
-        / n;
-    let mut scatter = Matrix3::zeros();
-    for &i in idx {
-        let d = points[i as usize].coords - mean;
-        scatter += d * d.transpose();
-    }
-    let eig = scatter.symmetric_eigen();
-    let k = eig.eigenvalues.imax();
-    let axis = eig.eigenvectors.column(k).into_owned();
-    if axis.iter().all(|c| c.is_finite()) && axis.norm() > 0.5 {
-        axis
-    } else {
-        Vector3::x()
-    }
+    PrincipalAxes::of(idx.iter().map(|&i| points[i as usize])).largest()
 }

@@ -11,6 +11,12 @@
 //!
 //! The `impl Bvh` blocks are split by concern: build, refit, pair traversal,
 //! k-nearest neighbours, validation.
+//!
+//! Spatial search has its home here: besides the tree, a hashed uniform grid
+//! (`grid_knn.rs`) answers exact k-nearest-neighbour queries for every point of
+//! a large cloud at once, much cheaper to build on millions of points than a
+//! tree; the filters and the sampling spacing of large clouds use it
+//! ([`knn_map`]).
 
 mod aabb;
 mod bvh_build;
@@ -19,6 +25,7 @@ mod bvh_refit;
 mod bvh_traverse_bvtt;
 mod bvh_tree;
 mod bvh_validation;
+mod grid_knn;
 
 #[cfg(test)]
 mod bvh_tests;
@@ -26,3 +33,17 @@ mod bvh_tests;
 pub use aabb::Aabb;
 pub use bvh_traverse_bvtt::{prune_bound, PairTraversal};
 pub use bvh_tree::{Bvh, BvhNode, BvhSettings, BvhWorkspace};
+
+pub(crate) use grid_knn::for_each_knn;
+
+/// For every point of a non-empty, finite cloud (fewer than 2^32 points),
+/// `f(i, neighbours)` with its `k` nearest *other* points as `(squared
+/// distance, index)` in no particular order; in parallel, results in point
+/// order: the exact k-NN of the hashed grid.
+pub(crate) fn knn_map<T, F>(points: &[crate::math::Point3], k: usize, f: F) -> Vec<T>
+where
+    T: Send,
+    F: Fn(usize, &[(f64, u32)]) -> T + Sync,
+{
+    for_each_knn(points, k, f)
+}

@@ -301,10 +301,10 @@ impl PointCloud {
             let bvh = self.bvh();
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
             let per_point: Vec<Real> = if self.points.len() > GRID_KNN_MIN_POINTS {
-                // The hashed grid of the filters: exact, and much cheaper than the
+                // The hashed grid of the spatial search (also the filters'): exact, and much cheaper than the
                 // tree on large clouds (the distance to the k-th neighbour does
                 // not depend on how ties are broken).
-                crate::filter::knn_map(&self.points, k, |_, nb| {
+                crate::bvh::knn_map(&self.points, k, |_, nb| {
                     nb.iter().fold(0.0, |m: Real, &(d2, _)| m.max(d2)).sqrt()
                 })
             } else {

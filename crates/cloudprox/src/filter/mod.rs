@@ -14,8 +14,8 @@
 //! and returns them in a [`Voxelized`].
 //!
 //! Every filter runs in parallel over points (rayon). The neighbour searches of
-//! [`statistical_outlier_removal`] and of the unorganized [`shadow_filter`] use a
-//! private hashed uniform grid (cell size calibrated to the cloud's occupancy),
+//! [`statistical_outlier_removal`] and of the unorganized [`shadow_filter`] use the
+//! hashed uniform grid of [`crate::bvh`] (cell size calibrated to the cloud's occupancy),
 //! which is much cheaper to build on millions of points than a tree. Its cost
 //! grows with the density contrast of the cloud (a depth image is 4x denser at
 //! half the distance) and it degrades on many exactly repeated points (thousands
@@ -26,7 +26,6 @@
 //! parameter out of its domain gives [`crate::Error::InvalidInput`] naming it.
 
 mod crop_box;
-mod grid;
 mod outlier;
 mod self_filter;
 mod shadow;
@@ -42,18 +41,6 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::math::Point3;
-
-/// For every point of a non-empty, finite cloud (fewer than 2^32 points),
-/// `f(i, neighbours)` with its `k` nearest *other* points as `(squared
-/// distance, index)` in no particular order; in parallel, results in point
-/// order. The exact k-NN of the filters' hashed grid, for other stages.
-pub(crate) fn knn_map<T, F>(points: &[Point3], k: usize, f: F) -> Vec<T>
-where
-    T: Send,
-    F: Fn(usize, &[(f64, u32)]) -> T + Sync,
-{
-    grid::for_each_knn(points, k, f)
-}
 
 /// Checks that a filter's input cloud is non-empty, indexable by `u32` and finite.
 pub(crate) fn check_points(filter: &str, points: &[Point3]) -> Result<()> {

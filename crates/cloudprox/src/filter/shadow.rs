@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::check_points;
-use super::grid::for_each_knn;
+use crate::bvh::for_each_knn;
 use crate::error::{Error, Result};
 use crate::io::Grid;
 use crate::math::{Point3, Vector3};

@@ -10,7 +10,7 @@
 //! surfaces (tangent, or an edge on a face) keep one side; two crossing surfaces
 //! do not.
 
-use crate::math::{Matrix3, Point3, Vector3};
+use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
 use crate::probability::normal_cdf;
 use crate::uncertainty::{directional_std_of, max_std};
 use crate::Real;
@@ -126,24 +126,9 @@ pub fn crossing_probabilities(
 /// of the `idx` points, if they are flat; `None` otherwise.
 fn flat_plane(idx: &[usize], pts: &[Point3], covs: &[Matrix3]) -> Option<(Point3, Vector3, Real)> {
     let n = idx.len() as Real;
-    let centre = Point3::from(idx.iter().map(|&j| pts[j].coords).sum::<Vector3>() / n);
-    let scatter = idx
-        .iter()
-        .map(|&j| {
-            let d = pts[j] - centre;
-            d * d.transpose()
-        })
-        .sum::<Matrix3>()
-        / n;
-    let eig = scatter.symmetric_eigen();
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    let (k, thickness_var, spread_var) = (
-        order[0],
-        eig.eigenvalues[order[0]],
-        eig.eigenvalues[order[1]],
-    );
-    let normal: Vector3 = eig.eigenvectors.column(k).into_owned();
+    let pa = PrincipalAxes::of(idx.iter().map(|&j| pts[j]));
+    let (centre, thickness_var, spread_var) = (pa.mean, pa.variances[0], pa.variances[1]);
+    let normal: Vector3 = pa.least();
     let noise_var = idx
         .iter()
         .map(|&j| directional_std_of(&covs[j], &normal).powi(2))
