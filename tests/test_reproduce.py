@@ -113,12 +113,14 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
         "p_vs_distance.png",
         "flip_rate.png",
         "roc.png",
+        "reliability.png",
         "kinect_scene.png",
     ):
         assert (quick_run / name).stat().st_size > 0, name
     summary = json.loads((quick_run / "summary.json").read_text())
     methods = {m["method"] for m in summary["metrics"]}
     assert {
+        "cloudprox elements quadric",
         "cloudprox quadric surface",
         "cloudprox quadric max",
         "cloudprox quadric union",
@@ -131,6 +133,7 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
     } <= methods
     kinect = {m["method"] for m in summary["metrics"] if m["level"] == "kinect"}
     assert kinect == {
+        "cloudprox elements quadric",
         "cloudprox quadric surface",
         "cloudprox quadric max",
         "cloudprox linear surface",
@@ -141,9 +144,9 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
     }
     assert summary["kinect"]["frame_points"] == 273225
     lines = (quick_run / "results.csv").read_text().splitlines()
-    # Piano: 2 levels x 100 poses x 2 draws x 10 methods; Kinect: 100 poses x 2
-    # draws x 7 methods; plus the header.
-    assert len(lines) == 1 + 2 * 100 * 2 * 10 + 100 * 2 * 7
+    # Piano: 2 levels x 100 poses x 2 draws x 11 methods; Kinect: 100 poses x 2
+    # draws x 8 methods; plus the header.
+    assert len(lines) == 1 + 2 * 100 * 2 * 11 + 100 * 2 * 8
     assert "Headline claims" in (quick_run / "summary.md").read_text()
 
 
@@ -187,3 +190,15 @@ def test_without_open3d_the_reconstruction_and_the_scan_are_skipped_with_notes(
     assert "reconstruct-then-collide skipped: Open3D is not installed" in text
     assert "real-scan experiment skipped" in text
     assert run_module.steps(config) == 2 + 1 * (3 + len(run_module.VARIANTS))
+
+
+def test_reliability_bins_mean_prediction_and_observed_share() -> None:
+    from cloudprox.reproduce.figures import reliability
+
+    score = np.array([0.05, 0.05, 0.95, 0.95, 1.0, 0.5])
+    label = np.array([False, True, True, True, True, False])
+    mean_p, observed, count = reliability(score, label)
+    assert count.tolist() == [2, 0, 0, 0, 0, 1, 0, 0, 0, 3]
+    assert mean_p[0] == pytest.approx(0.05) and observed[0] == 0.5
+    assert mean_p[9] == pytest.approx((0.95 + 0.95 + 1.0) / 3) and observed[9] == 1.0
+    assert observed[5] == 0.0 and np.isnan(observed[1])

@@ -9,7 +9,16 @@ import numpy.typing as npt
 
 from cloudprox.reproduce.metrics import NEAR_SIGMA, Metrics, roc_curve
 
-__all__ = ["plot_flip_rates", "plot_probability_vs_distance", "plot_roc", "plot_scan_scene"]
+__all__ = [
+    "plot_flip_rates",
+    "plot_probability_vs_distance",
+    "plot_reliability",
+    "plot_roc",
+    "plot_scan_scene",
+]
+
+#: Bins of predicted P in the reliability plot.
+RELIABILITY_BINS = 10
 
 
 def _figure(width: float, height: float):  # type: ignore[no-untyped-def]
@@ -43,6 +52,53 @@ def plot_probability_vs_distance(
         ax.set_title(title)
         ax.set_xlim(-9.0, 12.0)
         ax.legend(fontsize=7, loc="upper right")
+    fig.savefig(path, dpi=120)
+
+
+def reliability(
+    score: npt.NDArray[np.float64], label: npt.NDArray[np.bool_], bins: int = RELIABILITY_BINS
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Mean predicted ``P``, observed collision frequency and count per bin of ``P``.
+
+    Bins are ``[k / bins, (k + 1) / bins)`` (the last one closed); empty bins give NaN.
+    """
+    k = np.minimum((score * bins).astype(int), bins - 1)
+    count = np.bincount(k, minlength=bins)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean_p = np.bincount(k, weights=score, minlength=bins) / count
+        observed = np.bincount(k, weights=label.astype(float), minlength=bins) / count
+    return mean_p, observed, count
+
+
+def plot_reliability(
+    panels: list[tuple[str, float, npt.NDArray[np.float64], dict[str, npt.NDArray[np.float64]]]],
+    path: Path,
+) -> None:
+    """Draw predicted ``P`` against the observed frequency of exact collisions, per level.
+
+    ``panels`` holds ``(title, sigma, signed_distance (m,), {method: score (draws, m)})``
+    (as :func:`plot_probability_vs_distance`); a calibrated method lies on the
+    diagonal. Marker area grows with the number of answers in the bin.
+    """
+    fig = _figure(4.2 * len(panels), 4.0)
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
+    colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+    for ax, (title, _sigma, dist, scores) in zip(axes, panels):
+        for (name, s), c in zip(scores.items(), colors):
+            label = np.broadcast_to(dist <= 0.0, s.shape).ravel()
+            mean_p, observed, count = reliability(np.clip(s.ravel(), 0.0, 1.0), label)
+            ok = count > 0
+            ax.plot(mean_p[ok], observed[ok], "-", color=c, lw=1, alpha=0.6)
+            ax.scatter(
+                mean_p[ok], observed[ok], s=8 + 60 * count[ok] / count.max(), color=c, label=name
+            )
+        ax.plot([0, 1], [0, 1], "k--", lw=0.8, label="calibrated")
+        ax.set_xlabel("predicted P (bin mean)")
+        ax.set_ylabel("observed share of exact collisions")
+        ax.set_title(title, fontsize=9)
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1)
+        ax.legend(fontsize=6, loc="upper left")
     fig.savefig(path, dpi=120)
 
 

@@ -323,7 +323,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
                 {
                     k2: v[:, near]
                     for k2, v in scores.items()
-                    if k2 in (OURS, "cloudprox linear surface", NN, MAP, SPHERES, RECON)
+                    if k2 in (ELEMENTS, OURS, "cloudprox linear surface", NN, MAP, SPHERES, RECON)
                 },
             )
         )
@@ -366,7 +366,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
                 {
                     k2: v[:, near]
                     for k2, v in scan.scores.items()
-                    if k2 in (OURS, "cloudprox linear surface", NN, MAP, SPHERES, RECON)
+                    if k2 in (ELEMENTS, OURS, "cloudprox linear surface", NN, MAP, SPHERES, RECON)
                 },
             )
         )
@@ -413,6 +413,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
         out / "flip_rate.png",
     )
     figures.plot_roc(fig_roc, summary.metrics, out / "roc.png")
+    figures.plot_reliability(fig_p, out / "reliability.png")
     (out / "summary.md").write_text(_markdown(summary))
     (out / "summary.json").write_text(
         json.dumps(
