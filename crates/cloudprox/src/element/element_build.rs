@@ -1,7 +1,7 @@
 //! Top-down construction of a cloud's surface elements.
 
 use crate::cloud::PointCloud;
-use crate::element::element_fit::{fit_element, Fit, SplitRule, MIN_PLANE_POINTS};
+use crate::element::element_fit::{fit_element, Fit, SplitRule};
 use crate::element::element_merge::merge_neighbours;
 use crate::element::element_samples::element_samples;
 use crate::element::{ElementSettings, SurfaceElement, SurfaceElements};
@@ -21,7 +21,7 @@ impl SurfaceElements {
         let mut stack = vec![(0usize, n)];
         while let Some((first, count)) = stack.pop() {
             let range = first..first + count;
-            if count >= MIN_PLANE_POINTS {
+            if count >= settings.min_points {
                 let fit = fit_element(
                     points,
                     sensor,

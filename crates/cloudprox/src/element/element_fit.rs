@@ -102,19 +102,7 @@ pub(crate) fn fit_element(
     };
     let confidence = 1.0 - settings.significance;
     if m < settings.min_points {
-        // Too few points to test curvature: a plane alone, its residual sum
-        // against chi-square with m - 3 degrees of freedom.
-        if m < MIN_PLANE_POINTS {
-            return median();
-        }
-        return match weighted_fit(&local, plane_row) {
-            Some(f)
-                if f.residual <= chi_square_quantile(m - 3, confidence) && spans_a_plane(&f) =>
-            {
-                Fit::Element(element(&pa, idx, sensor, &local, first, settings, &f))
-            }
-            _ => median(),
-        };
+        return median();
     }
     let Some(f) = weighted_fit(&local, quadric_row) else {
         return median();
@@ -162,9 +150,6 @@ pub(crate) fn fit_element(
 
 /// The most points of an element's surface probed in a query.
 const MAX_PROBES: usize = 25;
-
-/// The fewest points of an element: a plane with one degree of freedom left.
-pub(crate) const MIN_PLANE_POINTS: usize = 4;
 
 /// A weighted least-squares fit of the heights over the tangent plane.
 struct HeightFit<const D: usize> {

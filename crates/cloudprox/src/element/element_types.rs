@@ -15,7 +15,8 @@ pub struct ElementSettings {
     /// the stated noise.
     pub significance: Real,
     /// The fewest points of an element (default 10; at least 7, the quadric fit
-    /// needs 6).
+    /// needs 6 and its residual test a degree of freedom); smaller groups that
+    /// fail the tests stay single points.
     pub min_points: usize,
     /// Correlation `rho` in `[0, 1]` of the sensor noise between the points of an
     /// element (default 0, independent). The mean of `m` points then has the
