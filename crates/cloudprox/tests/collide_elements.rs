@@ -35,6 +35,23 @@ fn slab(k: usize, h: f64, tilt: (f64, f64), back: f64, sigma: f64, seed: u64) ->
     PointCloud::from_sigma(add_noise(&pts, sigma, seed), sigma).unwrap()
 }
 
+/// `collide` with B lifted by `z`.
+fn collide_at_height(
+    a: &PointCloud,
+    b: &PointCloud,
+    z: f64,
+    req: &CollisionRequest,
+) -> CollisionResult {
+    collide(
+        &Pose::identity(),
+        a,
+        &Pose::translation(0.0, 0.0, z),
+        b,
+        req,
+    )
+    .unwrap()
+}
+
 /// Two slabs, B above A, whose facing faces are planes at an uncertain gap and
 /// relative tilt: the gap at the centre drawn uniformly in +-4 standard errors of
 /// its fit, the tilts from the spread of their fits. Collision is the truth
@@ -65,14 +82,7 @@ fn parallel_plates_probability_is_calibrated() {
             .any(|&(x, y)| gap + tilt.0 * x + tilt.1 * y < 0.0);
         let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1000 + draw);
         let b = slab(k, h, tilt, 0.02, sigma, 5000 + draw);
-        let r = collide(
-            &Pose::identity(),
-            &a,
-            &Pose::translation(0.0, 0.0, gap),
-            &b,
-            &req,
-        )
-        .unwrap();
+        let r = collide_at_height(&a, &b, gap, &req);
         let p = r.probability;
         let bin = ((p * 5.0) as usize).min(4);
         bins[bin].0 += p;
@@ -108,14 +118,7 @@ fn parallel_plates_probability_is_calibrated() {
         (8.0 * se, CollisionState::Free),
         (-8.0 * se, CollisionState::Collision),
     ] {
-        let r = collide(
-            &Pose::identity(),
-            &a,
-            &Pose::translation(0.0, 0.0, gap),
-            &b,
-            &req,
-        )
-        .unwrap();
+        let r = collide_at_height(&a, &b, gap, &req);
         assert_eq!(r.state, state, "gap {gap}: P = {}", r.probability);
     }
 }

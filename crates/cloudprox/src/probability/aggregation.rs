@@ -119,13 +119,7 @@ pub fn surface_probability(margins: &[Real], stds: &[Real]) -> Real {
     }
     let mean = margins.iter().sum::<Real>() / n;
     let sd = stds.iter().map(|s| s * s).sum::<Real>().sqrt() / n;
-    if sd > 0.0 && sd.is_finite() {
-        crate::probability::normal_cdf(-mean / sd)
-    } else if mean > 0.0 {
-        0.0
-    } else {
-        1.0
-    }
+    crate::probability::gaussian::wrong_side(mean, sd)
 }
 
 #[cfg(test)]

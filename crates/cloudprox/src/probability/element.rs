@@ -3,7 +3,7 @@
 use crate::classify::Separator;
 use crate::element::SurfaceElement;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
-use crate::probability::normal_cdf;
+use crate::probability::gaussian::wrong_side;
 use crate::Real;
 
 /// Elements of the other side tried as the facing one (the nearest by mean).
@@ -12,17 +12,6 @@ const FACING_CANDIDATES: usize = 6;
 /// most this many sampling spacings (half a spacing: samples of two touching
 /// surfaces can be that far apart, as in the near rule).
 const FACING_SPACINGS: Real = 0.5;
-
-/// `Phi(-gap / sd)`, exact (0 or 1) when `sd` is 0.
-fn crossing(gap: Real, sd: Real) -> Real {
-    if sd > 0.0 && sd.is_finite() {
-        normal_cdf(-gap / sd)
-    } else if gap > 0.0 {
-        0.0
-    } else {
-        1.0
-    }
-}
 
 /// One side's elements of a patch, posed in the separator's frame.
 pub struct ElementSide<'a> {
@@ -235,7 +224,7 @@ pub fn element_crossing_probabilities(
         if (f.y - f.x).norm() > f.allowed + reach_sds * sd {
             continue;
         }
-        out[f.own] = Real::max(out[f.own], crossing(gap, sd));
+        out[f.own] = Real::max(out[f.own], wrong_side(gap, sd));
     }
     out
 }
@@ -244,11 +233,13 @@ pub fn element_crossing_probabilities(
 mod tests {
     use super::*;
 
+    use crate::probability::normal_cdf;
+
     #[test]
     fn crossing_is_the_gaussian_tail_and_exact_without_noise() {
-        assert!((crossing(0.3, 0.5) - normal_cdf(-0.6)).abs() < 1e-15);
-        assert_eq!(crossing(0.1, 0.0), 0.0);
-        assert_eq!(crossing(-0.1, 0.0), 1.0);
-        assert_eq!(crossing(0.0, 0.0), 1.0);
+        assert!((wrong_side(0.3, 0.5) - normal_cdf(-0.6)).abs() < 1e-15);
+        assert_eq!(wrong_side(0.1, 0.0), 0.0);
+        assert_eq!(wrong_side(-0.1, 0.0), 1.0);
+        assert_eq!(wrong_side(0.0, 0.0), 1.0);
     }
 }

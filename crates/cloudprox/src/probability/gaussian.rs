@@ -75,6 +75,20 @@ pub fn normal_quantile(p: Real) -> Real {
     x - u / (1.0 + 0.5 * x * u)
 }
 
+/// The probability that a quantity with mean `margin` and standard deviation
+/// `sd` is not positive, `Phi(-margin / sd)`; exact (0 or 1) without spread
+/// (`sd = 0`, or not finite): 1 for a margin of 0 or less. The one tail every
+/// "wrong side" probability of the crate uses.
+pub(crate) fn wrong_side(margin: Real, sd: Real) -> Real {
+    if sd > 0.0 && sd.is_finite() {
+        normal_cdf(-margin / sd)
+    } else if margin > 0.0 {
+        0.0
+    } else {
+        1.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,6 +1,8 @@
 //! Per-point probability of lying on the wrong side (paper, Eq. 3).
 
 use crate::math::{Matrix3, Vector3};
+use crate::probability::gaussian::wrong_side;
+#[cfg(test)]
 use crate::probability::normal_cdf;
 use crate::uncertainty::directional_std_of;
 use crate::Real;
@@ -13,15 +15,7 @@ use crate::Real;
 /// With no spread along the gradient the answer is exact: 1 when the point is on
 /// the wrong side or on the surface, 0 otherwise.
 pub fn point_probability(value: Real, gradient: &Vector3, cov: &Matrix3, label: Real) -> Real {
-    let margin = label * value;
-    let s = directional_std_of(cov, gradient);
-    if s > 0.0 && s.is_finite() {
-        normal_cdf(-margin / s)
-    } else if margin > 0.0 {
-        0.0
-    } else {
-        1.0
-    }
+    wrong_side(label * value, directional_std_of(cov, gradient))
 }
 
 #[cfg(test)]
