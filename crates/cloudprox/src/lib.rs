@@ -25,6 +25,7 @@
 //! | triangle meshes, primitives, surface sampling | [`shape`] |
 //! | sensor filters: self, shadow, crop box, voxel, outliers | [`filter`] |
 //! | files: PLY, PCD, XYZ/CSV, NPY, LAS/LAZ, STL, OBJ, OFF, PointCloud2 | [`io`] |
+//! | URDF robots: kinematics, link geometry, robot-vs-cloud queries, motions | [`robot`] |
 //!
 //! [`sample`] makes synthetic shapes and seeded noise for tests, benchmarks and demos.
 //!
@@ -58,6 +59,7 @@ pub mod io;
 pub mod math;
 pub mod probability;
 pub mod query;
+pub mod robot;
 pub mod sample;
 pub mod shape;
 pub mod uncertainty;

@@ -24,6 +24,7 @@ mod request;
 mod result;
 
 pub use collide::collide;
+pub(crate) use collide::collide_with_workspace;
 pub use collide_many::collide_many;
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,

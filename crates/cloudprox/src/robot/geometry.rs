@@ -1,0 +1,202 @@
+//! Link collision geometry: URDF primitives as meshes, mesh files, the cloud
+//! that stands for a link in a query, and the exact shape for self-collision.
+
+use std::sync::Arc;
+
+use crate::bvh::Aabb;
+use crate::cloud::PointCloud;
+use crate::error::{Error, Result};
+use crate::math::Point3;
+use crate::query::exact::ExactShape;
+use crate::shape::Mesh;
+use crate::Real;
+
+/// Segments around the axis of URDF cylinders, spheres and capsules (the
+/// polygon's chord error is `r (1 - cos(pi / 32))`, 0.5% of the radius).
+pub const CIRCLE_SEGMENTS: usize = 32;
+/// Rings from pole to equator of URDF spheres and capsule caps.
+const CAP_RINGS: usize = 8;
+
+/// A closed, outward-oriented surface of revolution about z from a profile of
+/// `(radius, z)` points running from the bottom pole to the top pole (both
+/// poles with radius 0, the points between with radius > 0).
+fn lathe(profile: &[(Real, Real)], segments: usize) -> Result<Mesh> {
+    let rings = &profile[1..profile.len() - 1];
+    let n = segments as u32;
+    let mut vertices = Vec::with_capacity(rings.len() * segments + 2);
+    for &(r, z) in rings {
+        for k in 0..segments {
+            let t = 2.0 * std::f64::consts::PI * k as Real / segments as Real;
+            vertices.push(Point3::new(r * t.cos(), r * t.sin(), z));
+        }
+    }
+    let bottom = vertices.len() as u32;
+    vertices.push(Point3::new(0.0, 0.0, profile[0].1));
+    let top = bottom + 1;
+    vertices.push(Point3::new(0.0, 0.0, profile[profile.len() - 1].1));
+    let mut faces = Vec::new();
+    let last = (rings.len() - 1) as u32;
+    for k in 0..n {
+        let k1 = (k + 1) % n;
+        faces.push([bottom, k1, k]);
+        faces.push([top, last * n + k, last * n + k1]);
+        for ring in 0..last {
+            let (a, b) = (ring * n, (ring + 1) * n);
+            faces.push([a + k, a + k1, b + k1]);
+            faces.push([a + k, b + k1, b + k]);
+        }
+    }
+    Mesh::new(vertices, faces)
+}
+
+fn positive(what: &str, v: Real) -> Result<Real> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::invalid(format!(
+            "{what} must be finite and > 0, got {v}"
+        )))
+    }
+}
+
+/// A sphere of `radius` centred at the origin: a closed convex mesh with
+/// [`CIRCLE_SEGMENTS`] segments and its vertices on the sphere.
+///
+/// # Errors
+/// [`Error::InvalidInput`] if `radius` is not finite and positive.
+pub fn sphere_mesh(radius: Real) -> Result<Mesh> {
+    capsule_mesh(radius, 0.0)
+}
+
+/// A capsule along z centred at the origin: a cylinder of `radius` and
+/// `length` (0 for a sphere) between two hemispheres, as a closed convex mesh.
+///
+/// # Errors
+/// [`Error::InvalidInput`] if `radius` is not finite and positive or `length`
+/// not finite and non-negative.
+pub fn capsule_mesh(radius: Real, length: Real) -> Result<Mesh> {
+    let r = positive("radius", radius)?;
+    if !(length.is_finite() && length >= 0.0) {
+        return Err(Error::invalid(format!(
+            "capsule length must be finite and >= 0, got {length}"
+        )));
+    }
+    let h = 0.5 * length;
+    let mut profile = Vec::with_capacity(2 * CAP_RINGS + 2);
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    // Bottom cap, pole to equator.
+    for i in 0..=CAP_RINGS {
+        let phi = -half_pi + half_pi * i as Real / CAP_RINGS as Real;
+        profile.push((r * phi.cos(), -h + r * phi.sin()));
+    }
+    // Top cap, equator to pole (the equator repeated only when the cylinder has length).
+    let start = usize::from(h == 0.0);
+    for i in start..=CAP_RINGS {
+        let phi = half_pi * i as Real / CAP_RINGS as Real;
+        profile.push((r * phi.cos(), h + r * phi.sin()));
+    }
+    profile[0].0 = 0.0;
+    let n = profile.len();
+    profile[n - 1].0 = 0.0;
+    lathe(&profile, CIRCLE_SEGMENTS)
+}
+
+/// A link's collision geometry in the link frame.
+#[derive(Debug, Clone)]
+pub struct LinkGeometry {
+    /// One mesh per `<collision>` element, in the link frame (origin and scale applied).
+    pub parts: Vec<Mesh>,
+    /// The parts merged into one mesh (sampled for queries; the self-filter's mesh).
+    pub mesh: Mesh,
+    /// The parts prepared for exact queries (self-collision).
+    pub exact: ExactShape,
+    /// Bounding box of the parts in the link frame.
+    pub aabb: Aabb,
+    /// Largest distance of a vertex from the link frame's origin.
+    pub radius: Real,
+}
+
+impl LinkGeometry {
+    /// Prepares the parts of one link (`link` names it in errors).
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the link if parry rejects a part.
+    pub fn new(link: &str, parts: Vec<Mesh>) -> Result<Self> {
+        let mesh = Mesh::merged(&parts)?;
+        let exact =
+            ExactShape::new(&parts).map_err(|e| Error::invalid(format!("link '{link}': {e}")))?;
+        let aabb = mesh.aabb();
+        let radius = mesh
+            .vertices()
+            .iter()
+            .map(|v| v.coords.norm())
+            .fold(0.0, Real::max);
+        Ok(Self {
+            parts,
+            mesh,
+            exact,
+            aabb,
+            radius,
+        })
+    }
+}
+
+/// The clouds that stand for the links in a query, sampled at one spacing.
+#[derive(Debug)]
+pub(crate) struct LinkSamples {
+    /// Per link (in link order): its cloud in the link frame, `None` without geometry.
+    pub clouds: Vec<Option<PointCloud>>,
+    /// Per link: the largest sampling spacing of its cloud (for the broad phase).
+    pub spacing_max: Vec<Real>,
+}
+
+impl LinkSamples {
+    pub(crate) fn new(links: &[super::Link], spacing: Real) -> Result<Self> {
+        let mut clouds = Vec::with_capacity(links.len());
+        let mut spacing_max = Vec::with_capacity(links.len());
+        for (i, link) in links.iter().enumerate() {
+            if let Some(g) = &link.geometry {
+                let cloud = PointCloud::from_mesh(&g.mesh, spacing, i as u64)
+                    .map_err(|e| Error::invalid(format!("link '{}': {e}", link.name)))?;
+                let _ = cloud.bvh();
+                spacing_max.push(cloud.spacing().iter().copied().fold(0.0, Real::max));
+                clouds.push(Some(cloud));
+            } else {
+                clouds.push(None);
+                spacing_max.push(0.0);
+            }
+        }
+        Ok(Self {
+            clouds,
+            spacing_max,
+        })
+    }
+}
+
+/// Cached samples of every link at `spacing`, sampled on first use.
+pub(crate) fn samples_at(robot: &super::Robot, spacing: Real) -> Result<Arc<LinkSamples>> {
+    let key = spacing.to_bits();
+    {
+        let cache = robot
+            .samples
+            .lock()
+            .map_err(|_| Error::invalid("robot sample cache poisoned by an earlier panic"))?;
+        if let Some((_, s)) = cache.iter().find(|(k, _)| *k == key) {
+            return Ok(Arc::clone(s));
+        }
+    }
+    let s = Arc::new(LinkSamples::new(&robot.links, spacing)?);
+    let mut cache = robot
+        .samples
+        .lock()
+        .map_err(|_| Error::invalid("robot sample cache poisoned by an earlier panic"))?;
+    if let Some((_, existing)) = cache.iter().find(|(k, _)| *k == key) {
+        return Ok(Arc::clone(existing));
+    }
+    // Keep a few spacings only: a planner queries one scene at a time.
+    if cache.len() >= 4 {
+        cache.remove(0);
+    }
+    cache.push((key, Arc::clone(&s)));
+    Ok(s)
+}

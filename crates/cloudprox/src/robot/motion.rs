@@ -1,0 +1,158 @@
+//! Checking a straight joint-space motion against an environment cloud.
+
+use super::geometry::samples_at;
+use super::model::Robot;
+use super::query::{
+    check_base, collide_robot_prepared, link_spacing, RobotRequest, RobotWorkspace,
+};
+use crate::cloud::PointCloud;
+use crate::error::{Error, Result};
+use crate::math::Pose;
+use crate::probability::CollisionState;
+use crate::Real;
+
+/// Most states [`check_motion`] checks on one motion.
+pub const MAX_MOTION_STATES: usize = 1_000_000;
+
+/// Options of [`check_motion`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MotionRequest {
+    /// The query at each state.
+    pub robot: RobotRequest,
+    /// The largest distance (metres) any point of any link may move between two
+    /// checked states; `None`: the cloud's median sensor standard deviation
+    /// (its largest direction), or half its median spacing where the cloud has
+    /// no noise. A collision between two checked states then leaves the robot
+    /// within half of it of the obstacle at one of them, where the noise model
+    /// sees it.
+    pub resolution: Option<Real>,
+    /// A state is unsafe when its collision probability exceeds this (a chance
+    /// constraint), or when links collide with each other (if self-collision is
+    /// checked). `None`: the request's free threshold.
+    pub max_probability: Option<Real>,
+}
+
+/// The answer of [`check_motion`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionResult {
+    /// Whether every checked state is safe.
+    pub safe: bool,
+    /// The largest collision probability of the states checked (up to the
+    /// first unsafe one: the check stops there).
+    pub probability: Real,
+    /// The fraction along the motion (0 at `q0`, 1 at `q1`) of the first unsafe state.
+    pub first_unsafe: Option<Real>,
+    /// The state at the first unsafe state, or the worst state's when safe.
+    pub state: CollisionState,
+    /// States checked.
+    pub states_checked: usize,
+    /// States the motion was divided into (`steps + 1` with both ends).
+    pub states_total: usize,
+    /// The largest displacement (metres) of a link point between two states.
+    pub resolution: Real,
+}
+
+/// The default [`MotionRequest::resolution`] for `cloud`.
+fn default_resolution(cloud: &PointCloud) -> Real {
+    let median = |v: &[Real]| -> Real {
+        let mut s = v.to_vec();
+        let mid = s.len() / 2;
+        let (_, m, _) = s.select_nth_unstable_by(mid, Real::total_cmp);
+        *m
+    };
+    let sigma = median(cloud.sensor_sigma_max());
+    if sigma > 0.0 {
+        sigma
+    } else {
+        0.5 * median(cloud.spacing())
+    }
+}
+
+/// Checks the straight joint-space motion from `q0` to `q1` (root at `base`)
+/// against `cloud`: states `q0 + t (q1 - q0)` at `t = i / n`, with `n` the
+/// smallest count for which no link point moves more than the resolution
+/// between two states ([`Robot::displacement_bound`]); checked in order from
+/// `q0`, stopping at the first unsafe state.
+///
+/// # Errors
+/// As [`Robot::check_configuration`] for `q0` and `q1`; an invalid request or
+/// resolution; a motion needing more than [`MAX_MOTION_STATES`] states.
+pub fn check_motion(
+    robot: &Robot,
+    q0: &[Real],
+    q1: &[Real],
+    base: &Pose,
+    cloud: &PointCloud,
+    request: &MotionRequest,
+) -> Result<MotionResult> {
+    request.robot.validate()?;
+    check_base(base)?;
+    robot
+        .check_configuration(q0)
+        .map_err(|e| Error::invalid(format!("q0: {e}")))?;
+    robot
+        .check_configuration(q1)
+        .map_err(|e| Error::invalid(format!("q1: {e}")))?;
+    let resolution = request
+        .resolution
+        .unwrap_or_else(|| default_resolution(cloud));
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(Error::invalid(format!(
+            "motion resolution must be finite and > 0, got {resolution}"
+        )));
+    }
+    let threshold = request
+        .max_probability
+        .unwrap_or(request.robot.collide.thresholds.free);
+    if !(0.0..=1.0).contains(&threshold) {
+        return Err(Error::invalid(format!(
+            "max_probability must be in [0, 1], got {threshold}"
+        )));
+    }
+    let dq: Vec<Real> = q0.iter().zip(q1).map(|(a, b)| b - a).collect();
+    let travel = robot.displacement_bound(&dq);
+    let steps_f = (travel / resolution).ceil().max(1.0);
+    if steps_f >= MAX_MOTION_STATES as Real {
+        return Err(Error::invalid(format!(
+            "the motion moves a link point up to {travel} m: {steps_f} states at resolution \
+             {resolution} m exceed {MAX_MOTION_STATES}; raise the resolution"
+        )));
+    }
+    let steps = steps_f as usize;
+    let samples = samples_at(robot, link_spacing(&request.robot, cloud)?)?;
+    let mut ws = RobotWorkspace::default();
+    let mut q = vec![0.0; q0.len()];
+    let mut worst = 0.0;
+    let mut worst_state = CollisionState::Free;
+    for i in 0..=steps {
+        let t = i as Real / steps as Real;
+        for (k, v) in q.iter_mut().enumerate() {
+            *v = q0[k] + t * dq[k];
+        }
+        let r = collide_robot_prepared(robot, &samples, &q, base, cloud, &request.robot, &mut ws);
+        if r.probability >= worst {
+            worst = r.probability;
+            worst_state = r.state;
+        }
+        if r.probability > threshold || r.self_colliding() {
+            return Ok(MotionResult {
+                safe: false,
+                probability: worst,
+                first_unsafe: Some(t),
+                state: r.state,
+                states_checked: i + 1,
+                states_total: steps + 1,
+                resolution,
+            });
+        }
+    }
+    Ok(MotionResult {
+        safe: true,
+        probability: worst,
+        first_unsafe: None,
+        state: worst_state,
+        states_checked: steps + 1,
+        states_total: steps + 1,
+        resolution,
+    })
+}

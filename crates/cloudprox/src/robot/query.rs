@@ -1,0 +1,425 @@
+//! A robot at a configuration against an environment cloud; self-collision.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::geometry::{samples_at, LinkSamples};
+use super::model::Robot;
+use crate::bvh::{Aabb, BvhWorkspace};
+use crate::cloud::PointCloud;
+use crate::error::{Error, Result};
+use crate::math::Pose;
+use crate::probability::{normal_quantile, Aggregation, CollisionState};
+use crate::query::collide::{
+    collide_with_workspace, mesh_sampling_spacing, CollisionRequest, CollisionResult,
+};
+use crate::query::exact::exact_intersects;
+use crate::Real;
+
+/// Options of [`collide_robot`]: the per-link query's options and the robot's own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobotRequest {
+    /// The query of each link against the cloud ([`crate::query::collide()`]).
+    pub collide: CollisionRequest,
+    /// Sampling spacing of the link meshes (metres); `None`: half the cloud's
+    /// median spacing, as [`crate::query::collide_mesh_cloud`] does.
+    pub mesh_spacing: Option<Real>,
+    /// Skip links whose bounding box is beyond the noise's reach of every node
+    /// of the cloud's hierarchy (default `true`). Such a link has no pair of
+    /// points near by the query's near rule, so its query would read `P = 0`:
+    /// the broad phase changes the cost, not the answer.
+    pub broad_phase: bool,
+    /// Check self-collision between non-adjacent links (default `true`).
+    pub self_collision: bool,
+}
+
+impl Default for RobotRequest {
+    fn default() -> Self {
+        Self {
+            collide: CollisionRequest::default(),
+            mesh_spacing: None,
+            broad_phase: true,
+            self_collision: true,
+        }
+    }
+}
+
+impl RobotRequest {
+    /// Checks every field's domain.
+    ///
+    /// # Errors
+    /// As [`CollisionRequest::validate`]; a mesh spacing that is not finite and positive.
+    pub fn validate(&self) -> Result<()> {
+        self.collide.validate()?;
+        if let Some(s) = self.mesh_spacing {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(Error::invalid(format!(
+                    "mesh_spacing must be finite and > 0, got {s}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One link's part of a [`RobotCollisionResult`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkCollision {
+    /// The link's index ([`Robot::link_names`]).
+    pub link: usize,
+    /// The link's collision probability (0 when the broad phase skipped it).
+    pub probability: Real,
+    /// Its state.
+    pub state: CollisionState,
+    /// Whether the link was queried (it passed the broad phase).
+    pub queried: bool,
+    /// The full query result, when queried (side A is the link's sample, in
+    /// the link's frame; regions in the world frame).
+    pub result: Option<CollisionResult>,
+}
+
+/// Two links whose exact shapes intersect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SelfCollision {
+    /// The first link's index.
+    pub link_a: usize,
+    /// The second link's index (`link_a < link_b`).
+    pub link_b: usize,
+}
+
+/// Counters and timings of one robot query.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RobotStats {
+    /// Links with geometry.
+    pub links_with_geometry: usize,
+    /// Links queried against the cloud (the others were skipped by the broad phase).
+    pub links_queried: usize,
+    /// Hierarchy nodes of the cloud visited by the broad phase.
+    pub broad_phase_nodes: usize,
+    /// Link pairs tested for self-collision.
+    pub self_pairs_checked: usize,
+    /// Node pairs visited by the per-link queries, summed.
+    pub node_pairs_visited: usize,
+    /// Wall time (seconds).
+    pub time_seconds: Real,
+}
+
+/// The answer of [`collide_robot`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotCollisionResult {
+    /// The robot's collision probability with the environment: the links'
+    /// probabilities aggregated as the request's aggregation does points (the
+    /// largest for `max` and `surface`, their capped sum for `union`,
+    /// `1 - prod(1 - p)` for `independent`).
+    pub probability: Real,
+    /// The state from `probability` and the thresholds.
+    pub state: CollisionState,
+    /// One entry per link with geometry, in link order.
+    pub links: Vec<LinkCollision>,
+    /// Pairs of non-adjacent links that intersect (exact meshes), empty when
+    /// not requested. Reported apart: it does not enter `probability`.
+    pub self_collisions: Vec<SelfCollision>,
+    /// Counters and timings.
+    pub stats: RobotStats,
+}
+
+impl RobotCollisionResult {
+    /// Whether self-collision was found.
+    pub fn self_colliding(&self) -> bool {
+        !self.self_collisions.is_empty()
+    }
+}
+
+/// The spacing links are sampled at against `cloud`.
+pub(crate) fn link_spacing(request: &RobotRequest, cloud: &PointCloud) -> Result<Real> {
+    let s = match request.mesh_spacing {
+        Some(s) => s,
+        None => mesh_sampling_spacing(cloud),
+    };
+    if s > 0.0 && s.is_finite() {
+        Ok(s)
+    } else {
+        Err(Error::invalid(
+            "the cloud's points coincide (sampling spacing 0): give mesh_spacing",
+        ))
+    }
+}
+
+/// Whether any node of the cloud's hierarchy lies within the near rule's
+/// reach of the box: `0.5 max(h_link, h_node) + sigma_node k`, with `k =
+/// -Phi^-1(epsilon / 2)` (the link's samples carry no sensor noise). Counts
+/// visited nodes.
+fn near_cloud(
+    link_box: &Aabb,
+    h_link: Real,
+    cloud: &PointCloud,
+    k: Real,
+    visited: &mut usize,
+    stack: &mut Vec<u32>,
+) -> bool {
+    let nodes = cloud.bvh().nodes();
+    let spacing = cloud.node_spacing();
+    stack.clear();
+    stack.push(0);
+    while let Some(id) = stack.pop() {
+        *visited += 1;
+        let node = &nodes[id as usize];
+        let reach = 0.5 * h_link.max(spacing[id as usize]) + node.sigma_max * k;
+        if node.aabb.distance(link_box) > reach {
+            continue;
+        }
+        match node.children {
+            None => return true,
+            Some([l, r]) => {
+                stack.push(r);
+                stack.push(l);
+            }
+        }
+    }
+    false
+}
+
+fn aggregate(aggregation: Aggregation, p: &[Real]) -> Real {
+    match aggregation {
+        Aggregation::Max | Aggregation::Surface => p.iter().copied().fold(0.0, Real::max),
+        Aggregation::Union => p.iter().sum::<Real>().min(1.0),
+        Aggregation::Independent => 1.0 - p.iter().map(|x| 1.0 - x).product::<Real>(),
+    }
+}
+
+/// Self-collision at `poses`: the checked pairs whose exact shapes intersect.
+pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollision> {
+    robot
+        .self_pairs
+        .iter()
+        .filter_map(|&(a, b)| {
+            let ga = robot.links[a].geometry.as_ref()?;
+            let gb = robot.links[b].geometry.as_ref()?;
+            exact_intersects(&poses[a], &ga.exact, &poses[b], &gb.exact).then_some(SelfCollision {
+                link_a: a,
+                link_b: b,
+            })
+        })
+        .collect()
+}
+
+/// Workspace of one thread of robot queries.
+#[derive(Debug, Default)]
+pub(crate) struct RobotWorkspace {
+    bvh: BvhWorkspace,
+    stack: Vec<u32>,
+}
+
+/// [`collide_robot`] with prepared samples and a workspace; `q` checked.
+pub(crate) fn collide_robot_prepared(
+    robot: &Robot,
+    samples: &LinkSamples,
+    q: &[Real],
+    base: &Pose,
+    cloud: &PointCloud,
+    request: &RobotRequest,
+    ws: &mut RobotWorkspace,
+) -> RobotCollisionResult {
+    let start = Instant::now();
+    let poses = robot.link_poses_unchecked(q, base);
+    let k = -normal_quantile(0.5 * request.collide.prune_epsilon);
+    let mut stats = RobotStats::default();
+    let mut links = Vec::new();
+    for (l, link_cloud) in samples.clouds.iter().enumerate() {
+        let Some(link_cloud) = link_cloud else {
+            continue;
+        };
+        stats.links_with_geometry += 1;
+        let near = !request.broad_phase || {
+            let local = robot.links[l]
+                .geometry
+                .as_ref()
+                .map_or_else(Aabb::empty, |g| g.aabb);
+            let world = local.transformed(&poses[l]);
+            near_cloud(
+                &world,
+                samples.spacing_max[l],
+                cloud,
+                k,
+                &mut stats.broad_phase_nodes,
+                &mut ws.stack,
+            )
+        };
+        if !near {
+            links.push(LinkCollision {
+                link: l,
+                probability: 0.0,
+                state: request.collide.thresholds.state(0.0),
+                queried: false,
+                result: None,
+            });
+            continue;
+        }
+        stats.links_queried += 1;
+        // The request was validated by the caller; a query error cannot occur.
+        match collide_with_workspace(
+            &poses[l],
+            link_cloud,
+            &Pose::identity(),
+            cloud,
+            &request.collide,
+            &mut ws.bvh,
+        ) {
+            Ok(r) => {
+                stats.node_pairs_visited += r.stats.node_pairs_visited;
+                links.push(LinkCollision {
+                    link: l,
+                    probability: r.probability,
+                    state: r.state,
+                    queried: true,
+                    result: Some(r),
+                });
+            }
+            Err(_) => links.push(LinkCollision {
+                link: l,
+                probability: 1.0,
+                state: CollisionState::Collision,
+                queried: true,
+                result: None,
+            }),
+        }
+    }
+    let p: Vec<Real> = links.iter().map(|l| l.probability).collect();
+    let probability = aggregate(request.collide.aggregation, &p);
+    let self_collisions = if request.self_collision {
+        stats.self_pairs_checked = robot.self_pairs.len();
+        self_collisions(robot, &poses)
+    } else {
+        Vec::new()
+    };
+    stats.time_seconds = start.elapsed().as_secs_f64();
+    RobotCollisionResult {
+        probability,
+        state: request.collide.thresholds.state(probability),
+        links,
+        self_collisions,
+        stats,
+    }
+}
+
+/// The robot at configuration `q`, its root link at `base`, against the
+/// environment cloud `cloud` (world frame).
+///
+/// Each link with geometry stands as the cloud sampled from its mesh (no
+/// sensor noise, its own discretization covariance; sampled once per spacing
+/// and cached on the robot). A broad phase skips the links beyond the noise's
+/// reach of the cloud (see [`RobotRequest::broad_phase`]); every other link is
+/// queried by [`crate::query::collide()`] at its pose. Self-collision between
+/// non-adjacent links is checked on the exact meshes and reported apart.
+///
+/// # Errors
+/// As [`Robot::check_configuration`] for `q`; an invalid request; a
+/// non-finite `base`.
+pub fn collide_robot(
+    robot: &Robot,
+    q: &[Real],
+    base: &Pose,
+    cloud: &PointCloud,
+    request: &RobotRequest,
+) -> Result<RobotCollisionResult> {
+    request.validate()?;
+    robot.check_configuration(q)?;
+    check_base(base)?;
+    let samples = samples_at(robot, link_spacing(request, cloud)?)?;
+    let mut ws = RobotWorkspace::default();
+    Ok(collide_robot_prepared(
+        robot, &samples, q, base, cloud, request, &mut ws,
+    ))
+}
+
+/// [`collide_robot`] for each configuration of `qs`, in parallel (rayon);
+/// results in the order of `qs`. Every configuration is checked before any
+/// query runs.
+///
+/// # Errors
+/// As [`collide_robot`], naming the configuration's index.
+pub fn collide_robot_many(
+    robot: &Robot,
+    qs: &[Vec<Real>],
+    base: &Pose,
+    cloud: &PointCloud,
+    request: &RobotRequest,
+) -> Result<Vec<RobotCollisionResult>> {
+    request.validate()?;
+    check_base(base)?;
+    for (i, q) in qs.iter().enumerate() {
+        robot.check_configuration(q).map_err(|e| match e {
+            Error::InvalidInput(m) => Error::InvalidInput(format!("configuration {i}: {m}")),
+            Error::Shape {
+                what,
+                expected,
+                got,
+            } => Error::Shape {
+                what: format!("configuration {i}: {what}"),
+                expected,
+                got,
+            },
+            other => other,
+        })?;
+    }
+    let samples = samples_at(robot, link_spacing(request, cloud)?)?;
+    let _ = (cloud.bvh(), cloud.spacing(), cloud.node_spacing());
+    Ok(qs
+        .par_iter()
+        .map_init(RobotWorkspace::default, |ws, q| {
+            collide_robot_prepared(robot, &samples, q, base, cloud, request, ws)
+        })
+        .collect())
+}
+
+pub(crate) fn check_base(base: &Pose) -> Result<()> {
+    let finite = base.translation.vector.iter().all(|v| v.is_finite())
+        && base.rotation.coords.iter().all(|v| v.is_finite());
+    if finite {
+        Ok(())
+    } else {
+        Err(Error::invalid("base pose has a non-finite entry"))
+    }
+}
+
+impl Robot {
+    /// Pairs of non-adjacent links whose exact shapes intersect at
+    /// configuration `q` (see [`Robot::self_collision_pairs`]).
+    ///
+    /// # Errors
+    /// As [`Robot::check_configuration`].
+    pub fn self_collisions(&self, q: &[Real]) -> Result<Vec<SelfCollision>> {
+        let poses = self.link_poses(q, &Pose::identity())?;
+        Ok(self_collisions(self, &poses))
+    }
+
+    /// The self-filter of the robot at `q` (root at `base`, in the cloud's
+    /// frame): every link with geometry, its merged collision mesh at its pose.
+    ///
+    /// # Errors
+    /// As [`Robot::check_configuration`] and [`crate::filter::SelfFilter::new`];
+    /// a robot without geometry.
+    pub fn self_filter(
+        &self,
+        q: &[Real],
+        base: &Pose,
+        padding: Real,
+    ) -> Result<crate::filter::SelfFilter> {
+        check_base(base)?;
+        let poses = self.link_poses(q, base)?;
+        let links: Vec<_> = self
+            .links
+            .iter()
+            .zip(&poses)
+            .filter_map(|(l, p)| l.geometry.as_ref().map(|g| (g.mesh.clone(), *p)))
+            .collect();
+        if links.is_empty() {
+            return Err(Error::invalid(format!(
+                "robot '{}' has no collision geometry",
+                self.name
+            )));
+        }
+        crate::filter::SelfFilter::new(links, padding)
+    }
+}
