@@ -56,8 +56,17 @@ impl Robot {
         }
         for &j in self.order.iter().rev() {
             let joint = &self.joints[j];
+            // A mimic joint's values are its master's limits mapped through
+            // the mimic (its own limits do not bound them).
+            let range = match joint.mimic {
+                Some(m) => {
+                    let [lo, hi] = self.joints[self.dof_joints[m.dof]].limits;
+                    [m.multiplier * lo + m.offset, m.multiplier * hi + m.offset]
+                }
+                None => joint.limits,
+            };
             let travel = match joint.kind {
-                JointKind::Prismatic => joint.limits[0].abs().max(joint.limits[1].abs()),
+                JointKind::Prismatic => range[0].abs().max(range[1].abs()),
                 _ => 0.0,
             };
             let r = joint.origin.translation.vector.norm() + travel + reach[joint.child];

@@ -182,10 +182,12 @@ fn joint_kind(res: &Resolver<'_>, j: &urdf_rs::Joint) -> Result<JointKind> {
         urdf_rs::JointType::Continuous => JointKind::Continuous,
         urdf_rs::JointType::Prismatic => JointKind::Prismatic,
         urdf_rs::JointType::Fixed => JointKind::Fixed,
-        ref other => return Err(res.format_error(format!(
+        ref other => {
+            return Err(res.format_error(format!(
             "joint '{}': type {other:?} is not supported (revolute, continuous, prismatic, fixed)",
             j.name
-        ))),
+        )))
+        }
     })
 }
 

@@ -1,0 +1,400 @@
+//! The robot against environment clouds: contact, broad phase, invariance,
+//! per-link equivalence, batches, motions, self-collision and the self-filter.
+
+mod robot_common;
+
+use cloudprox::prelude::*;
+use cloudprox::query::collide::mesh_sampling_spacing;
+use cloudprox::robot::{
+    check_motion, collide_robot, collide_robot_many, MotionRequest, RobotRequest,
+};
+use cloudprox::sample::box_surface;
+use robot_common::{arm, wall};
+
+const SIGMA: f64 = 0.002;
+
+fn link_p(r: &cloudprox::robot::RobotCollisionResult, link: usize) -> f64 {
+    r.links.iter().find(|l| l.link == link).unwrap().probability
+}
+
+#[test]
+fn a_link_pushed_into_a_wall_collides_and_the_rest_is_free() {
+    let robot = arm();
+    // Wall x = 0.40 around the arm's tip (z = 0.3); link3's sphere reaches
+    // x = 0.33 + j3.
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 1);
+    let req = RobotRequest::default();
+    let free = collide_robot(
+        &robot,
+        &[0.0, 0.0, 0.0, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(free.state, CollisionState::Free, "{}", free.probability);
+    let hit = collide_robot(
+        &robot,
+        &[0.0, 0.0, 0.1, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(hit.state, CollisionState::Collision);
+    assert!(link_p(&hit, 3) > 0.99);
+    // The links far from the wall are skipped by the broad phase.
+    for l in [0, 1] {
+        let entry = hit.links.iter().find(|e| e.link == l).unwrap();
+        assert!(!entry.queried && entry.probability == 0.0);
+    }
+    // Regions come with the link they belong to, in the world frame, at the wall.
+    let link3 = hit.links.iter().find(|e| e.link == 3).unwrap();
+    let regions = &link3.result.as_ref().unwrap().regions;
+    assert!(!regions.is_empty());
+    assert!(regions.iter().all(|g| (g.point.x - 0.40).abs() < 0.03));
+    assert!(hit.self_collisions.is_empty());
+}
+
+#[test]
+fn a_robot_far_from_the_cloud_costs_no_link_query() {
+    let robot = arm();
+    let cloud = wall(5.0, 0.3, 0.1, SIGMA, 2);
+    let r = collide_robot(
+        &robot,
+        &[0.4, -0.3, 0.05, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &RobotRequest::default(),
+    )
+    .unwrap();
+    assert_eq!(r.probability, 0.0);
+    assert_eq!(r.state, CollisionState::Free);
+    assert_eq!(r.stats.links_with_geometry, 6);
+    assert_eq!(r.stats.links_queried, 0);
+    // The broad phase stops at the root of the cloud's hierarchy.
+    assert_eq!(r.stats.broad_phase_nodes, 6);
+}
+
+#[test]
+fn broad_phase_changes_the_cost_not_the_answer() {
+    let robot = arm();
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 3);
+    let with = RobotRequest::default();
+    let without = RobotRequest {
+        broad_phase: false,
+        ..RobotRequest::default()
+    };
+    for q in [
+        [0.0, 0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.06, 0.0],
+        [0.0, 0.0, 0.075, 0.0],
+        [0.2, -0.1, 0.1, 0.0],
+        [1.5, 0.0, 0.1, 0.0],
+    ] {
+        let a = collide_robot(&robot, &q, &Pose::identity(), &cloud, &with).unwrap();
+        let b = collide_robot(&robot, &q, &Pose::identity(), &cloud, &without).unwrap();
+        assert_eq!(b.stats.links_queried, 6);
+        assert_eq!(a.probability, b.probability, "{q:?}");
+        for (x, y) in a.links.iter().zip(&b.links) {
+            assert_eq!(x.probability, y.probability, "{q:?} link {}", x.link);
+        }
+    }
+}
+
+#[test]
+fn robot_result_equals_the_per_link_collide_calls() {
+    let robot = arm();
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 4);
+    let q = [0.05, 0.02, 0.07, 0.0];
+    let req = RobotRequest {
+        broad_phase: false,
+        ..RobotRequest::default()
+    };
+    let r = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
+    let poses = robot.link_poses(&q, &Pose::identity()).unwrap();
+    let spacing = mesh_sampling_spacing(&cloud);
+    let mut max_p: f64 = 0.0;
+    for entry in &r.links {
+        let mesh = &robot.links()[entry.link].geometry.as_ref().unwrap().mesh;
+        // Each link is sampled as collide_mesh_cloud does, seeded by its index.
+        let sample = PointCloud::from_mesh(mesh, spacing, entry.link as u64).unwrap();
+        let direct = collide(
+            &poses[entry.link],
+            &sample,
+            &Pose::identity(),
+            &cloud,
+            &req.collide,
+        )
+        .unwrap();
+        assert_eq!(direct.probability, entry.probability, "link {}", entry.link);
+        max_p = max_p.max(direct.probability);
+    }
+    assert_eq!(r.probability, max_p);
+    assert!(r.probability > 0.0);
+}
+
+#[test]
+fn a_common_rigid_motion_of_base_and_cloud_changes_nothing() {
+    let robot = arm();
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 5);
+    let motion = Pose::new(Vector3::new(0.7, -1.2, 0.4), Vector3::new(0.3, -0.5, 0.9));
+    let moved = cloud.transformed(&motion);
+    let req = RobotRequest::default();
+    for q in [
+        [0.0, 0.0, 0.065, 0.0],
+        [0.0, 0.0, 0.1, 0.0],
+        [0.3, 0.1, 0.02, 0.0],
+    ] {
+        let a = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
+        let b = collide_robot(&robot, &q, &motion, &moved, &req).unwrap();
+        assert!(
+            (a.probability - b.probability).abs() < 1e-6,
+            "{q:?}: {} vs {}",
+            a.probability,
+            b.probability
+        );
+        assert_eq!(a.state, b.state);
+        for (x, y) in a.links.iter().zip(&b.links) {
+            assert!((x.probability - y.probability).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn collide_robot_many_equals_a_loop() {
+    let robot = arm();
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 6);
+    let req = RobotRequest::default();
+    let qs: Vec<Vec<f64>> = (0..12)
+        .map(|i| {
+            let t = f64::from(i) / 11.0;
+            vec![0.3 * (t - 0.5), 0.1 * t, 0.1 * t, 0.0]
+        })
+        .collect();
+    let many = collide_robot_many(&robot, &qs, &Pose::identity(), &cloud, &req).unwrap();
+    assert_eq!(many.len(), qs.len());
+    for (q, m) in qs.iter().zip(&many) {
+        let one = collide_robot(&robot, q, &Pose::identity(), &cloud, &req).unwrap();
+        assert_eq!(one.probability, m.probability);
+        assert_eq!(one.state, m.state);
+    }
+    assert!(many.iter().any(|r| r.state == CollisionState::Collision));
+    assert!(many.iter().any(|r| r.state == CollisionState::Free));
+    // A bad configuration is named by its index, before any query runs.
+    let mut bad = qs.clone();
+    bad[7][1] = 9.0;
+    let e = collide_robot_many(&robot, &bad, &Pose::identity(), &cloud, &req).unwrap_err();
+    assert!(e.to_string().contains("configuration 7") && e.to_string().contains("j2"));
+}
+
+/// A small noisy box in the way of link2 when j1 = 0: centred at (0.2, 0, 0.3).
+fn obstacle() -> PointCloud {
+    let pts = box_surface(
+        &Point3::new(0.2, 0.0, 0.3),
+        &Vector3::new(0.01, 0.01, 0.05),
+        0.005,
+    );
+    PointCloud::from_sigma(cloudprox::sample::add_noise(&pts, SIGMA, 7), SIGMA).unwrap()
+}
+
+#[test]
+fn check_motion_finds_a_collision_between_two_free_waypoints() {
+    let robot = arm();
+    let cloud = obstacle();
+    let req = MotionRequest::default();
+    let (q0, q1) = ([-0.6, 0.0, 0.0, 0.0], [0.6, 0.0, 0.0, 0.0]);
+    for q in [&q0, &q1] {
+        let r = collide_robot(&robot, q, &Pose::identity(), &cloud, &req.robot).unwrap();
+        assert_eq!(r.state, CollisionState::Free);
+    }
+    let m = check_motion(&robot, &q0, &q1, &Pose::identity(), &cloud, &req).unwrap();
+    assert!(!m.safe);
+    let t = m.first_unsafe.unwrap();
+    assert!(m.probability > 0.1);
+    // The default resolution is the cloud's noise: the arm's tip (0.33 m from
+    // the axis) moves at most about one sigma between checked states.
+    assert!((m.resolution - SIGMA).abs() < 1e-12);
+    assert!(m.states_total as f64 >= 1.2 * 0.33 / SIGMA);
+    assert!(m.states_checked < m.states_total);
+    // Against a fine brute-force sweep of the same motion.
+    let n = 2000;
+    let first = (0..=n)
+        .map(|i| f64::from(i) / f64::from(n))
+        .find(|&s| {
+            let q = [-0.6 + 1.2 * s, 0.0, 0.0, 0.0];
+            collide_robot(&robot, &q, &Pose::identity(), &cloud, &req.robot)
+                .unwrap()
+                .probability
+                > 0.1
+        })
+        .unwrap();
+    let step = 1.0 / (m.states_total - 1) as f64;
+    assert!(
+        (t - first).abs() <= step + 1.0 / f64::from(n),
+        "check_motion {t}, sweep {first}, step {step}"
+    );
+    // The same motion with the obstacle moved off the path is safe.
+    let away = obstacle().transformed(&Pose::translation(0.0, 0.0, 0.5));
+    let m = check_motion(&robot, &q0, &q1, &Pose::identity(), &away, &req).unwrap();
+    assert!(m.safe && m.first_unsafe.is_none());
+    assert_eq!(m.states_checked, m.states_total);
+}
+
+#[test]
+fn check_motion_rejects_bad_input() {
+    let robot = arm();
+    let cloud = obstacle();
+    let req = MotionRequest::default();
+    let e = check_motion(
+        &robot,
+        &[0.0; 4],
+        &[0.0, 3.0, 0.0, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("q1") && e.to_string().contains("j2"),
+        "{e}"
+    );
+    let bad = MotionRequest {
+        resolution: Some(-1.0),
+        ..MotionRequest::default()
+    };
+    assert!(check_motion(
+        &robot,
+        &[0.0; 4],
+        &[0.1, 0.0, 0.0, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &bad
+    )
+    .is_err());
+}
+
+#[test]
+fn displacement_bound_holds_for_link_vertices() {
+    let robot = arm();
+    let q0 = [-1.0, 0.5, 0.02, 0.0];
+    let q1 = [0.8, -1.2, 0.09, 3.0];
+    let dq: Vec<f64> = q0.iter().zip(&q1).map(|(a, b)| b - a).collect();
+    let bound = robot.displacement_bound(&dq);
+    let n = 200;
+    let mut prev = robot.link_poses(&q0, &Pose::identity()).unwrap();
+    let mut travelled = vec![0.0; robot.links().len()];
+    for i in 1..=n {
+        let t = f64::from(i) / f64::from(n);
+        let q: Vec<f64> = q0.iter().zip(&dq).map(|(a, d)| a + t * d).collect();
+        let poses = robot.link_poses(&q, &Pose::identity()).unwrap();
+        for (l, link) in robot.links().iter().enumerate() {
+            if let Some(g) = &link.geometry {
+                let step = g
+                    .mesh
+                    .vertices()
+                    .iter()
+                    .map(|v| (poses[l] * v - prev[l] * v).norm())
+                    .fold(0.0, f64::max);
+                travelled[l] += step;
+            }
+        }
+        prev = poses;
+    }
+    let worst = travelled.iter().copied().fold(0.0, f64::max);
+    assert!(worst <= bound, "{worst} > {bound}");
+    assert!(worst > 0.3 * bound, "bound {bound} too loose for {worst}");
+}
+
+#[test]
+fn a_folded_arm_collides_with_its_base() {
+    let robot = arm();
+    let names = robot.link_names();
+    // link2 folded straight down from z = 0.3 reaches z = 0, into the base box.
+    let folded = [0.0, std::f64::consts::FRAC_PI_2, 0.0, 0.0];
+    let pairs = robot.self_collisions(&folded).unwrap();
+    let named: Vec<_> = pairs
+        .iter()
+        .map(|p| (names[p.link_a], names[p.link_b]))
+        .collect();
+    assert!(named.contains(&("base", "link2")), "{named:?}");
+    assert!(robot
+        .self_collisions(&[0.0, 0.0, 0.0, 0.0])
+        .unwrap()
+        .is_empty());
+    assert!(robot
+        .self_collisions(&[0.0, 1.0, 0.0, 0.0])
+        .unwrap()
+        .is_empty());
+    // Reported apart from the environment: far from any cloud, P stays 0.
+    let cloud = wall(5.0, 0.3, 0.1, SIGMA, 8);
+    let r = collide_robot(
+        &robot,
+        &folded,
+        &Pose::identity(),
+        &cloud,
+        &RobotRequest::default(),
+    )
+    .unwrap();
+    assert_eq!(r.probability, 0.0);
+    assert!(r.self_colliding());
+    // A motion through the folded configuration is unsafe because of it.
+    let m = check_motion(
+        &robot,
+        &[0.0; 4],
+        &folded,
+        &Pose::identity(),
+        &cloud,
+        &MotionRequest::default(),
+    )
+    .unwrap();
+    assert!(!m.safe && m.first_unsafe.unwrap() > 0.5);
+}
+
+#[test]
+fn the_self_filter_removes_a_sampled_link() {
+    let robot = arm();
+    let q = [0.4, -0.3, 0.05, 0.0];
+    let base = Pose::translation(0.1, 0.2, 0.0);
+    let poses = robot.link_poses(&q, &base).unwrap();
+    let link2 = robot.links()[2].geometry.as_ref().unwrap();
+    let on_link: Vec<Point3> = link2
+        .mesh
+        .sample_surface_density(40_000.0, 3)
+        .unwrap()
+        .points
+        .iter()
+        .map(|p| poses[2] * p)
+        .collect();
+    let far: Vec<Point3> = (0..50)
+        .map(|i| Point3::new(1.0 + 0.01 * f64::from(i), 0.0, 0.0))
+        .collect();
+    let mut pts = on_link.clone();
+    pts.extend_from_slice(&far);
+    let filter = robot.self_filter(&q, &base, 0.005).unwrap();
+    let kept = filter.apply(&pts);
+    let expected: Vec<u32> = (on_link.len() as u32..pts.len() as u32).collect();
+    assert_eq!(kept, expected);
+    assert!(robot.self_filter(&q, &base, -1.0).is_err());
+}
+
+#[test]
+fn bad_queries_are_rejected() {
+    let robot = arm();
+    let cloud = obstacle();
+    let req = RobotRequest::default();
+    assert!(collide_robot(&robot, &[0.0; 3], &Pose::identity(), &cloud, &req).is_err());
+    assert!(collide_robot(
+        &robot,
+        &[0.0, 0.0, f64::INFINITY, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req
+    )
+    .is_err());
+    let bad = RobotRequest {
+        mesh_spacing: Some(0.0),
+        ..RobotRequest::default()
+    };
+    assert!(collide_robot(&robot, &[0.0; 4], &Pose::identity(), &cloud, &bad).is_err());
+}
