@@ -199,6 +199,15 @@ pub struct PySelfFilter {
     inner: RwLock<SelfFilter>,
 }
 
+impl PySelfFilter {
+    /// Wraps a core filter (`Robot.self_filter`).
+    pub(crate) fn wrap(inner: SelfFilter) -> Self {
+        Self {
+            inner: RwLock::new(inner),
+        }
+    }
+}
+
 #[pymethods]
 impl PySelfFilter {
     #[new]

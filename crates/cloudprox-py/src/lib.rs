@@ -16,6 +16,7 @@
 //! | `sample.rs` | seeded synthetic shapes |
 //! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
 //! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
+//! | `robot.rs` | `Robot`, `collide_robot`, `collide_robot_many`, `check_motion` |
 //!
 //! The Python package `cloudprox` re-exports everything; `_native.pyi` is the stub.
 #![deny(unused_qualifications)]
@@ -31,6 +32,7 @@ mod io;
 mod mesh;
 mod request;
 mod result;
+mod robot;
 mod sample;
 mod sensor;
 mod side;
@@ -71,5 +73,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample::sample_sphere, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_box_surface, m)?)?;
     m.add_function(wrap_pyfunction!(sample::add_noise, m)?)?;
+    m.add_class::<robot::PyRobot>()?;
+    m.add_class::<robot::PyLinkCollision>()?;
+    m.add_class::<robot::PyRobotCollisionResult>()?;
+    m.add_class::<robot::PyRobotBatchResult>()?;
+    m.add_class::<robot::PyMotionResult>()?;
+    m.add_function(wrap_pyfunction!(robot::collide_robot, m)?)?;
+    m.add_function(wrap_pyfunction!(robot::collide_robot_many, m)?)?;
+    m.add_function(wrap_pyfunction!(robot::check_motion, m)?)?;
     Ok(())
 }

@@ -35,6 +35,13 @@ pub struct PyContactRegion {
     inner: ContactRegion,
 }
 
+impl PyContactRegion {
+    /// Wraps a core region (the robot queries' regions).
+    pub(crate) fn wrap(inner: ContactRegion) -> Self {
+        Self { inner }
+    }
+}
+
 #[pymethods]
 impl PyContactRegion {
     /// Index of the connected near region this patch belongs to.

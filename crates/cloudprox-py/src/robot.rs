@@ -1,0 +1,748 @@
+//! `Robot` (a URDF robot), `collide_robot`, `collide_robot_many`, `check_motion`.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use cloudprox::cloud::{pose_to_matrix, PointCloud};
+use cloudprox::math::Pose;
+use cloudprox::robot::{
+    check_motion as core_check_motion, collide_robot as core_collide_robot,
+    collide_robot_many as core_collide_robot_many, LinkCollision, MotionRequest, Robot,
+    RobotCollisionResult, RobotStats,
+};
+use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+use crate::cloud::PyPointCloud;
+use crate::convert::{check_shape, pose_from, to_f64_array, vec_to_py};
+use crate::error::{invalid_input, run_detached, CoreResultExt};
+use crate::filter::PySelfFilter;
+use crate::mesh::PyMesh;
+use crate::request::RequestOptions;
+use crate::result::{PyCollisionResult, PyContactRegion};
+
+/// Names of the options of `collide_robot` beyond those of `collide`.
+const ROBOT_OPTIONS: [&str; 3] = ["mesh_spacing", "broad_phase", "self_collision"];
+/// Names of the options of `check_motion` beyond those of `collide_robot`.
+const MOTION_OPTIONS: [&str; 2] = ["resolution", "max_probability"];
+/// Names of the options shared with `collide`.
+const COLLIDE_OPTIONS: [&str; 14] = [
+    "surface",
+    "aggregation",
+    "threshold_collision",
+    "threshold_free",
+    "prune_epsilon",
+    "region_max_points",
+    "near_context",
+    "lambda_",
+    "robust_eta",
+    "robust_model",
+    "solver",
+    "use_hierarchy",
+    "model",
+    "decide_only",
+];
+
+fn extract<'py, T: FromPyObjectOwned<'py>>(
+    py: Python<'py>,
+    v: &Bound<'py, PyAny>,
+    key: &str,
+    kind: &str,
+) -> PyResult<T> {
+    v.extract::<T>()
+        .map_err(|_| invalid_input(py, format!("option {key} must be {kind}")))
+}
+
+/// The keyword options of a robot query, parsed (unknown names are errors).
+fn motion_request(
+    py: Python<'_>,
+    options: Option<&Bound<'_, PyDict>>,
+    motion: bool,
+) -> PyResult<MotionRequest> {
+    let mut req = RequestOptions::default();
+    let mut out = MotionRequest::default();
+    if let Some(options) = options {
+        for (k, v) in options.iter() {
+            let key: String = k.extract()?;
+            if v.is_none() {
+                continue;
+            }
+            match key.as_str() {
+                "surface" => req.surface = Some(extract(py, &v, &key, "a str")?),
+                "aggregation" => req.aggregation = Some(extract(py, &v, &key, "a str")?),
+                "threshold_collision" => {
+                    req.threshold_collision = Some(extract(py, &v, &key, "a float")?);
+                }
+                "threshold_free" => req.threshold_free = Some(extract(py, &v, &key, "a float")?),
+                "prune_epsilon" => req.prune_epsilon = Some(extract(py, &v, &key, "a float")?),
+                "region_max_points" => {
+                    req.region_max_points = Some(extract(py, &v, &key, "an int")?);
+                }
+                "near_context" => req.near_context = Some(extract(py, &v, &key, "a float")?),
+                "lambda_" => req.lambda = Some(extract(py, &v, &key, "a float")?),
+                "robust_eta" => req.robust_eta = Some(extract(py, &v, &key, "a float")?),
+                "robust_model" => req.robust_model = Some(extract(py, &v, &key, "a str")?),
+                "solver" => req.solver = Some(extract(py, &v, &key, "a str")?),
+                "use_hierarchy" => req.use_hierarchy = Some(extract(py, &v, &key, "a bool")?),
+                "model" => req.model = Some(extract(py, &v, &key, "a str")?),
+                "decide_only" => req.decide_only = Some(extract(py, &v, &key, "a bool")?),
+                "mesh_spacing" => {
+                    out.robot.mesh_spacing = Some(extract(py, &v, &key, "a float")?);
+                }
+                "broad_phase" => out.robot.broad_phase = extract(py, &v, &key, "a bool")?,
+                "self_collision" => out.robot.self_collision = extract(py, &v, &key, "a bool")?,
+                "resolution" if motion => {
+                    out.resolution = Some(extract(py, &v, &key, "a float")?);
+                }
+                "max_probability" if motion => {
+                    out.max_probability = Some(extract(py, &v, &key, "a float")?);
+                }
+                _ => {
+                    let mut valid: Vec<&str> = COLLIDE_OPTIONS.to_vec();
+                    valid.extend(ROBOT_OPTIONS);
+                    if motion {
+                        valid.extend(MOTION_OPTIONS);
+                    }
+                    return Err(invalid_input(
+                        py,
+                        format!(
+                            "unknown option '{key}'; valid options: {}",
+                            valid.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    out.robot.collide = req.build(py)?;
+    out.robot.validate().or_py(py)?;
+    Ok(out)
+}
+
+/// A float64 array of shape `(dof,)` as a vector (its length is checked by the core).
+fn config_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    let arr = to_f64_array(obj, what)?;
+    check_shape(&arr, &[None], what, "(dof,)")?;
+    array_data(&arr, what)
+}
+
+fn array_data(arr: &Bound<'_, PyArrayDyn<f64>>, what: &str) -> PyResult<Vec<f64>> {
+    let ro = arr.readonly();
+    ro.as_slice()
+        .map(<[f64]>::to_vec)
+        .map_err(|_| invalid_input(arr.py(), format!("{what} is not contiguous")))
+}
+
+fn cloud_from(obj: &Bound<'_, PyAny>) -> PyResult<Arc<PointCloud>> {
+    if let Ok(c) = obj.cast::<PyPointCloud>() {
+        return Ok(Arc::clone(&c.get().inner));
+    }
+    let ty = obj.get_type().name()?;
+    Err(pyo3::exceptions::PyTypeError::new_err(format!(
+        "cloud must be a PointCloud, got {ty}; wrap arrays in PointCloud(points, sigma=...)"
+    )))
+}
+
+fn matrix_to_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let m = pose_to_matrix(pose);
+    let rows: Vec<Vec<f64>> = (0..4)
+        .map(|i| (0..4).map(|j| m[(i, j)]).collect())
+        .collect();
+    Ok(PyArray2::from_vec2(py, &rows)?)
+}
+
+/// A robot loaded from a URDF file: links, joints, limits and collision
+/// geometry, prepared once for many queries.
+#[pyclass(name = "Robot", frozen, module = "cloudprox._native")]
+pub struct PyRobot {
+    inner: Arc<Robot>,
+}
+
+impl PyRobot {
+    fn names(&self, pairs: &[(usize, usize)]) -> Vec<(String, String)> {
+        let names = self.inner.link_names();
+        pairs
+            .iter()
+            .map(|&(a, b)| (names[a].to_string(), names[b].to_string()))
+            .collect()
+    }
+}
+
+#[pymethods]
+impl PyRobot {
+    /// Loads a URDF file; `package_dirs` are searched for `package://` URIs.
+    #[staticmethod]
+    #[pyo3(signature = (path, package_dirs=None))]
+    fn from_urdf(
+        py: Python<'_>,
+        path: PathBuf,
+        package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
+        let dirs = package_dirs.unwrap_or_default();
+        let robot = run_detached(py, move || Robot::from_urdf_file(&path, &dirs))?;
+        Ok(Self {
+            inner: Arc::new(robot),
+        })
+    }
+
+    /// The robot's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name().to_string()
+    }
+
+    /// Number of configuration entries.
+    #[getter]
+    fn dof(&self) -> usize {
+        self.inner.dof()
+    }
+
+    /// Names of the joints of the configuration entries, in order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.inner
+            .joint_names()
+            .into_iter()
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// Names of the links, in URDF order.
+    #[getter]
+    fn link_names(&self) -> Vec<String> {
+        self.inner
+            .link_names()
+            .into_iter()
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// `(dof, 2)` lower and upper limits (infinite for continuous joints).
+    #[getter]
+    fn joint_limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let rows: Vec<Vec<f64>> = self
+            .inner
+            .joint_limits()
+            .iter()
+            .map(|l| l.to_vec())
+            .collect();
+        if rows.is_empty() {
+            return Ok(PyArray2::zeros(py, [0, 2], false));
+        }
+        Ok(PyArray2::from_vec2(py, &rows)?)
+    }
+
+    /// Link pairs checked for self-collision, as name pairs.
+    #[getter]
+    fn self_collision_pairs(&self) -> Vec<(String, String)> {
+        self.names(self.inner.self_collision_pairs())
+    }
+
+    /// Link pairs never checked for self-collision (adjacent, or touching at the
+    /// reference configuration), as name pairs.
+    #[getter]
+    fn ignored_pairs(&self) -> Vec<(String, String)> {
+        self.names(self.inner.ignored_pairs())
+    }
+
+    /// Every link's pose (4x4, link frame to world) at `q`, the root at `base_pose`.
+    #[pyo3(signature = (q, base_pose=None))]
+    fn link_poses<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        base_pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let q = config_from(q, "q")?;
+        let base = pose_from(py, base_pose, "base_pose")?;
+        let poses = self.inner.link_poses(&q, &base).or_py(py)?;
+        let d = PyDict::new(py);
+        for (name, pose) in self.inner.link_names().into_iter().zip(&poses) {
+            d.set_item(name, matrix_to_py(py, pose)?)?;
+        }
+        Ok(d)
+    }
+
+    /// `q` clamped into the joint limits.
+    fn clamp<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let q = config_from(q, "q")?;
+        if q.len() != self.inner.dof() {
+            return Err(invalid_input(
+                py,
+                format!(
+                    "q must have {} entries (one per joint), got {}",
+                    self.inner.dof(),
+                    q.len()
+                ),
+            ));
+        }
+        Ok(vec_to_py(py, &self.inner.clamp(&q)))
+    }
+
+    /// The collision mesh of a link in its own frame, or `None` without geometry.
+    fn link_mesh(&self, py: Python<'_>, link: &str) -> PyResult<Option<PyMesh>> {
+        let i = self
+            .inner
+            .link_index(link)
+            .ok_or_else(|| invalid_input(py, format!("robot has no link named '{link}'")))?;
+        Ok(self.inner.links()[i]
+            .geometry
+            .as_ref()
+            .map(|g| PyMesh::wrap(g.mesh.clone())))
+    }
+
+    /// Pairs of non-adjacent links whose exact meshes intersect at `q`.
+    fn self_collisions(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+    ) -> PyResult<Vec<(String, String)>> {
+        let q = config_from(q, "q")?;
+        let pairs = self.inner.self_collisions(&q).or_py(py)?;
+        let pairs: Vec<(usize, usize)> = pairs.iter().map(|p| (p.link_a, p.link_b)).collect();
+        Ok(self.names(&pairs))
+    }
+
+    /// The self-filter of the robot at `q` (root at `base_pose`, in the cloud's
+    /// frame): removes the points within `padding` of a link, or inside a closed link.
+    #[pyo3(signature = (q, padding=0.01, base_pose=None))]
+    fn self_filter(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        padding: f64,
+        base_pose: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PySelfFilter> {
+        let q = config_from(q, "q")?;
+        let base = pose_from(py, base_pose, "base_pose")?;
+        let robot = Arc::clone(&self.inner);
+        let f = run_detached(py, move || robot.self_filter(&q, &base, padding))?;
+        Ok(PySelfFilter::wrap(f))
+    }
+
+    fn __repr__(&self) -> String {
+        let with_geometry = self
+            .inner
+            .links()
+            .iter()
+            .filter(|l| l.geometry.is_some())
+            .count();
+        format!(
+            "Robot(name='{}', dof={}, links={}, with_geometry={})",
+            self.inner.name(),
+            self.inner.dof(),
+            self.inner.links().len(),
+            with_geometry
+        )
+    }
+}
+
+/// One link's part of a `RobotCollisionResult`.
+#[pyclass(name = "LinkCollision", frozen, module = "cloudprox._native")]
+pub struct PyLinkCollision {
+    name: String,
+    inner: LinkCollision,
+}
+
+#[pymethods]
+impl PyLinkCollision {
+    /// The link's name.
+    #[getter]
+    fn link(&self) -> &str {
+        &self.name
+    }
+
+    /// The link's collision probability (0 when the broad phase skipped it).
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.inner.probability
+    }
+
+    /// `"free"`, `"contact"` or `"collision"`.
+    #[getter]
+    fn state(&self) -> &'static str {
+        self.inner.state.name()
+    }
+
+    /// Whether the link was queried (it passed the broad phase).
+    #[getter]
+    fn queried(&self) -> bool {
+        self.inner.queried
+    }
+
+    /// The full query result of the link (side A is the link's sample), or
+    /// `None` when the broad phase skipped it.
+    #[getter]
+    fn result(&self, py: Python<'_>) -> PyResult<Option<PyCollisionResult>> {
+        self.inner
+            .result
+            .clone()
+            .map(|r| PyCollisionResult::new(py, r))
+            .transpose()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "LinkCollision(link='{}', probability={:.6}, state='{}', queried={})",
+            self.name,
+            self.inner.probability,
+            self.inner.state.name(),
+            if self.inner.queried { "True" } else { "False" }
+        )
+    }
+}
+
+/// The answer of `collide_robot`.
+#[pyclass(name = "RobotCollisionResult", frozen, module = "cloudprox._native")]
+pub struct PyRobotCollisionResult {
+    probability: f64,
+    state: &'static str,
+    links: Vec<Py<PyLinkCollision>>,
+    self_collisions: Vec<(String, String)>,
+    stats: RobotStats,
+}
+
+impl PyRobotCollisionResult {
+    fn new(py: Python<'_>, robot: &Robot, r: RobotCollisionResult) -> PyResult<Self> {
+        let names = robot.link_names();
+        let links = r
+            .links
+            .into_iter()
+            .map(|l| {
+                Py::new(
+                    py,
+                    PyLinkCollision {
+                        name: names[l.link].to_string(),
+                        inner: l,
+                    },
+                )
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let self_collisions = r
+            .self_collisions
+            .iter()
+            .map(|p| (names[p.link_a].to_string(), names[p.link_b].to_string()))
+            .collect();
+        Ok(Self {
+            probability: r.probability,
+            state: r.state.name(),
+            links,
+            self_collisions,
+            stats: r.stats,
+        })
+    }
+}
+
+#[pymethods]
+impl PyRobotCollisionResult {
+    /// The robot's collision probability with the environment.
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.probability
+    }
+
+    /// `"free"`, `"contact"` or `"collision"`.
+    #[getter]
+    fn state(&self) -> &'static str {
+        self.state
+    }
+
+    /// Per link with geometry: its `LinkCollision`, by link name (URDF order).
+    #[getter]
+    fn links<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for l in &self.links {
+            d.set_item(l.get().name.as_str(), l.clone_ref(py))?;
+        }
+        Ok(d)
+    }
+
+    /// The contact regions of every queried link, as `(link name, ContactRegion)`.
+    #[getter]
+    fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let mut out = Vec::new();
+        for l in &self.links {
+            let l = l.get();
+            if let Some(r) = &l.inner.result {
+                for g in &r.regions {
+                    let region = Py::new(py, PyContactRegion::wrap(g.clone()))?;
+                    out.push(PyTuple::new(
+                        py,
+                        [
+                            l.name.clone().into_pyobject(py)?.into_any(),
+                            region.into_bound(py).into_any(),
+                        ],
+                    )?);
+                }
+            }
+        }
+        PyList::new(py, out)
+    }
+
+    /// Pairs of non-adjacent links that intersect (exact meshes), as name pairs;
+    /// reported apart from `probability`.
+    #[getter]
+    fn self_collisions(&self) -> Vec<(String, String)> {
+        self.self_collisions.clone()
+    }
+
+    /// Counters and timings, as a dict.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let RobotStats {
+            links_with_geometry,
+            links_queried,
+            broad_phase_nodes,
+            self_pairs_checked,
+            node_pairs_visited,
+            time_seconds,
+        } = &self.stats;
+        let d = PyDict::new(py);
+        d.set_item("links_with_geometry", links_with_geometry)?;
+        d.set_item("links_queried", links_queried)?;
+        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
+        d.set_item("self_pairs_checked", self_pairs_checked)?;
+        d.set_item("node_pairs_visited", node_pairs_visited)?;
+        d.set_item("time_seconds", time_seconds)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RobotCollisionResult(probability={:.6}, state='{}', links={}, self_collisions={})",
+            self.probability,
+            self.state,
+            self.links.len(),
+            self.self_collisions.len()
+        )
+    }
+}
+
+fn robot_arg(robot: &Bound<'_, PyAny>) -> PyResult<Arc<Robot>> {
+    let r = robot
+        .cast::<PyRobot>()
+        .map_err(|_| pyo3::exceptions::PyTypeError::new_err("robot must be a cloudprox.Robot"))?;
+    Ok(Arc::clone(&r.get().inner))
+}
+
+/// The robot at configuration `q` (root at `base_pose`) against the cloud.
+#[pyfunction]
+#[pyo3(signature = (robot, q, cloud, base_pose=None, **options))]
+pub fn collide_robot(
+    py: Python<'_>,
+    robot: &Bound<'_, PyAny>,
+    q: &Bound<'_, PyAny>,
+    cloud: &Bound<'_, PyAny>,
+    base_pose: Option<&Bound<'_, PyAny>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyRobotCollisionResult> {
+    let robot = robot_arg(robot)?;
+    let request = motion_request(py, options, false)?.robot;
+    let q = config_from(q, "q")?;
+    let base = pose_from(py, base_pose, "base_pose")?;
+    let cloud = cloud_from(cloud)?;
+    let r2 = Arc::clone(&robot);
+    let result = run_detached(py, move || {
+        core_collide_robot(&r2, &q, &base, &cloud, &request)
+    })?;
+    PyRobotCollisionResult::new(py, &robot, result)
+}
+
+/// The answer of `collide_robot_many`: arrays over the configurations.
+#[pyclass(name = "RobotBatchResult", frozen, module = "cloudprox._native")]
+pub struct PyRobotBatchResult {
+    probabilities: Vec<f64>,
+    states: Vec<&'static str>,
+    self_colliding: Vec<bool>,
+    link_probabilities: Vec<f64>,
+    n_links: usize,
+}
+
+#[pymethods]
+impl PyRobotBatchResult {
+    /// `(m,)` collision probabilities.
+    #[getter]
+    fn probabilities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec_to_py(py, &self.probabilities)
+    }
+
+    /// `(m,)` states (`"free"`, `"contact"`, `"collision"`), a numpy string array.
+    #[getter]
+    fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("numpy")?
+            .call_method1("array", (self.states.clone(),))
+    }
+
+    /// `(m,)` whether non-adjacent links intersect.
+    #[getter]
+    fn self_colliding<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        PyArray1::from_slice(py, &self.self_colliding)
+    }
+
+    /// `(m, n_links)` per-link probabilities, links in `Robot.link_names` order
+    /// (0 for links without geometry and links the broad phase skipped).
+    #[getter]
+    fn link_probabilities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let m = self.probabilities.len();
+        PyArray1::from_slice(py, &self.link_probabilities).reshape([m, self.n_links])
+    }
+
+    fn __len__(&self) -> usize {
+        self.probabilities.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RobotBatchResult(configurations={}, links={})",
+            self.probabilities.len(),
+            self.n_links
+        )
+    }
+}
+
+/// `collide_robot` for each row of the `(m, dof)` array `qs`, in parallel
+/// (rayon) with the GIL released.
+#[pyfunction]
+#[pyo3(signature = (robot, qs, cloud, base_pose=None, **options))]
+pub fn collide_robot_many(
+    py: Python<'_>,
+    robot: &Bound<'_, PyAny>,
+    qs: &Bound<'_, PyAny>,
+    cloud: &Bound<'_, PyAny>,
+    base_pose: Option<&Bound<'_, PyAny>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyRobotBatchResult> {
+    let robot = robot_arg(robot)?;
+    let request = motion_request(py, options, false)?.robot;
+    let arr = to_f64_array(qs, "qs")?;
+    check_shape(
+        &arr,
+        &[None, Some(robot.dof())],
+        "qs",
+        &format!("(m, {})", robot.dof()),
+    )?;
+    let flat = array_data(&arr, "qs")?;
+    let qs: Vec<Vec<f64>> = if robot.dof() == 0 {
+        vec![Vec::new(); arr.shape()[0]]
+    } else {
+        flat.chunks_exact(robot.dof())
+            .map(<[f64]>::to_vec)
+            .collect()
+    };
+    let base = pose_from(py, base_pose, "base_pose")?;
+    let cloud = cloud_from(cloud)?;
+    let r2 = Arc::clone(&robot);
+    let results = run_detached(py, move || {
+        core_collide_robot_many(&r2, &qs, &base, &cloud, &request)
+    })?;
+    let n_links = robot.links().len();
+    let mut link_probabilities = vec![0.0; results.len() * n_links];
+    for (i, r) in results.iter().enumerate() {
+        for l in &r.links {
+            link_probabilities[i * n_links + l.link] = l.probability;
+        }
+    }
+    Ok(PyRobotBatchResult {
+        probabilities: results.iter().map(|r| r.probability).collect(),
+        states: results.iter().map(|r| r.state.name()).collect(),
+        self_colliding: results
+            .iter()
+            .map(RobotCollisionResult::self_colliding)
+            .collect(),
+        link_probabilities,
+        n_links,
+    })
+}
+
+/// The answer of `check_motion`.
+#[pyclass(name = "MotionResult", frozen, module = "cloudprox._native")]
+pub struct PyMotionResult {
+    inner: cloudprox::robot::MotionResult,
+}
+
+#[pymethods]
+impl PyMotionResult {
+    /// Whether every checked state is safe.
+    #[getter]
+    fn safe(&self) -> bool {
+        self.inner.safe
+    }
+
+    /// The largest collision probability of the states checked.
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.inner.probability
+    }
+
+    /// Fraction along the motion of the first unsafe state, or `None`.
+    #[getter]
+    fn first_unsafe(&self) -> Option<f64> {
+        self.inner.first_unsafe
+    }
+
+    /// The state at the first unsafe state, or the worst state's when safe.
+    #[getter]
+    fn state(&self) -> &'static str {
+        self.inner.state.name()
+    }
+
+    /// States checked.
+    #[getter]
+    fn states_checked(&self) -> usize {
+        self.inner.states_checked
+    }
+
+    /// States the motion was divided into (both ends included).
+    #[getter]
+    fn states_total(&self) -> usize {
+        self.inner.states_total
+    }
+
+    /// The largest displacement (metres) of a link point between two states.
+    #[getter]
+    fn resolution(&self) -> f64 {
+        self.inner.resolution
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "MotionResult(safe={}, probability={:.6}, first_unsafe={}, states={}/{})",
+            if self.inner.safe { "True" } else { "False" },
+            self.inner.probability,
+            self.inner
+                .first_unsafe
+                .map_or("None".to_string(), |t| format!("{t:.6}")),
+            self.inner.states_checked,
+            self.inner.states_total
+        )
+    }
+}
+
+/// The straight joint-space motion from `q0` to `q1` against the cloud.
+#[pyfunction]
+#[pyo3(signature = (robot, q0, q1, cloud, base_pose=None, **options))]
+pub fn check_motion(
+    py: Python<'_>,
+    robot: &Bound<'_, PyAny>,
+    q0: &Bound<'_, PyAny>,
+    q1: &Bound<'_, PyAny>,
+    cloud: &Bound<'_, PyAny>,
+    base_pose: Option<&Bound<'_, PyAny>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyMotionResult> {
+    let robot = robot_arg(robot)?;
+    let request = motion_request(py, options, true)?;
+    let q0 = config_from(q0, "q0")?;
+    let q1 = config_from(q1, "q1")?;
+    let base = pose_from(py, base_pose, "base_pose")?;
+    let cloud = cloud_from(cloud)?;
+    let inner = run_detached(py, move || {
+        core_check_motion(&robot, &q0, &q1, &base, &cloud, &request)
+    })?;
+    Ok(PyMotionResult { inner })
+}
