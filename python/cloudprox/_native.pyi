@@ -8,6 +8,7 @@ arrays. Units are SI: metres, and metres squared for covariances. Poses map an
 object's own frame to the world; ``None`` means identity.
 """
 
+import os
 from collections.abc import Sequence
 from typing import Any, Final, Literal, TypedDict, final
 
@@ -25,15 +26,23 @@ __all__ = [
     "FormatError",
     "InvalidInputError",
     "Lidar",
+    "LinkCollision",
     "Mesh",
+    "MotionResult",
     "PointCloud",
+    "Robot",
+    "RobotBatchResult",
+    "RobotCollisionResult",
     "SelfFilter",
     "SolverError",
     "StereoCamera",
     "__version__",
     "add_noise",
+    "check_motion",
     "collide",
     "collide_many",
+    "collide_robot",
+    "collide_robot_many",
     "crop_box",
     "default_options",
     "exact_intersects_many",
@@ -935,3 +944,206 @@ class SelfFilter:
 
 def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> tuple[Mesh, int]:
     """Read a mesh from bytes (see :func:`cloudprox.io.parse_mesh`)."""
+
+# ---------------------------------------------------------------- robots (issue 11)
+
+@final
+class Robot:
+    """A robot loaded from a URDF file, prepared once for many queries.
+
+    A configuration ``q`` holds one value per independent moving joint (revolute,
+    continuous, prismatic; mimic joints follow their master), in the order of
+    :attr:`joint_names`. A configuration outside the joint limits, of the wrong
+    length or with a NaN raises :class:`InvalidInputError` naming the joint; it is
+    never clamped silently (:meth:`clamp` clamps on request).
+    """
+
+    @staticmethod
+    def from_urdf(
+        path: str | os.PathLike[str], package_dirs: Sequence[str | os.PathLike[str]] | None = None
+    ) -> Robot:
+        """Load a URDF file.
+
+        ``package://NAME/PATH`` mesh URIs are looked for as ``DIR/NAME/PATH`` (or
+        ``DIR/PATH`` when ``DIR`` is named ``NAME``) for each of ``package_dirs``,
+        then in the URDF's own folders; ``file://`` and plain paths are absolute or
+        relative to the URDF's folder. Meshes: STL, OBJ, PLY, OFF (COLLADA raises
+        :class:`FormatError`); ``box``, ``cylinder``, ``sphere`` and ``capsule``
+        become closed meshes. A missing file raises ``FileNotFoundError`` naming
+        the link and the paths tried; a malformed URDF raises :class:`FormatError`
+        naming the joint or link.
+        """
+    @property
+    def name(self) -> str:
+        """The robot's name."""
+    @property
+    def dof(self) -> int:
+        """Number of configuration entries."""
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the joints of the configuration entries, in order."""
+    @property
+    def link_names(self) -> list[str]:
+        """Names of the links, in URDF order."""
+    @property
+    def joint_limits(self) -> _FloatArray:
+        """Lower and upper limits, shape ``(dof, 2)`` (infinite for continuous joints)."""
+    @property
+    def self_collision_pairs(self) -> list[tuple[str, str]]:
+        """Link pairs checked for self-collision."""
+    @property
+    def ignored_pairs(self) -> list[tuple[str, str]]:
+        """Link pairs never checked: adjacent, or touching at the reference configuration."""
+    def link_poses(
+        self, q: npt.ArrayLike, base_pose: npt.ArrayLike | None = None
+    ) -> dict[str, _FloatArray]:
+        """Every link's ``(4, 4)`` pose (link frame to world) at ``q``, the root at ``base_pose``."""
+    def clamp(self, q: npt.ArrayLike) -> _FloatArray:
+        """Return ``q`` clamped into the joint limits."""
+    def link_mesh(self, link: str) -> Mesh | None:
+        """Return the collision mesh of ``link`` in its own frame (``None`` without geometry)."""
+    def self_collisions(self, q: npt.ArrayLike) -> list[tuple[str, str]]:
+        """Return the pairs of non-adjacent links whose exact meshes intersect at ``q``."""
+    def self_filter(
+        self, q: npt.ArrayLike, padding: float = 0.01, base_pose: npt.ArrayLike | None = None
+    ) -> SelfFilter:
+        """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame)."""
+
+@final
+class LinkCollision:
+    """One link's part of a :class:`RobotCollisionResult`."""
+
+    @property
+    def link(self) -> str:
+        """The link's name."""
+    @property
+    def probability(self) -> float:
+        """The link's collision probability (0 when the broad phase skipped it)."""
+    @property
+    def state(self) -> _StateName:
+        """The link's state."""
+    @property
+    def queried(self) -> bool:
+        """Whether the link was queried (it passed the broad phase)."""
+    @property
+    def result(self) -> CollisionResult | None:
+        """The link's full query result (side A: the link's sample), ``None`` when skipped."""
+
+@final
+class RobotCollisionResult:
+    """The answer of :func:`collide_robot`."""
+
+    @property
+    def probability(self) -> float:
+        """The robot's collision probability with the environment (links aggregated as points are)."""
+    @property
+    def state(self) -> _StateName:
+        """The state from ``probability`` and the thresholds."""
+    @property
+    def links(self) -> dict[str, LinkCollision]:
+        """Per link with geometry, by name (URDF order)."""
+    @property
+    def regions(self) -> list[tuple[str, ContactRegion]]:
+        """Contact regions of every queried link, as ``(link name, region)``."""
+    @property
+    def self_collisions(self) -> list[tuple[str, str]]:
+        """Pairs of non-adjacent links that intersect; not part of ``probability``."""
+    @property
+    def stats(self) -> dict[str, int | float]:
+        """Counters and timings of the query.
+
+        Keys: ``links_with_geometry``, ``links_queried``, ``broad_phase_nodes``,
+        ``self_pairs_checked``, ``node_pairs_visited`` (int), ``time_seconds`` (float).
+        """
+
+@final
+class RobotBatchResult:
+    """The answer of :func:`collide_robot_many`: arrays over the configurations."""
+
+    @property
+    def probabilities(self) -> _FloatArray:
+        """Collision probabilities, shape ``(m,)``."""
+    @property
+    def states(self) -> npt.NDArray[np.str_]:
+        """States, shape ``(m,)``."""
+    @property
+    def self_colliding(self) -> npt.NDArray[np.bool_]:
+        """Whether non-adjacent links intersect, shape ``(m,)``."""
+    @property
+    def link_probabilities(self) -> _FloatArray:
+        """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order."""
+    def __len__(self) -> int: ...
+
+@final
+class MotionResult:
+    """The answer of :func:`check_motion`."""
+
+    @property
+    def safe(self) -> bool:
+        """Whether every checked state is safe."""
+    @property
+    def probability(self) -> float:
+        """The largest collision probability of the states checked."""
+    @property
+    def first_unsafe(self) -> float | None:
+        """Fraction along the motion of the first unsafe state, or ``None``."""
+    @property
+    def state(self) -> _StateName:
+        """The state at the first unsafe state, or the worst state's when safe."""
+    @property
+    def states_checked(self) -> int:
+        """States checked (the check stops at the first unsafe one)."""
+    @property
+    def states_total(self) -> int:
+        """States the motion was divided into, both ends included."""
+    @property
+    def resolution(self) -> float:
+        """The largest displacement (metres) of a link point between two states."""
+
+def collide_robot(
+    robot: Robot,
+    q: npt.ArrayLike,
+    cloud: PointCloud,
+    base_pose: npt.ArrayLike | None = None,
+    **options: Any,
+) -> RobotCollisionResult:
+    """Query the robot at configuration ``q`` (root at ``base_pose``) against a cloud.
+
+    Each link with geometry is sampled once per spacing (``mesh_spacing``, default
+    half the cloud's median spacing) into a cloud without sensor noise. A broad
+    phase (``broad_phase=True``) skips links whose bounding box is beyond the noise's
+    reach of every node of the cloud's hierarchy: their query would read 0. Every
+    other link is queried as :func:`collide` does. Self-collision between
+    non-adjacent links (exact meshes, ``self_collision=True``) is reported apart.
+    ``options`` are those of :func:`collide` plus ``mesh_spacing``,
+    ``broad_phase`` and ``self_collision``; unknown names raise
+    :class:`InvalidInputError`. The GIL is released.
+    """
+
+def collide_robot_many(
+    robot: Robot,
+    qs: npt.ArrayLike,
+    cloud: PointCloud,
+    base_pose: npt.ArrayLike | None = None,
+    **options: Any,
+) -> RobotBatchResult:
+    """:func:`collide_robot` for each row of the ``(m, dof)`` array ``qs``, in parallel, GIL released."""
+
+def check_motion(
+    robot: Robot,
+    q0: npt.ArrayLike,
+    q1: npt.ArrayLike,
+    cloud: PointCloud,
+    base_pose: npt.ArrayLike | None = None,
+    **options: Any,
+) -> MotionResult:
+    """Check the straight joint-space motion from ``q0`` to ``q1`` against the cloud.
+
+    States ``q0 + t (q1 - q0)`` at ``t = i / n`` are checked in order, ``n`` the
+    smallest count for which no link point moves more than ``resolution`` metres
+    between two states (default: the cloud's median noise standard deviation, or half
+    its median spacing without noise); the check stops at the first unsafe state
+    (probability above ``max_probability``, default ``threshold_free``, or
+    self-collision). ``options``: those of :func:`collide_robot` plus
+    ``resolution`` and ``max_probability``.
+    """
