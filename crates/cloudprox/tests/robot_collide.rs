@@ -7,6 +7,7 @@ use cloudprox::prelude::*;
 use cloudprox::query::collide::mesh_sampling_spacing;
 use cloudprox::robot::{
     check_motion, collide_robot, collide_robot_many, MotionRequest, RobotRequest,
+    LINK_SAMPLING_SEED,
 };
 use cloudprox::sample::box_surface;
 use robot_common::{arm, wall};
@@ -117,8 +118,8 @@ fn robot_result_equals_the_per_link_collide_calls() {
     let mut max_p: f64 = 0.0;
     for entry in &r.links {
         let mesh = &robot.links()[entry.link].geometry.as_ref().unwrap().mesh;
-        // Each link is sampled as collide_mesh_cloud does, seeded by its index.
-        let sample = PointCloud::from_mesh(mesh, spacing, entry.link as u64).unwrap();
+        // Each link is sampled as collide_mesh_cloud does.
+        let sample = PointCloud::from_mesh(mesh, spacing, LINK_SAMPLING_SEED).unwrap();
         let direct = collide(
             &poses[entry.link],
             &sample,

@@ -141,6 +141,10 @@ impl LinkGeometry {
     }
 }
 
+/// Seed of every link's sampling: the seed [`crate::query::collide_mesh_cloud`]
+/// and the Python `collide` use for a mesh, so a link's query equals theirs.
+pub const LINK_SAMPLING_SEED: u64 = 0;
+
 /// The clouds that stand for the links in a query, sampled at one spacing.
 #[derive(Debug)]
 pub(crate) struct LinkSamples {
@@ -154,9 +158,9 @@ impl LinkSamples {
     pub(crate) fn new(links: &[super::Link], spacing: Real) -> Result<Self> {
         let mut clouds = Vec::with_capacity(links.len());
         let mut spacing_max = Vec::with_capacity(links.len());
-        for (i, link) in links.iter().enumerate() {
+        for link in links {
             if let Some(g) = &link.geometry {
-                let cloud = PointCloud::from_mesh(&g.mesh, spacing, i as u64)
+                let cloud = PointCloud::from_mesh(&g.mesh, spacing, LINK_SAMPLING_SEED)
                     .map_err(|e| Error::invalid(format!("link '{}': {e}", link.name)))?;
                 let _ = cloud.bvh();
                 spacing_max.push(cloud.spacing().iter().copied().fold(0.0, Real::max));

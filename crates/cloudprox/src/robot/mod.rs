@@ -23,7 +23,7 @@ mod motion;
 mod query;
 mod urdf;
 
-pub use geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS};
+pub use geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS, LINK_SAMPLING_SEED};
 pub use model::{Joint, JointKind, Link, Mimic, Robot};
 pub use motion::{check_motion, MotionRequest, MotionResult};
 pub use query::{

@@ -1,0 +1,347 @@
+"""Robots against sensor clouds: URDF loading, kinematics, queries, motions, bad input.
+
+The arm of :mod:`tests.robots` has hand-computed poses; the Franka Panda (URDF and
+collision meshes from a pinned PyPI wheel) is checked against yourdfpy's forward
+kinematics. The Panda test skips when PyPI cannot be reached, except on CI
+(``CI=true``), where it fails.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cloudprox as cp
+from tests.realfiles import RealFileUnavailable
+from tests.robots import ARM_URDF, arm_poses, panda_urdf, wall
+
+SIGMA = 0.002
+
+
+@pytest.fixture(scope="module")
+def arm_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("arm") / "arm.urdf"
+    path.write_text(ARM_URDF)
+    return path
+
+
+@pytest.fixture(scope="module")
+def arm(arm_path: Path) -> cp.Robot:
+    return cp.Robot.from_urdf(arm_path)
+
+
+@pytest.fixture(scope="module")
+def panda() -> tuple[cp.Robot, Path]:
+    try:
+        path = panda_urdf()
+    except RealFileUnavailable as exc:
+        if os.environ.get("CI") == "true":
+            pytest.fail(f"CI=true: the Panda URDF must be fetched, but {exc}")
+        pytest.skip(f"Panda URDF unavailable: {exc}")
+    return cp.Robot.from_urdf(path), path
+
+
+def wall_cloud(x0: float = 0.40, seed: int = 1) -> cp.PointCloud:
+    return cp.PointCloud(wall(x0, 0.3, 0.1, SIGMA, seed), sigma=SIGMA)
+
+
+def rigid(rotvec: tuple[float, float, float], t: tuple[float, float, float]) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    m = np.eye(4)
+    m[:3, :3] = Rotation.from_rotvec(rotvec).as_matrix()
+    m[:3, 3] = t
+    return m
+
+
+# ------------------------------------------------------------------ the model
+
+
+def test_arm_names_and_limits(arm: cp.Robot) -> None:
+    assert arm.name == "arm"
+    assert arm.dof == 4
+    assert arm.joint_names == ["j1", "j2", "j3", "j5"]
+    assert arm.link_names == ["base", "link1", "link2", "link3", "link4", "tool", "wheel"]
+    np.testing.assert_array_equal(arm.joint_limits, [[-3, 3], [-2, 2], [0, 0.1], [-np.inf, np.inf]])
+    assert arm.link_mesh("wheel") is None
+    assert arm.link_mesh("base").volume == pytest.approx(0.004, abs=1e-12)
+    assert ("base", "link2") in arm.self_collision_pairs
+    assert ("link1", "link2") in arm.ignored_pairs
+
+
+@pytest.mark.parametrize(
+    "q", [[0, 0, 0, 0], [0.7, -0.4, 0.05, 2.0], [-2.5, 1.9, 0.1, -7.0], [3.0, -2.0, 0.0, 1e2]]
+)
+def test_arm_link_poses_match_hand_computed_ones(arm: cp.Robot, q: list[float]) -> None:
+    poses = arm.link_poses(q)
+    expected = arm_poses(np.asarray(q, dtype=float))
+    assert list(poses) == arm.link_names
+    for name, m in expected.items():
+        np.testing.assert_allclose(poses[name], m, atol=1e-12, err_msg=name)
+    base = rigid((0.1, -0.2, 0.3), (1.0, 2.0, -0.5))
+    moved = arm.link_poses(q, base_pose=base)
+    for name, m in expected.items():
+        np.testing.assert_allclose(moved[name], base @ m, atol=1e-12, err_msg=name)
+
+
+def test_panda_link_poses_match_yourdfpy(panda: tuple[cp.Robot, Path]) -> None:
+    import yourdfpy
+
+    robot, path = panda
+    ref = yourdfpy.URDF.load(
+        str(path),
+        load_meshes=False,
+        build_collision_scene_graph=False,
+        load_collision_meshes=False,
+    )
+    assert robot.joint_names == list(ref.actuated_joint_names)
+    assert robot.dof == 9
+    limits = robot.joint_limits
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        q = rng.uniform(limits[:, 0], limits[:, 1])
+        ref.update_cfg(q)
+        poses = robot.link_poses(q)
+        for name in robot.link_names:
+            np.testing.assert_allclose(
+                poses[name], ref.get_transform(name, "world"), atol=1e-9, err_msg=name
+            )
+
+
+def test_panda_geometry_is_its_collision_meshes(panda: tuple[cp.Robot, Path]) -> None:
+    robot, path = panda
+    stl = cp.io.read_mesh(path.parent / "meshes" / "collision" / "link1.stl")
+    mesh = robot.link_mesh("panda_link1")
+    assert mesh is not None
+    np.testing.assert_allclose(mesh.vertices, stl.vertices)
+    # The fingers are siblings under the hand: a tree, not a chain.
+    assert ("panda_hand", "panda_leftfinger") in robot.ignored_pairs
+    assert robot.link_mesh("panda_link8") is None
+
+
+# ------------------------------------------------------------------ queries
+
+
+def test_a_link_pushed_into_a_wall_collides(arm: cp.Robot) -> None:
+    cloud = wall_cloud()
+    free = cp.collide_robot(arm, [0, 0, 0, 0], cloud)
+    assert free.state == "free"
+    hit = cp.collide_robot(arm, [0, 0, 0.1, 0], cloud)
+    assert hit.state == "collision"
+    links = hit.links
+    assert list(links) == ["base", "link1", "link2", "link3", "link4", "tool"]
+    assert links["link3"].probability > 0.99 and links["link3"].queried
+    assert not links["base"].queried and links["base"].probability == 0.0
+    assert links["base"].result is None
+    full = links["link3"].result
+    assert full is not None and full.probability == links["link3"].probability
+    assert hit.regions and all(name == "link3" for name, _ in hit.regions if _.probability > 0.9)
+    for _, region in hit.regions:
+        assert abs(region.point[0] - 0.40) < 0.03
+    assert hit.self_collisions == []
+    assert hit.stats["links_with_geometry"] == 6
+
+
+def test_far_from_the_cloud_no_link_is_queried(arm: cp.Robot) -> None:
+    r = cp.collide_robot(arm, [0.4, -0.3, 0.05, 0.0], wall_cloud(x0=5.0))
+    assert r.probability == 0.0 and r.state == "free"
+    assert r.stats["links_queried"] == 0
+    assert r.stats["broad_phase_nodes"] == 6  # one hierarchy root per link
+
+
+def test_broad_phase_changes_the_cost_not_the_answer(arm: cp.Robot) -> None:
+    cloud = wall_cloud(seed=3)
+    qs = np.array([[0, 0, c, 0] for c in np.linspace(0.0, 0.1, 9)] + [[1.5, 0, 0.1, 0]])
+    with_bp = cp.collide_robot_many(arm, qs, cloud)
+    without = cp.collide_robot_many(arm, qs, cloud, broad_phase=False)
+    np.testing.assert_array_equal(with_bp.probabilities, without.probabilities)
+    np.testing.assert_array_equal(with_bp.link_probabilities, without.link_probabilities)
+
+
+def test_collide_robot_equals_the_per_link_collide_calls(arm: cp.Robot) -> None:
+    cloud = wall_cloud(seed=4)
+    q = [0.05, 0.02, 0.07, 0.0]
+    r = cp.collide_robot(arm, q, cloud, broad_phase=False)
+    poses = arm.link_poses(q)
+    for name, link in r.links.items():
+        mesh = arm.link_mesh(name)
+        assert mesh is not None
+        # The link is sampled as collide samples a mesh (same spacing and seed).
+        direct = cp.collide(mesh, cloud, pose_a=poses[name])
+        assert direct.probability == link.probability, name
+        assert direct.state == link.state, name
+    assert r.probability == max(link.probability for link in r.links.values())
+
+
+def test_a_common_rigid_motion_of_base_and_cloud_changes_nothing(arm: cp.Robot) -> None:
+    pts = wall(0.40, 0.3, 0.1, SIGMA, 5)
+    motion = rigid((0.3, -0.5, 0.9), (0.7, -1.2, 0.4))
+    moved = pts @ motion[:3, :3].T + motion[:3, 3]
+    a_cloud = cp.PointCloud(pts, sigma=SIGMA)
+    b_cloud = cp.PointCloud(moved, sigma=SIGMA)
+    for q in ([0, 0, 0.065, 0], [0, 0, 0.1, 0], [0.3, 0.1, 0.02, 0]):
+        a = cp.collide_robot(arm, q, a_cloud)
+        b = cp.collide_robot(arm, q, b_cloud, base_pose=motion)
+        assert a.probability == pytest.approx(b.probability, abs=1e-6)
+        assert a.state == b.state
+
+
+def test_collide_robot_many_equals_a_loop(arm: cp.Robot) -> None:
+    cloud = wall_cloud(seed=6)
+    t = np.linspace(0.0, 1.0, 12)
+    qs = np.column_stack([0.3 * (t - 0.5), 0.1 * t, 0.1 * t, np.zeros_like(t)])
+    many = cp.collide_robot_many(arm, qs, cloud)
+    assert len(many) == 12
+    assert many.probabilities.shape == (12,)
+    assert many.states.shape == (12,)
+    assert many.link_probabilities.shape == (12, len(arm.link_names))
+    assert many.self_colliding.shape == (12,) and not many.self_colliding.any()
+    for i, q in enumerate(qs):
+        one = cp.collide_robot(arm, q, cloud)
+        assert one.probability == many.probabilities[i]
+        assert one.state == many.states[i]
+        for j, name in enumerate(arm.link_names):
+            expected = one.links[name].probability if name in one.links else 0.0
+            assert many.link_probabilities[i, j] == expected
+    assert {"free", "collision"} <= set(many.states)
+
+
+def obstacle() -> cp.PointCloud:
+    """A small noisy box surface in link2's way when j1 = 0, centred at (0.2, 0, 0.3)."""
+    pts = cp.sample_box_surface((0.01, 0.01, 0.05), 0.005, center=(0.2, 0.0, 0.3))
+    return cp.PointCloud(cp.add_noise(pts, SIGMA, seed=7), sigma=SIGMA)
+
+
+def test_check_motion_finds_a_collision_between_two_free_waypoints(arm: cp.Robot) -> None:
+    cloud = obstacle()
+    q0, q1 = np.array([-0.6, 0, 0, 0]), np.array([0.6, 0, 0, 0])
+    assert cp.collide_robot(arm, q0, cloud).state == "free"
+    assert cp.collide_robot(arm, q1, cloud).state == "free"
+    m = cp.check_motion(arm, q0, q1, cloud)
+    assert not m.safe and m.first_unsafe is not None
+    assert m.probability > 0.1
+    assert m.resolution == pytest.approx(SIGMA)
+    assert m.states_checked < m.states_total
+    # A fine brute-force sweep of the motion's first half (the obstacle is at
+    # its middle); decide_only keeps whether P exceeds 0.1.
+    s = np.linspace(0.0, 0.5, 1001)
+    sweep = cp.collide_robot_many(arm, q0 + s[:, None] * (q1 - q0), cloud, decide_only=True)
+    first = s[np.argmax(sweep.probabilities > 0.1)]
+    assert abs(m.first_unsafe - first) <= 1.0 / (m.states_total - 1) + 1.0 / 2000
+    # Off the path, the same motion is safe and checked to the end.
+    away = cp.PointCloud(cloud.points + np.array([0.0, 0.0, 0.5]), sigma=SIGMA)
+    m = cp.check_motion(arm, q0, q1, away)
+    assert m.safe and m.first_unsafe is None and m.states_checked == m.states_total
+    # A coarser resolution checks fewer states.
+    coarse = cp.check_motion(arm, q0, q1, away, resolution=0.02)
+    assert coarse.states_total < m.states_total
+
+
+def test_self_collision_on_a_folded_arm(arm: cp.Robot) -> None:
+    folded = [0.0, np.pi / 2, 0.0, 0.0]
+    assert ("base", "link2") in arm.self_collisions(folded)
+    assert arm.self_collisions([0.0, 1.0, 0.0, 0.0]) == []
+    r = cp.collide_robot(arm, folded, wall_cloud(x0=5.0))
+    assert r.probability == 0.0  # reported apart from the environment
+    assert ("base", "link2") in r.self_collisions
+    r = cp.collide_robot(arm, folded, wall_cloud(x0=5.0), self_collision=False)
+    assert r.self_collisions == []
+
+
+def test_the_self_filter_removes_a_sampled_link(arm: cp.Robot) -> None:
+    q = [0.4, -0.3, 0.05, 0.0]
+    base = rigid((0.0, 0.0, 0.2), (0.1, 0.2, 0.0))
+    pose = arm.link_poses(q, base_pose=base)["link2"]
+    mesh = arm.link_mesh("link2")
+    assert mesh is not None
+    on_link, _, _ = mesh.sample(2000, seed=3)
+    on_link = on_link @ pose[:3, :3].T + pose[:3, 3]
+    far = np.column_stack([np.linspace(1.0, 1.5, 50), np.zeros(50), np.zeros(50)])
+    keep = arm.self_filter(q, padding=0.005, base_pose=base).apply(np.vstack([on_link, far]))
+    np.testing.assert_array_equal(keep, np.arange(2000, 2050))
+
+
+def test_panda_against_a_table(panda: tuple[cp.Robot, Path]) -> None:
+    robot, _ = panda
+    # A table top at z = 0.25 in front of the robot (x 0.35..0.95, y -0.3..0.3).
+    gx, gy = np.arange(0.35, 0.95, 0.01), np.arange(-0.3, 0.3, 0.01)
+    xx, yy = np.meshgrid(gx, gy, indexing="ij")
+    table = np.column_stack([xx.ravel(), yy.ravel(), np.full(xx.size, 0.25)])
+    cloud = cp.PointCloud(cp.add_noise(table, SIGMA, seed=9), sigma=SIGMA)
+    # The hand 23 cm above the table, and the fingers 8 cm into it.
+    up = np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8, 0.02, 0.02])
+    down = np.array([0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02, 0.02])
+    r_up = cp.collide_robot(robot, up, cloud)
+    r_down = cp.collide_robot(robot, down, cloud)
+    assert r_up.state == "free"
+    assert r_down.state == "collision"
+    assert r_down.links["panda_link0"].queried is False
+    m = cp.check_motion(robot, up, down, cloud)
+    assert not m.safe and 0.0 < m.first_unsafe < 1.0
+
+
+# ------------------------------------------------------------------ bad input
+
+
+def test_bad_configurations_name_the_joint(arm: cp.Robot) -> None:
+    cloud = obstacle()
+    with pytest.raises(cp.InvalidInputError, match=r"expected 4, got 3"):
+        cp.collide_robot(arm, [0, 0, 0], cloud)
+    with pytest.raises(cp.InvalidInputError, match=r"joint 'j2'.*outside its limits"):
+        arm.link_poses([0, 2.5, 0, 0])
+    with pytest.raises(cp.InvalidInputError, match=r"joint 'j3'.*not finite"):
+        cp.collide_robot(arm, [0, 0, np.nan, 0], cloud)
+    with pytest.raises(cp.InvalidInputError, match=r"configuration 1.*j1"):
+        cp.collide_robot_many(arm, [[0, 0, 0, 0], [4, 0, 0, 0]], cloud)
+    with pytest.raises(cp.InvalidInputError, match=r"shape \(m, 4\)"):
+        cp.collide_robot_many(arm, np.zeros((3, 5)), cloud)
+    with pytest.raises(cp.InvalidInputError, match=r"q1.*j2"):
+        cp.check_motion(arm, [0, 0, 0, 0], [0, 3, 0, 0], cloud)
+    np.testing.assert_array_equal(arm.clamp([5, -5, 0.5, 9]), [3, -2, 0.1, 9])
+
+
+def test_bad_options_and_arguments(arm: cp.Robot) -> None:
+    cloud = obstacle()
+    with pytest.raises(cp.InvalidInputError, match=r"unknown option 'resolution'"):
+        cp.collide_robot(arm, [0, 0, 0, 0], cloud, resolution=0.01)
+    with pytest.raises(cp.InvalidInputError, match=r"unknown option 'nope'.*broad_phase"):
+        cp.collide_robot(arm, [0, 0, 0, 0], cloud, nope=1)
+    with pytest.raises(cp.InvalidInputError, match=r"mesh_spacing"):
+        cp.collide_robot(arm, [0, 0, 0, 0], cloud, mesh_spacing=-1.0)
+    with pytest.raises(cp.InvalidInputError, match=r"resolution"):
+        cp.check_motion(arm, [0, 0, 0, 0], [0.1, 0, 0, 0], cloud, resolution=0.0)
+    with pytest.raises(TypeError, match="PointCloud"):
+        cp.collide_robot(arm, [0, 0, 0, 0], np.zeros((10, 3)))
+    with pytest.raises(TypeError, match="Robot"):
+        cp.collide_robot("arm", [0, 0, 0, 0], cloud)
+
+
+def test_bad_urdf_files(tmp_path: Path) -> None:
+    missing = tmp_path / "missing.urdf"
+    with pytest.raises(FileNotFoundError):
+        cp.Robot.from_urdf(missing)
+    mesh_urdf = tmp_path / "m.urdf"
+    mesh_urdf.write_text(
+        '<robot name="m"><link name="base"><collision><geometry>'
+        '<mesh filename="package://pkg/meshes/part.stl"/></geometry></collision></link></robot>'
+    )
+    with pytest.raises(FileNotFoundError, match=r"link 'base'.*package_dirs"):
+        cp.Robot.from_urdf(mesh_urdf)
+    part = tmp_path / "share" / "pkg" / "meshes" / "part.stl"
+    part.parent.mkdir(parents=True)
+    cp.io.write_mesh(part, cp.Mesh.cuboid(0.1, 0.1, 0.1))
+    robot = cp.Robot.from_urdf(mesh_urdf, package_dirs=[tmp_path / "share"])
+    assert robot.dof == 0 and robot.link_names == ["base"]
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'>")
+    with pytest.raises(cp.FormatError, match=r"bad.urdf.*URDF"):
+        cp.Robot.from_urdf(bad)
+    bad.write_text(ARM_URDF.replace('type="continuous"', 'type="planar"'))
+    with pytest.raises(cp.FormatError, match=r"joint 'j5'.*not supported"):
+        cp.Robot.from_urdf(bad)
+    bad.write_text(ARM_URDF.replace('<mimic joint="j3"', '<mimic joint="j9"'))
+    with pytest.raises(cp.FormatError, match=r"j4.*j9"):
+        cp.Robot.from_urdf(bad)
