@@ -270,6 +270,159 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------ robot
+
+
+def read_configurations(text: str | None, path: str | None, dof: int) -> np.ndarray:
+    """Return the configurations of ``cloudprox robot`` as an ``(m, dof)`` array.
+
+    Parameters
+    ----------
+    text : str, optional
+        One configuration, ``dof`` numbers separated by commas or spaces (``--q``).
+    path : str, optional
+        A ``.npy`` file of shape ``(m, dof)`` or ``(dof,)``, or a CSV / text file with
+        one configuration per line (``--q-file``; ``#`` starts a comment).
+    dof : int
+        The robot's number of configuration entries.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(m, dof)``, float64.
+
+    Raises
+    ------
+    CliError
+        If neither or both are given, a file cannot be parsed, or a row has the
+        wrong length.
+    """
+    if (text is None) == (path is None):
+        raise CliError("give exactly one of --q and --q-file")
+    if text is not None:
+        try:
+            q = np.array([float(v) for v in text.replace(",", " ").split()], dtype=float)
+        except ValueError:
+            raise CliError(f"--q: not a list of numbers: {text!r}") from None
+        qs = q.reshape(1, -1)
+        what = "--q"
+    else:
+        assert path is not None
+        what = f"--q-file {path}"
+        if not Path(path).is_file():
+            raise CliError(f"{path}: no such file")
+        try:
+            if path.lower().endswith(".npy"):
+                qs = np.load(path, allow_pickle=False)
+            else:
+                qs = np.loadtxt(path, delimiter=None if "," not in Path(path).read_text() else ",")
+        except (ValueError, OSError) as e:
+            raise CliError(f"{what}: cannot read configurations: {e}") from None
+        qs = np.atleast_2d(np.asarray(qs, dtype=float))
+    if qs.ndim != 2 or qs.shape[1] != dof or qs.shape[0] == 0:
+        raise CliError(
+            f"{what}: expected configurations of {dof} joint values, got shape {qs.shape}"
+        )
+    return qs
+
+
+def _cmd_robot(args: argparse.Namespace) -> int:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    from cloudprox import Robot, collide_robot, collide_robot_many
+    from cloudprox.pipeline import PipelineError, load_side, parse_filter, parse_pose
+
+    robot = Robot.from_urdf(args.urdf, package_dirs=args.package_dir or None)
+    qs = read_configurations(args.q, args.q_file, robot.dof)
+    try:
+        sensor = _sensor_spec(args)
+        steps = [parse_filter(f) for f in args.filter]
+        side = load_side(args.scan, sensor, steps)
+        base = None if args.base_pose is None else parse_pose(args.base_pose, "--base-pose")
+    except (PipelineError, FileNotFoundError) as e:
+        raise CliError(str(e)) from None
+    if side.cloud is None:
+        raise CliError(f"{args.scan}: the scan must be a point cloud, not a mesh")
+    options: dict[str, Any] = {"mesh_spacing": args.mesh_spacing}
+    if args.q is not None:
+        result = collide_robot(robot, qs[0], side.cloud, base, **options)
+        if args.json:
+            doc = {
+                "probability": result.probability,
+                "state": result.state,
+                "links": {
+                    name: {
+                        "probability": link.probability,
+                        "state": link.state,
+                        "queried": link.queried,
+                    }
+                    for name, link in result.links.items()
+                },
+                "self_collisions": [list(p) for p in result.self_collisions],
+                "stats": result.stats,
+            }
+            print(json.dumps(doc, indent=2))
+            return 0
+        console = _console()
+        style = {"free": "green", "contact": "yellow", "collision": "red"}[result.state]
+        console.print(
+            f"{robot.name}: {robot.dof} joints, {len(result.links)} links with geometry; "
+            f"{args.scan}: {len(side.cloud)} points"
+        )
+        console.print(
+            f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
+            f"links queried: {result.stats['links_queried']}   "
+            f"time: {1e3 * result.stats['time_seconds']:.2f} ms"
+        )
+        for name, link in result.links.items():
+            if link.queried:
+                console.print(f"  {name}: P = {link.probability:.3g} ({link.state})")
+        if result.self_collisions:
+            pairs = ", ".join(f"{a}-{b}" for a, b in result.self_collisions)
+            console.print(f"self-collision: {pairs}")
+        return 0
+    chunk = 256
+    parts = []
+    with Progress(
+        TextColumn("[progress.description]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        console=_console(stderr=True),
+        transient=True,
+        disable=args.json,
+    ) as progress:
+        task = progress.add_task("configurations", total=len(qs))
+        for start in range(0, len(qs), chunk):
+            parts.append(
+                collide_robot_many(robot, qs[start : start + chunk], side.cloud, base, **options)
+            )
+            progress.update(task, advance=len(parts[-1]))
+    probabilities = np.concatenate([p.probabilities for p in parts])
+    states = np.concatenate([p.states for p in parts])
+    links = np.vstack([p.link_probabilities for p in parts])
+    selfc = np.concatenate([p.self_colliding for p in parts])
+    if args.json:
+        doc = {
+            "configurations": len(qs),
+            "probabilities": probabilities.tolist(),
+            "states": states.tolist(),
+            "self_colliding": selfc.tolist(),
+            "link_names": robot.link_names,
+            "link_probabilities": links.tolist(),
+        }
+        print(json.dumps(doc, indent=2))
+        return 0
+    console = _console()
+    counts = {s: int(np.sum(states == s)) for s in ("free", "contact", "collision")}
+    console.print(
+        f"{len(qs)} configurations: {counts['free']} free, {counts['contact']} contact, "
+        f"{counts['collision']} collision, {int(selfc.sum())} self-colliding"
+    )
+    for i, (p, s) in enumerate(zip(probabilities, states)):
+        console.print(f"  {i}: P = {p:.6g}  {s}{'  self-collision' if selfc[i] else ''}")
+    return 0
+
+
 # ------------------------------------------------------------------------ example
 
 
@@ -642,6 +795,73 @@ def _parser() -> argparse.ArgumentParser:
     col.add_argument("--json", action="store_true", help="print the result as JSON")
     col.set_defaults(func=_cmd_collide)
 
+    rob = sub.add_parser(
+        "robot",
+        help="a URDF robot at one or many configurations against a scan",
+        description=(
+            "The robot of URDF at the configuration --q (or each row of --q-file) against "
+            "the point-cloud file SCAN, with the scan's noise from --sigma, --sensor or the "
+            "file's covariances, after the --filter steps."
+        ),
+    )
+    rob.add_argument("urdf", metavar="URDF", help="the robot's URDF file")
+    rob.add_argument("scan", metavar="SCAN", help="point-cloud file of the environment")
+    rob.add_argument(
+        "--q", default=None, help="one configuration: joint values separated by commas"
+    )
+    rob.add_argument(
+        "--q-file",
+        default=None,
+        metavar="FILE",
+        help="many configurations: .npy (m, dof) or CSV/text, one per line",
+    )
+    rob.add_argument(
+        "--base-pose",
+        default=None,
+        metavar="POSE",
+        help="pose of the robot's root link in the scan's frame (as --pose-a of collide)",
+    )
+    rob.add_argument(
+        "--package-dir",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="folder searched for package:// mesh URIs (repeatable)",
+    )
+    rob.add_argument(
+        "--sigma", type=float, default=None, help="isotropic noise standard deviation (metres)"
+    )
+    rob.add_argument("--sensor", choices=["isotropic", "depth-camera", "stereo", "lidar"])
+    rob.add_argument("--preset", choices=["khoshelham-2012", "nguyen-2012"])
+    rob.add_argument("--origin", metavar="X,Y,Z", help="sensor origin in the scan's frame")
+    rob.add_argument("--sensor-pose", metavar="POSE", help="sensor pose (default: VIEWPOINT)")
+    rob.add_argument(
+        "--filter", action="append", default=[], metavar="STEP", help="filter step (as collide)"
+    )
+    rob.add_argument(
+        "--mesh-spacing",
+        type=float,
+        default=None,
+        help="sampling spacing of the links (m; default half the scan's spacing)",
+    )
+    rob.add_argument("--json", action="store_true", help="print the result as JSON")
+    rob.set_defaults(
+        func=_cmd_robot,
+        **dict.fromkeys(
+            (
+                "axial_offset",
+                "axial_quadratic",
+                "axial_depth0",
+                "focal_px",
+                "sigma_px",
+                "baseline",
+                "sigma_disparity_px",
+                "sigma_range",
+                "sigma_angle",
+            )
+        ),
+    )
+
     ex = sub.add_parser(
         "example",
         help="write example files: a depth-camera scan (PCD), a gripper (STL), two grasp poses",
@@ -720,7 +940,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_usage(sys.stderr)
         print(
             "cloudprox: error: a command is required "
-            "(demo, collide, info, example, bench or reproduce)",
+            "(demo, collide, robot, info, example, bench or reproduce)",
             file=sys.stderr,
         )
         return 2
