@@ -8,7 +8,13 @@ kinematics. The Panda test skips when PyPI cannot be reached, except on CI
 
 from __future__ import annotations
 
+import contextlib
+import io
+import json
 import os
+import re
+import shlex
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -345,3 +351,126 @@ def test_bad_urdf_files(tmp_path: Path) -> None:
     bad.write_text(ARM_URDF.replace('<mimic joint="j3"', '<mimic joint="j9"'))
     with pytest.raises(cp.FormatError, match=r"j4.*j9"):
         cp.Robot.from_urdf(bad)
+
+
+# ------------------------------------------------------------------ command line
+
+
+def _scan_file(path: Path) -> Path:
+    """The wall in front of the arm's tip as an XYZ file (noise given by --sigma)."""
+    np.savetxt(path, wall(0.40, 0.3, 0.1, SIGMA, 11))
+    return path
+
+
+def test_cli_one_configuration(
+    arm_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from cloudprox.cli import main
+
+    scan = _scan_file(tmp_path / "wall.xyz")
+    args = ["robot", str(arm_path), str(scan), "--sigma", str(SIGMA)]
+    assert main([*args, "--q", "0,0,0,0"]) == 0
+    assert "state: free" in capsys.readouterr().out
+    assert main([*args, "--q", "0,0,0.1,0", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["state"] == "collision"
+    assert doc["links"]["link3"]["probability"] > 0.99
+    assert doc["links"]["base"]["queried"] is False
+    # A base pose moving the arm 1 m away from the wall.
+    assert main([*args, "--q", "0,0,0.1,0", "--base-pose=-1,0,0", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["probability"] == 0.0
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npy", ".txt"])
+def test_cli_many_configurations(
+    arm_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], suffix: str
+) -> None:
+    from cloudprox.cli import main
+
+    scan = _scan_file(tmp_path / "wall.xyz")
+    qs = np.array([[0, 0, c, 0] for c in (0.0, 0.05, 0.1)])
+    qfile = tmp_path / f"qs{suffix}"
+    if suffix == ".npy":
+        np.save(qfile, qs)
+    else:
+        np.savetxt(qfile, qs, delimiter="," if suffix == ".csv" else " ")
+    args = ["robot", str(arm_path), str(scan), "--sigma", str(SIGMA), "--q-file", str(qfile)]
+    assert main([*args, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    expected = cp.collide_robot_many(
+        cp.Robot.from_urdf(arm_path),
+        qs,
+        cp.PointCloud(wall(0.40, 0.3, 0.1, SIGMA, 11), sigma=SIGMA),
+    )
+    # The XYZ file holds the points to its printed precision: same states.
+    assert doc["states"] == expected.states.tolist()
+    assert doc["link_names"] == cp.Robot.from_urdf(arm_path).link_names
+    assert np.shape(doc["link_probabilities"]) == (3, 7)
+    assert main(args) == 0
+    assert "3 configurations: 2 free, 0 contact, 1 collision" in capsys.readouterr().out
+
+
+def test_cli_errors_exit_2(
+    arm_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from cloudprox.cli import main
+
+    scan = _scan_file(tmp_path / "wall.xyz")
+    base = ["robot", str(arm_path), str(scan), "--sigma", str(SIGMA)]
+    for extra, message in (
+        (["--q", "0,0"], "expected configurations of 4 joint values"),
+        (["--q", "0,5,0,0"], "joint 'j2'"),
+        ([], "exactly one of --q and --q-file"),
+        (["--q", "a,b,c,d"], "not a list of numbers"),
+        (["--q-file", str(tmp_path / "none.csv")], "no such file"),
+    ):
+        assert main([*base, *extra]) == 2
+        assert message in capsys.readouterr().err
+    assert main(["robot", str(tmp_path / "none.urdf"), str(scan), "--q", "0,0,0,0"]) == 2
+    assert "none.urdf" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ README
+
+
+def _readme_block(tag: str) -> str:
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    m = re.search(rf"<!-- readme-test: {tag} -->\n```\w+\n(.*?)```", text, re.S)
+    assert m, f"README has no block tagged readme-test: {tag}"
+    return m.group(1)
+
+
+@pytest.fixture(scope="module")
+def readme_folder(panda: tuple[cp.Robot, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from cloudprox.examples import write_example_files
+
+    folder = tmp_path_factory.mktemp("readme-robot")
+    shutil.copytree(panda[1].parent, folder / "panda")
+    write_example_files(folder / "example")
+    return folder
+
+
+def test_readme_robot_python(readme_folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    code = _readme_block("robot-python")
+    assert len([ln for ln in code.splitlines() if ln.strip()]) <= 6
+    monkeypatch.chdir(readme_folder)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), {})
+    assert out.getvalue().strip() == (
+        "1.0 collision ['panda_hand', 'panda_leftfinger', 'panda_rightfinger']"
+    )
+
+
+def test_readme_robot_cli(
+    readme_folder: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from cloudprox.cli import main
+
+    line = _readme_block("robot-cli").strip()
+    argv = shlex.split(line)
+    assert argv[0] == "cloudprox" and "\n" not in line
+    monkeypatch.chdir(readme_folder)
+    monkeypatch.setenv("COLUMNS", "200")
+    assert main(argv[1:]) == 0
+    assert "P = 0   state: free" in capsys.readouterr().out
