@@ -104,6 +104,38 @@ fn broad_phase_changes_the_cost_not_the_answer() {
 }
 
 #[test]
+fn the_elements_model_queries_every_near_link() {
+    let robot = arm();
+    let cloud = wall(0.40, 0.3, 0.1, SIGMA, 9);
+    let req = RobotRequest {
+        collide: CollisionRequest::builder()
+            .model(QueryModel::Elements)
+            .build()
+            .unwrap(),
+        ..RobotRequest::default()
+    };
+    let hit = collide_robot(
+        &robot,
+        &[0.0, 0.0, 0.1, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(hit.stats.links_queried, 6);
+    assert_eq!(hit.state, CollisionState::Collision);
+    let free = collide_robot(
+        &robot,
+        &[0.0, 0.0, 0.0, 0.0],
+        &Pose::identity(),
+        &cloud,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(free.state, CollisionState::Free);
+}
+
+#[test]
 fn robot_result_equals_the_per_link_collide_calls() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 4);

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::math::Pose;
 use crate::probability::{normal_quantile, Aggregation, CollisionState};
 use crate::query::collide::{
-    collide_with_workspace, mesh_sampling_spacing, CollisionRequest, CollisionResult,
+    collide_with_workspace, mesh_sampling_spacing, CollisionRequest, CollisionResult, QueryModel,
 };
 use crate::query::exact::exact_intersects;
 use crate::Real;
@@ -28,7 +28,9 @@ pub struct RobotRequest {
     /// Skip links whose bounding box is beyond the noise's reach of every node
     /// of the cloud's hierarchy (default `true`). Such a link has no pair of
     /// points near by the query's near rule, so its query would read `P = 0`:
-    /// the broad phase changes the cost, not the answer.
+    /// the broad phase changes the cost, not the answer. Applied with the
+    /// points model only (the elements model's near rule runs on the
+    /// elements' samples, which the links' boxes do not bound).
     pub broad_phase: bool,
     /// Check self-collision between non-adjacent links (default `true`).
     pub self_collision: bool,
@@ -226,12 +228,15 @@ pub(crate) fn collide_robot_prepared(
     let k = -normal_quantile(0.5 * request.collide.prune_epsilon);
     let mut stats = RobotStats::default();
     let mut links = Vec::new();
+    // The broad phase reproduces the near rule on the points; the elements
+    // model applies it to the elements' samples, which it does not bound.
+    let broad_phase = request.broad_phase && request.collide.model == QueryModel::Points;
     for (l, link_cloud) in samples.clouds.iter().enumerate() {
         let Some(link_cloud) = link_cloud else {
             continue;
         };
         stats.links_with_geometry += 1;
-        let near = !request.broad_phase || {
+        let near = !broad_phase || {
             let local = robot.links[l]
                 .geometry
                 .as_ref()
