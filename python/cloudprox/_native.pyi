@@ -270,7 +270,8 @@ class CollisionResult:
 
         Keys: ``node_pairs_visited``, ``leaf_pairs``, ``near_regions``, ``patches``,
         ``misfit_cuts`` (patches cut because one surface misfit them),
-        ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
+        ``patches_beyond_reach`` (patches of the elements model pruned because no
+        element faces the other side within the noise's reach), ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
         where the barrier method gave way to Clarabel), ``solver_fallbacks`` (patches
         that fell back to a plane) (int),
         ``pruned_bound`` and ``time_seconds`` (float).

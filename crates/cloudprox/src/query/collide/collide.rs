@@ -122,12 +122,15 @@ pub(crate) fn collide_with_workspace(
             covs.extend(covsb);
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
-            // Decide-only: where no element of either side faces the other
-            // within the noise's reach, the surfaces cannot cross, and no
-            // separating surface is needed to say so.
-            if let (true, Some((ea, eb))) = (request.decide_only, elements) {
+            // Where no element of either side faces the other within the
+            // noise's reach, the surfaces cannot cross (every pair would count
+            // 0 in [`element_crossings`]): the patch is pruned like a node
+            // pair, without a separating surface, and its points keep
+            // `p_i = 0`.
+            if let Some((ea, eb)) = elements {
                 let reach = -normal_quantile(0.5 * request.prune_epsilon);
                 if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
+                    stats.patches_beyond_reach += 1;
                     continue;
                 }
             }
