@@ -261,7 +261,14 @@ fn patches_whose_surfaces_cannot_reach_are_pruned_without_a_classifier() {
     let (a, b) = spheres(3000);
     let mut pruned = 0;
     for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
-        let r = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &elements()).unwrap();
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &sphere_pose(gap * SIGMA),
+            &b,
+            &elements(),
+        )
+        .unwrap();
         if r.stats.patches_beyond_reach == 0 {
             continue;
         }
@@ -271,7 +278,11 @@ fn patches_whose_surfaces_cannot_reach_are_pruned_without_a_classifier() {
         assert_eq!(r.stats.points_classified, 0);
         assert_eq!(r.probability, 0.0);
         assert_eq!(r.state, CollisionState::Free);
-        assert!(r.probabilities_a.iter().chain(&r.probabilities_b).all(|&p| p == 0.0));
+        assert!(r
+            .probabilities_a
+            .iter()
+            .chain(&r.probabilities_b)
+            .all(|&p| p == 0.0));
     }
     assert!(pruned >= 1, "no gap between 3 and 7 sigma was pruned");
     let near = collide(&Pose::identity(), &a, &sphere_pose(SIGMA), &b, &elements()).unwrap();

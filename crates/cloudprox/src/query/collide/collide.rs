@@ -127,7 +127,12 @@ pub(crate) fn collide_with_workspace(
             // 0 in [`element_crossings`]): the patch is pruned like a node
             // pair, without a separating surface, and its points keep
             // `p_i = 0`.
-            if let Some((ea, eb)) = elements {
+            // A patch where neither side has a surface element (lone points:
+            // outliers, sparse corners, single-point clouds) has no surfaces to
+            // compare: its points are judged as in the points model (Eq. 3).
+            let surfaces = elements
+                .filter(|&(ea, eb)| has_surface_element(ea, &ia) || has_surface_element(eb, &ib));
+            if let Some((ea, eb)) = surfaces {
                 let reach = -normal_quantile(0.5 * request.prune_epsilon);
                 if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
                     stats.patches_beyond_reach += 1;
@@ -167,14 +172,13 @@ pub(crate) fn collide_with_workspace(
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
             let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
-            let (qa, qb) = match (request.model, request.aggregation) {
-                (QueryModel::Elements, _) => {
-                    let (ea, eb) = elements.expect("the elements model has elements");
+            let (qa, qb) = match (surfaces, request.aggregation) {
+                (Some((ea, eb)), _) => {
                     let id = Pose::identity();
                     let reach = -normal_quantile(0.5 * request.prune_epsilon);
                     element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
                 }
-                (QueryModel::Points, Aggregation::Surface) => {
+                (None, Aggregation::Surface) if elements.is_none() => {
                     let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
                         q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
                     };
@@ -189,7 +193,7 @@ pub(crate) fn collide_with_workspace(
                         ),
                     )
                 }
-                (QueryModel::Points, _) => (
+                (None, _) => (
                     fit.probabilities[..na].to_vec(),
                     fit.probabilities[na..].to_vec(),
                 ),
@@ -306,6 +310,14 @@ fn element_crossings(
             .collect::<Vec<Real>>()
     };
     (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
+}
+
+/// Whether some sample of `samples` stands for an element of more than one point.
+fn has_surface_element(elements: &SurfaceElements, samples: &[u32]) -> bool {
+    let owner = elements.sample_owner();
+    samples
+        .iter()
+        .any(|&s| !elements.elements()[owner[s as usize] as usize].is_point())
 }
 
 /// Whether the elements of a patch's samples (`ia` of `ea` at `pose_a` in B's
