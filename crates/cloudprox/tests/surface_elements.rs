@@ -117,3 +117,34 @@ fn bad_settings_are_named() {
         assert!(e.to_string().contains(word), "{e}");
     }
 }
+
+#[test]
+fn coplanar_patches_apart_never_share_an_element() {
+    // Two flat 10 x 10 patches (5 mm spacing) on one plane, 20 cm apart: one
+    // plane fits both within the noise, but the plane between them was never
+    // sampled, so no element may span the gap.
+    let sigma = 0.001;
+    let mut pts = grid(10, 0.005, 0.0);
+    pts.extend(grid(10, 0.005, 0.0).iter().map(|p| p + Vector3::new(0.25, 0.0, 0.0)));
+    let cloud = PointCloud::from_sigma(add_noise(&pts, sigma, 3), sigma).unwrap();
+    let el = cloud.elements();
+    assert!(el.multi_point_count() >= 2);
+    for (k, e) in el.elements().iter().enumerate() {
+        let sides: Vec<bool> = el
+            .element_points(k as u32)
+            .iter()
+            .map(|&i| i < 100)
+            .collect();
+        assert!(
+            sides.iter().all(|&s| s) || sides.iter().all(|&s| !s),
+            "element {k} of {} points spans both patches (extent {:?})",
+            e.count,
+            e.extent
+        );
+        // The rectangle an element claims is covered by its points.
+        let [[u0, u1], [v0, v1]] = e.extent;
+        if !e.is_point() {
+            assert!((u1 - u0) <= 0.06 && (v1 - v0) <= 0.06, "{:?}", e.extent);
+        }
+    }
+}

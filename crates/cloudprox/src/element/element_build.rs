@@ -15,6 +15,7 @@ impl SurfaceElements {
         settings.validate()?;
         let points = cloud.points();
         let sensor = cloud.sensor_covariances();
+        let spacing = cloud.spacing();
         let n = points.len();
         let mut indices: Vec<u32> = (0..n as u32).collect();
         let mut elements = Vec::new();
@@ -25,6 +26,7 @@ impl SurfaceElements {
                 let fit = fit_element(
                     points,
                     sensor,
+                    spacing,
                     &indices[range.clone()],
                     first as u32,
                     settings,
@@ -86,10 +88,9 @@ impl SurfaceElements {
                 (g, e)
             })
             .collect();
-        let groups = merge_neighbours(points, sensor, settings, groups);
+        let groups = merge_neighbours(points, sensor, spacing, settings, groups);
         let mut indices = Vec::with_capacity(n);
         let mut elements = Vec::with_capacity(groups.len());
-        let spacing = cloud.spacing();
         for (g, mut e) in groups {
             e.first = indices.len() as u32;
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;

@@ -3,22 +3,23 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{Separator, SocpSolver, SolveStatus};
+use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::PointCloud;
-use crate::element::SurfaceElements;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{
-    crossing_probabilities, element_crossing_probabilities, elements_within_reach, normal_quantile,
-    point_probability, surface_probability, Aggregation, ElementSide,
-};
+use crate::probability::{crossing_probabilities, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
+use crate::query::collide::elements::{
+    element_crossings, element_points, element_sides_within_reach, has_surface_element,
+};
 use crate::query::collide::near::near_set;
+use crate::query::collide::probabilities::{
+    core_values, indexed, point_probabilities, surface_probabilities,
+};
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactRegion, QueryModel, QueryStats,
 };
-use crate::uncertainty::directional_std_of;
 use crate::Real;
 
 /// The probabilistic collision query between cloud `a` at world pose `pose_a` and
@@ -275,183 +276,6 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
-}
-
-/// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
-/// in the separator's frame; `ib` of B's), that the fitted surface of the
-/// element it stands for crosses the other side's
-/// ([`element_crossing_probabilities`]).
-#[allow(clippy::too_many_arguments)]
-fn element_crossings(
-    ea: &SurfaceElements,
-    ia: &[u32],
-    pose_a: &Pose,
-    eb: &SurfaceElements,
-    ib: &[u32],
-    pose_b: &Pose,
-    sep: &Separator,
-    reach_sds: Real,
-) -> (Vec<Real>, Vec<Real>) {
-    let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
-    let (sa, sb) = (
-        element_side(ea, &ua, pose_a, 1.0),
-        element_side(eb, &ub, pose_b, -1.0),
-    );
-    let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
-    let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
-    let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
-        let owner = els.sample_owner();
-        idx.iter()
-            .map(|&s| {
-                q[unique
-                    .binary_search(&owner[s as usize])
-                    .expect("owner listed")]
-            })
-            .collect::<Vec<Real>>()
-    };
-    (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
-}
-
-/// Whether some sample of `samples` stands for an element of more than one point.
-fn has_surface_element(elements: &SurfaceElements, samples: &[u32]) -> bool {
-    let owner = elements.sample_owner();
-    samples
-        .iter()
-        .any(|&s| !elements.elements()[owner[s as usize] as usize].is_point())
-}
-
-/// Whether the elements of a patch's samples (`ia` of `ea` at `pose_a` in B's
-/// frame, `ib` of `eb`) face each other within `reach_sds` noise standard
-/// deviations ([`elements_within_reach`]).
-fn element_sides_within_reach(
-    ea: &SurfaceElements,
-    ia: &[u32],
-    pose_a: &Pose,
-    eb: &SurfaceElements,
-    ib: &[u32],
-    reach_sds: Real,
-) -> bool {
-    let sa = element_side(ea, &unique_owners(ea, ia), pose_a, 1.0);
-    let sb = element_side(eb, &unique_owners(eb, ib), &Pose::identity(), -1.0);
-    elements_within_reach(&sa, &sb, reach_sds)
-}
-
-/// The elements `unique` of `els` as one side of a patch.
-fn element_side<'a>(
-    els: &'a SurfaceElements,
-    unique: &[u32],
-    pose: &Pose,
-    label: Real,
-) -> ElementSide<'a> {
-    ElementSide {
-        elements: unique
-            .iter()
-            .map(|&e| &els.elements()[e as usize])
-            .collect(),
-        pose: *pose,
-        label,
-    }
-}
-
-/// The elements (sorted, each once) that the samples `samples` stand for.
-fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
-    let owner = elements.sample_owner();
-    let mut unique: Vec<u32> = samples.iter().map(|&s| owner[s as usize]).collect();
-    unique.sort_unstable();
-    unique.dedup();
-    unique
-}
-
-/// The point indices of the elements that the samples `samples` stand for, each
-/// element once, in the order of first appearance.
-fn element_points(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
-    unique_owners(elements, samples)
-        .iter()
-        .flat_map(|&e| elements.element_points(e).iter().copied())
-        .collect()
-}
-
-/// Eq. 3 of each point `idx` of `cloud` (moved by `pose` into the separator's
-/// frame) against `sep`, with label `label`; the larger of it and what `out`
-/// already holds (a point can be in several patches).
-fn point_probabilities(
-    sep: &Separator,
-    pose: &Pose,
-    cloud: &PointCloud,
-    idx: &[u32],
-    label: Real,
-    out: &mut [Real],
-) {
-    let r = pose.rotation.to_rotation_matrix();
-    let r = r.matrix();
-    for &i in idx {
-        let i = i as usize;
-        let x = pose * cloud.points()[i];
-        let cov = r * cloud.covariances()[i] * r.transpose();
-        let (f, g) = sep.value_and_gradient_local(&x);
-        out[i] = out[i].max(point_probability(f, &g, &cov, label));
-    }
-}
-
-/// The values of the `(point index, value)` pairs whose point is a core point.
-/// Only they count towards `P`: a context point is beyond the noise's reach of
-/// the other cloud, so a surface that puts it on the wrong side misfits; that is
-/// no evidence of a collision.
-fn core_values<'a>(
-    points: impl Iterator<Item = (usize, Real)> + 'a,
-    core: &'a [bool],
-) -> impl Iterator<Item = Real> + 'a {
-    points.filter(|&(i, _)| core[i]).map(|(_, v)| v)
-}
-
-/// `(point index, value)` pairs of a patch's points `idx` and their `values`.
-fn indexed<'a>(idx: &'a [u32], values: &'a [Real]) -> impl Iterator<Item = (usize, Real)> + 'a {
-    idx.iter().map(|&i| i as usize).zip(values.iter().copied())
-}
-
-/// Neighbours behind a surface probability: the point and its 6 nearest.
-const SURFACE_NEIGHBOURS: usize = 7;
-
-/// The surface probability `q_i` ([`surface_probability`]) of each of one side's
-/// points of a patch (`pts`, `covs` in the separator's frame, label `label`),
-/// from the point and its nearest neighbours among that side's patch points
-/// (neighbours beyond the patch belong to surfaces the separator was not
-/// fitted to, e.g. the far face of a thin plate).
-fn surface_probabilities(
-    sep: &Separator,
-    pts: &[Point3],
-    covs: &[Matrix3],
-    label: Real,
-) -> Vec<Real> {
-    let (margins, stds): (Vec<Real>, Vec<Real>) = pts
-        .iter()
-        .zip(covs)
-        .map(|(x, c)| {
-            let (f, g) = sep.value_and_gradient_local(x);
-            (label * f, directional_std_of(c, &g))
-        })
-        .unzip();
-    let k = SURFACE_NEIGHBOURS.min(pts.len());
-    let mut by_distance: Vec<(Real, usize)> = Vec::with_capacity(pts.len());
-    let (mut m, mut s) = (Vec::with_capacity(k), Vec::with_capacity(k));
-    pts.iter()
-        .map(|x| {
-            by_distance.clear();
-            by_distance.extend(
-                pts.iter()
-                    .enumerate()
-                    .map(|(j, y)| ((x - y).norm_squared(), j)),
-            );
-            by_distance.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-            m.clear();
-            s.clear();
-            for &(_, j) in &by_distance[..k] {
-                m.push(margins[j]);
-                s.push(stds[j]);
-            }
-            surface_probability(&m, &s)
-        })
-        .collect()
 }
 
 /// Patches are cut on a misfit only while both halves keep this many points of

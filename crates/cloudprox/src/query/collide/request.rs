@@ -16,11 +16,11 @@ pub enum QueryModel {
     /// at any noise level, and `P` is the probability that the sampled surfaces
     /// cross ([`crate::probability::pair_crossing_probabilities`]). Per-point
     /// probabilities (Eq. 3 with each point's own covariance against the trained
-    /// surface) are still reported. The default.
-    #[default]
+    /// surface) are still reported.
     Elements,
     /// Every point is a sample of the classifier and a candidate for `P` (the
-    /// paper's method, with the aggregations [`Aggregation`]).
+    /// paper's method, with the aggregations [`Aggregation`]). The default.
+    #[default]
     Points,
 }
 
