@@ -76,6 +76,7 @@ impl SurfaceElements {
                     height: [0.0; 3],
                     height_cov: nalgebra::SMatrix::zeros(),
                     common_var: 0.0,
+                    footprint: Vec::new(),
                 });
             }
         }
@@ -93,6 +94,7 @@ impl SurfaceElements {
         let mut elements = Vec::with_capacity(groups.len());
         for (g, mut e) in groups {
             e.first = indices.len() as u32;
+            // (The same mean as the fit's for a multi-point element.)
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
             indices.extend_from_slice(&g);
             elements.push(e);

@@ -134,6 +134,10 @@ fn for_each_facing(
             for &(_, j) in &nearest[..c] {
                 let o = &other[j];
                 let (ou, ov) = o.coordinates(&x);
+                // Over the other element's surface only where it was sampled.
+                if !o.e.covers(ou, ov) {
+                    continue;
+                }
                 let (y, var_y) = o.at(ou, ov);
                 let d = y - x;
                 let lateral = if o.e.is_point() {
