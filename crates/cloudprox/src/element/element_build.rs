@@ -33,7 +33,7 @@ impl SurfaceElements {
                 );
                 match fit {
                     Fit::Element(e) => {
-                        elements.push(e);
+                        elements.push(*e);
                         continue;
                     }
                     Fit::Split(rule) => {

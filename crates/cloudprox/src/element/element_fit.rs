@@ -22,7 +22,7 @@ pub fn chi_square_quantile(dof: usize, p: Real) -> Real {
 /// What the tests say of a group.
 pub(crate) enum Fit {
     /// The group is an element.
-    Element(SurfaceElement),
+    Element(Box<SurfaceElement>),
     /// It is not; split it as the rule says.
     Split(SplitRule),
 }
@@ -146,7 +146,7 @@ pub(crate) fn fit_element(
         Some(p) if spans_a_plane(&p) => {
             let e = element(&pa, idx, sensor, spacing, &local, first, settings, &p);
             if covers_its_extent(&e, &local) {
-                Fit::Element(e)
+                Fit::Element(Box::new(e))
             } else {
                 median()
             }
@@ -308,7 +308,7 @@ fn element(
     } else {
         Vec::new()
     };
-    footprint.sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    footprint.sort_unstable_by_key(|a| (a.0, a.1));
     SurfaceElement {
         first,
         count: idx.len() as u32,

@@ -58,7 +58,7 @@ pub(crate) fn merge_neighbours(
             let mut union = groups[i].0.clone();
             union.extend_from_slice(&groups[j].0);
             if let Fit::Element(e) = fit_element(points, sensor, spacing, &union, 0, settings) {
-                groups[i] = (union, e);
+                groups[i] = (union, *e);
                 groups[j].0.clear();
                 touched[i] = true;
                 touched[j] = true;

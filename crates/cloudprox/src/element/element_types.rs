@@ -150,7 +150,7 @@ impl SurfaceElement {
     /// the points are. Always true for a single point.
     pub fn covers(&self, u: Real, v: Real) -> bool {
         let h = self.spacing;
-        if self.footprint.is_empty() || !(h > 0.0) {
+        if self.footprint.is_empty() || h.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return true;
         }
         let (ci, cj) = footprint_cell(u, v, h);
