@@ -134,6 +134,11 @@ class PointCloud:
     k : int, optional
         Number of neighbours for ``discretization`` (Rust default: 10; ``>= 2``);
         only allowed with ``discretization=True``.
+    noise_correlation : float, optional
+        Correlation ``rho`` in ``[0, 1]`` of the sensor noise between the points
+        of one surface element (``model="elements"``): the mean of ``m`` points
+        has the covariance ``(1 - rho) sum(Sigma_i) / m^2 + rho sum(Sigma_i) / m``.
+        Default: the sensor model's (0 for ``sigma`` and ``cov``: independent).
 
     Raises
     ------
@@ -156,7 +161,16 @@ class PointCloud:
         sensor_pose: npt.ArrayLike | None = None,
         discretization: bool = False,
         k: int | None = None,
+        noise_correlation: float | None = None,
     ) -> PointCloud: ...
+    @property
+    def noise_correlation(self) -> float:
+        """Correlation of the sensor noise between the points of one surface element.
+
+        Set by ``noise_correlation=``, else the sensor model's
+        (:meth:`DepthCamera.noise_correlation` at the median depth); 0 for ``sigma``
+        and ``cov``.
+        """
     @property
     def points(self) -> _FloatArray:
         """Point positions, shape ``(n, 3)``, float64 (metres)."""
@@ -279,7 +293,8 @@ class CollisionResult:
 
         Keys: ``node_pairs_visited``, ``leaf_pairs``, ``near_regions``, ``patches``,
         ``misfit_cuts`` (patches cut because one surface misfit them),
-        ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
+        ``patches_beyond_reach`` (patches of the elements model pruned because no
+        element faces the other side within the noise's reach), ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
         where the barrier method gave way to Clarabel), ``solver_fallbacks`` (patches
         that fell back to a plane) (int),
         ``pruned_bound`` and ``time_seconds`` (float).
@@ -683,6 +698,15 @@ class DepthCamera:
         Focal length in pixels (``> 0``).
     sigma_px : float
         Lateral standard deviation in pixels (``>= 0``).
+    baseline_m : float
+        Projector-camera baseline in metres (``> 0``; Kinect v1: 0.075).
+    disparity_step_px : float
+        Resolution of the measured disparity in pixels (``>= 0``; Kinect v1: 1/8).
+        Depth comes in steps of ``z^2 disparity_step_px / (focal_px baseline_m)``;
+        that share of the error (variance ``step^2 / 12``) is common to
+        neighbouring points of a surface and does not average away: a cloud seen
+        by this camera builds its surface elements with the noise correlation
+        :meth:`noise_correlation` at its median depth.
     """
 
     def __new__(
@@ -693,6 +717,8 @@ class DepthCamera:
         axial_depth0: float = 0.0,
         focal_px: float = 580.0,
         sigma_px: float = 0.8,
+        baseline_m: float = 0.075,
+        disparity_step_px: float = 0.125,
     ) -> DepthCamera: ...
     @staticmethod
     def nguyen_2012() -> DepthCamera:
@@ -710,6 +736,14 @@ class DepthCamera:
     def focal_px(self) -> float: ...
     @property
     def sigma_px(self) -> float: ...
+    @property
+    def baseline_m(self) -> float: ...
+    @property
+    def disparity_step_px(self) -> float: ...
+    def depth_step(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Depth step (one disparity step) at each depth (metres), flattened."""
+    def noise_correlation(self, depth: npt.ArrayLike) -> _FloatArray:
+        """Share of the axial variance common to one surface's points at each depth."""
     def sigma_axial(self, depth: npt.ArrayLike) -> _FloatArray:
         """Axial (depth) standard deviation at each depth (metres), flattened."""
     def sigma_lateral(self, depth: npt.ArrayLike) -> _FloatArray:

@@ -226,9 +226,11 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         raise CliError(str(e)) from None
     options: dict[str, Any] = {
         k: getattr(args, k)
-        for k in ("surface", "aggregation", "solver", "mesh_spacing")
+        for k in ("model", "surface", "aggregation", "solver", "mesh_spacing")
         if getattr(args, k) is not None
     }
+    if args.decide_only:
+        options["decide_only"] = True
     result = collide(sides[0].obj, sides[1].obj, poses[0], poses[1], **options)
     if args.json:
         doc = result_to_dict(result) | {"a": sides[0].summary(), "b": sides[1].summary()}
@@ -773,6 +775,18 @@ def _parser() -> argparse.ArgumentParser:
         type=float,
         default=None,
         help="sampling spacing of a mesh side (m; default half the cloud's spacing)",
+    )
+    col.add_argument(
+        "--model",
+        choices=names["model"],
+        default=None,
+        help="what is classified: surface elements fitted to the points, or every point "
+        f"(the paper's method) (default: {defaults['model']})",
+    )
+    col.add_argument(
+        "--decide-only",
+        action="store_true",
+        help="return as soon as the state is decided (no per-point probabilities)",
     )
     col.add_argument(
         "--surface",

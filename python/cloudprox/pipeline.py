@@ -100,6 +100,21 @@ class SensorSpec:
             )
         return self.model.covariances(points, sensor_pose=pose)
 
+    def noise_correlation(self, scan: io.CloudFile, points: FloatArray) -> float | None:
+        """Return how much of the sensor noise the points of one surface share.
+
+        The sensor model's value for ``points`` (see
+        :attr:`cloudprox.PointCloud.noise_correlation`); ``None`` without a model.
+        """
+        if self.model is None:
+            return None
+        where = (
+            {"origin": self.origin}
+            if self.origin is not None
+            else {"sensor_pose": self._pose(scan)}
+        )
+        return PointCloud(points, sensor=self.model, **where).noise_correlation
+
     def sensor_origin(self, scan: io.CloudFile) -> FloatArray | None:
         """Return where the sensor sits (for the shadow filter), if known."""
         if self.origin is not None:
@@ -301,7 +316,12 @@ def load_side(
         if len(points) == 0:
             raise PipelineError(f"{path}: filter {step.describe()} removed every point")
     if covs is not None:
-        side.cloud = PointCloud(points, cov=covs, discretization=True)
+        side.cloud = PointCloud(
+            points,
+            cov=covs,
+            discretization=True,
+            noise_correlation=spec.noise_correlation(scan, points),
+        )
     else:
         side.cloud = PointCloud(points, sigma=spec.sigma, discretization=True)
     return side

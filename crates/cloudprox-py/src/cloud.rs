@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
+use cloudprox::element::ElementSettings;
 use cloudprox::uncertainty::DiscretizationSettings;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -97,6 +98,7 @@ impl PyPointCloud {
         noise: Noise,
         discretization: bool,
         k: Option<i64>,
+        noise_correlation: Option<f64>,
     ) -> PyResult<Self> {
         let disc = if discretization {
             let mut settings = DiscretizationSettings::default();
@@ -121,10 +123,18 @@ impl PyPointCloud {
                 Noise::Sigmas(s) => PointCloud::from_sigmas(points, s),
                 Noise::Covariances(c) => PointCloud::from_covariances(points, c),
             }?;
-            match disc {
-                Some(settings) => cloud.with_discretization(&settings),
-                None => Ok(cloud),
+            let mut cloud = match disc {
+                Some(settings) => cloud.with_discretization(&settings)?,
+                None => cloud,
+            };
+            if let Some(rho) = noise_correlation {
+                let settings = ElementSettings {
+                    noise_correlation: rho,
+                    ..*cloud.element_settings()
+                };
+                cloud.set_element_settings(settings)?;
             }
+            Ok(cloud)
         })?;
         Ok(Self {
             inner: Arc::new(cloud),
@@ -137,7 +147,7 @@ impl PyPointCloud {
     #[new]
     #[pyo3(signature = (
         points, sigma=None, cov=None, *, sensor=None, origin=None, sensor_pose=None,
-        discretization=false, k=None
+        discretization=false, k=None, noise_correlation=None
     ))]
     fn new(
         py: Python<'_>,
@@ -149,10 +159,11 @@ impl PyPointCloud {
         sensor_pose: Option<&Bound<'_, PyAny>>,
         discretization: bool,
         k: Option<i64>,
+        noise_correlation: Option<f64>,
     ) -> PyResult<Self> {
         let points = points_from(points, "points")?;
         let noise = noise_from(py, sigma, cov, sensor, origin, sensor_pose)?;
-        Self::build(py, points, noise, discretization, k)
+        Self::build(py, points, noise, discretization, k, noise_correlation)
     }
 
     /// Point positions, shape `(n, 3)`, float64 (metres).
@@ -180,6 +191,13 @@ impl PyPointCloud {
         let inner = Arc::clone(&self.inner);
         let s = run_detached(py, move || Ok(inner.spacing().to_vec()))?;
         Ok(PyArray1::from_vec(py, s))
+    }
+
+    /// Correlation of the sensor noise between the points of one surface element
+    /// (set by `noise_correlation=`, else the sensor model's; 0 for `sigma`/`cov`).
+    #[getter]
+    fn noise_correlation(&self) -> f64 {
+        self.inner.element_settings().noise_correlation
     }
 
     /// Per-point sensor covariances (without the discretization part), shape

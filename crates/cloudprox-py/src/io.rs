@@ -396,7 +396,14 @@ impl PyCloudFile {
         } else {
             noise_from(py, sigma, cov, sensor, origin, sensor_pose)?
         };
-        PyPointCloud::build(py, self.data.points.clone(), noise, discretization, None)
+        PyPointCloud::build(
+            py,
+            self.data.points.clone(),
+            noise,
+            discretization,
+            None,
+            None,
+        )
     }
 
     fn __len__(&self) -> usize {

@@ -205,6 +205,7 @@ impl PyCollisionResult {
             near_regions,
             patches,
             misfit_cuts,
+            patches_beyond_reach,
             points_classified,
             solver_iterations,
             barrier_fallbacks,
@@ -218,6 +219,7 @@ impl PyCollisionResult {
         d.set_item("near_regions", near_regions)?;
         d.set_item("patches", patches)?;
         d.set_item("misfit_cuts", misfit_cuts)?;
+        d.set_item("patches_beyond_reach", patches_beyond_reach)?;
         d.set_item("points_classified", points_classified)?;
         d.set_item("solver_iterations", solver_iterations)?;
         d.set_item("barrier_fallbacks", barrier_fallbacks)?;

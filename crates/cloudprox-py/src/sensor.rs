@@ -1,6 +1,7 @@
 //! Sensor noise models: `DepthCamera`, `StereoCamera`, `Lidar`.
 
 use cloudprox::math::Point3;
+use cloudprox::uncertainty::sensor::{KINECT_BASELINE_M, KINECT_DISPARITY_STEP_PX};
 use cloudprox::uncertainty::{DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray3};
@@ -89,7 +90,10 @@ pub struct PyDepthCamera {
 #[pymethods]
 impl PyDepthCamera {
     #[new]
-    #[pyo3(signature = (*, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0, sigma_px=0.8))]
+    #[pyo3(signature = (
+        *, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0,
+        sigma_px=0.8, baseline_m=KINECT_BASELINE_M, disparity_step_px=KINECT_DISPARITY_STEP_PX
+    ))]
     fn new(
         py: Python<'_>,
         axial_offset: f64,
@@ -97,6 +101,8 @@ impl PyDepthCamera {
         axial_depth0: f64,
         focal_px: f64,
         sigma_px: f64,
+        baseline_m: f64,
+        disparity_step_px: f64,
     ) -> PyResult<Self> {
         let inner = DepthCamera {
             axial_offset,
@@ -104,6 +110,8 @@ impl PyDepthCamera {
             axial_depth0,
             focal_px,
             sigma_px,
+            baseline_m,
+            disparity_step_px,
         };
         inner.validate().or_py(py)?;
         Ok(Self { inner })
@@ -144,6 +152,32 @@ impl PyDepthCamera {
     #[getter]
     fn sigma_px(&self) -> f64 {
         self.inner.sigma_px
+    }
+    #[getter]
+    fn baseline_m(&self) -> f64 {
+        self.inner.baseline_m
+    }
+    #[getter]
+    fn disparity_step_px(&self) -> f64 {
+        self.inner.disparity_step_px
+    }
+
+    /// Depth step (one disparity step) at each depth, metres.
+    fn depth_step<'py>(
+        &self,
+        py: Python<'py>,
+        depth: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        map_depth(py, depth, |z| self.inner.depth_step(z))
+    }
+
+    /// Share of the axial variance common to one surface's points at each depth.
+    fn noise_correlation<'py>(
+        &self,
+        py: Python<'py>,
+        depth: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        map_depth(py, depth, |z| self.inner.noise_correlation(z))
     }
 
     /// Axial (depth) standard deviation at each depth, metres.

@@ -7,8 +7,11 @@ use cloudprox::prelude::*;
 use cloudprox::probability::normal_cdf;
 use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 
+/// The paper's per-point model (this file's subject; the surface elements,
+/// the default, are tested in `collide_elements.rs`) with `surface`.
 fn request(surface: Surface) -> CollisionRequest {
     CollisionRequest::builder()
+        .model(QueryModel::Points)
         .classify(
             ClassifySettings::builder()
                 .surface(surface)
@@ -200,6 +203,7 @@ fn the_classifier_is_equivariant_under_rotations_of_the_data() {
     let t = Pose::new(Vector3::new(0.3, -1.2, 0.7), Vector3::new(0.4, -0.9, 2.1));
     for surface in [Surface::Quadric, Surface::Linear] {
         let req = CollisionRequest::builder()
+            .model(QueryModel::Points)
             .classify(
                 ClassifySettings::builder()
                     .surface(surface)

@@ -251,3 +251,41 @@ fn moved_points_give_the_elements_of_a_fresh_cloud() {
     let fresh = PointCloud::from_sigma(shifted, SIGMA).unwrap();
     assert_eq!(moved.elements().elements(), fresh.elements().elements());
 }
+
+#[test]
+fn patches_whose_surfaces_cannot_reach_are_pruned_without_a_classifier() {
+    // 1 mm of noise on 3000-point spheres: an element of tens of points locates
+    // its surface to a fraction of a millimetre, so a few sigma apart the
+    // points are near (their noise reaches across) but no element faces the
+    // other sphere within the noise's reach of the fitted surfaces.
+    let (a, b) = spheres(3000);
+    let mut pruned = 0;
+    for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &sphere_pose(gap * SIGMA),
+            &b,
+            &elements(),
+        )
+        .unwrap();
+        if r.stats.patches_beyond_reach == 0 {
+            continue;
+        }
+        pruned += 1;
+        assert!(r.stats.near_regions >= 1, "{:?}", r.stats);
+        assert!(r.regions.is_empty(), "gap {gap}");
+        assert_eq!(r.stats.points_classified, 0);
+        assert_eq!(r.probability, 0.0);
+        assert_eq!(r.state, CollisionState::Free);
+        assert!(r
+            .probabilities_a
+            .iter()
+            .chain(&r.probabilities_b)
+            .all(|&p| p == 0.0));
+    }
+    assert!(pruned >= 1, "no gap between 3 and 7 sigma was pruned");
+    let near = collide(&Pose::identity(), &a, &sphere_pose(SIGMA), &b, &elements()).unwrap();
+    assert_eq!(near.stats.patches_beyond_reach, 0, "{:?}", near.stats);
+    assert!(!near.regions.is_empty());
+}

@@ -117,3 +117,75 @@ fn bad_settings_are_named() {
         assert!(e.to_string().contains(word), "{e}");
     }
 }
+
+#[test]
+fn coplanar_patches_apart_never_share_an_element() {
+    // Two flat 10 x 10 patches (5 mm spacing) on one plane, 20 cm apart: one
+    // plane fits both within the noise, but the plane between them was never
+    // sampled, so no element may span the gap.
+    let sigma = 0.001;
+    let mut pts = grid(10, 0.005, 0.0);
+    pts.extend(
+        grid(10, 0.005, 0.0)
+            .iter()
+            .map(|p| p + Vector3::new(0.25, 0.0, 0.0)),
+    );
+    let cloud = PointCloud::from_sigma(add_noise(&pts, sigma, 3), sigma).unwrap();
+    let el = cloud.elements();
+    assert!(el.multi_point_count() >= 2);
+    for (k, e) in el.elements().iter().enumerate() {
+        let sides: Vec<bool> = el
+            .element_points(k as u32)
+            .iter()
+            .map(|&i| i < 100)
+            .collect();
+        assert!(
+            sides.iter().all(|&s| s) || sides.iter().all(|&s| !s),
+            "element {k} of {} points spans both patches (extent {:?})",
+            e.count,
+            e.extent
+        );
+        // The rectangle an element claims is covered by its points.
+        let [[u0, u1], [v0, v1]] = e.extent;
+        if !e.is_point() {
+            assert!((u1 - u0) <= 0.06 && (v1 - v0) <= 0.06, "{:?}", e.extent);
+        }
+    }
+}
+
+#[test]
+fn an_element_covers_where_its_points_are_not_its_rectangle_corners() {
+    // A flat disc of radius 5 cm (1600 points, 1 mm noise): its elements'
+    // rectangles (from the points' spread along the principal axes) stick out
+    // of the disc at their corners; the footprint does not.
+    let sigma = 0.001;
+    let pts: Vec<Point3> = grid(60, 0.002, 0.0)
+        .into_iter()
+        .map(|p| p - Vector3::new(0.059, 0.059, 0.0))
+        .filter(|p| p.coords.xy().norm() <= 0.05)
+        .collect();
+    let cloud = PointCloud::from_sigma(add_noise(&pts, sigma, 4), sigma).unwrap();
+    let el = cloud.elements();
+    let mut corners_outside = 0;
+    for (k, e) in el.elements().iter().enumerate() {
+        if e.is_point() {
+            continue;
+        }
+        // Every point of the element is covered.
+        for &i in el.element_points(k as u32) {
+            let d = cloud.points()[i as usize] - e.mean;
+            assert!(e.covers(d.dot(&e.tangents[0]), d.dot(&e.tangents[1])));
+        }
+        // Corners of the rectangle that lie off the disc by more than two
+        // spacings are not.
+        for (u, v) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let (cu, cv) = (e.extent[0][u], e.extent[1][v]);
+            let x = e.mean + e.tangents[0] * cu + e.tangents[1] * cv;
+            if x.coords.xy().norm() > 0.05 + 2.0 * e.spacing {
+                corners_outside += 1;
+                assert!(!e.covers(cu, cv), "corner {x:?} of element {k}");
+            }
+        }
+    }
+    assert!(corners_outside > 0, "no rectangle corner left the disc");
+}

@@ -211,3 +211,72 @@ fn bad_inputs_are_named() {
     ));
     assert!(m.contains("axis"), "{m}");
 }
+
+#[test]
+fn depth_quantization_sets_the_noise_correlation_of_elements() {
+    // Kinect v1: disparity in 1/8 px, baseline 7.5 cm, focal 580 px, so depth
+    // steps of z^2 / 348 m; Khoshelham's sigma_z = 1.425e-3 z^2 makes the
+    // quantization's share of the variance the same at every depth.
+    let cam = DepthCamera::default();
+    let step = |z: f64| z * z * 0.125 / (580.0 * 0.075);
+    for z in [0.8, 2.0, 4.0] {
+        assert!(close(cam.depth_step(z), step(z), 1e-12));
+        let share = (step(z).powi(2) / 12.0) / (1.425e-3 * z * z).powi(2);
+        assert!(close(cam.noise_correlation(z), share, 1e-9));
+    }
+    assert!(close(cam.noise_correlation(2.0), 0.3389, 1e-3));
+    // A camera without quantization shares nothing; one whose steps exceed its
+    // noise shares everything.
+    let continuous = DepthCamera {
+        disparity_step_px: 0.0,
+        ..cam
+    };
+    assert_eq!(continuous.noise_correlation(2.0), 0.0);
+    let coarse = DepthCamera {
+        disparity_step_px: 4.0,
+        ..cam
+    };
+    assert_eq!(coarse.noise_correlation(2.0), 1.0);
+    // A cloud seen by the camera builds its elements with the median share; by
+    // a laser or with plain sigmas, independent noise.
+    let vp = Viewpoint::at(Point3::origin());
+    let pts: Vec<Point3> = (0..50)
+        .map(|i| Point3::new(0.01 * i as f64, 0.0, 1.0 + 0.04 * i as f64))
+        .collect();
+    let nguyen = DepthCamera::nguyen_2012();
+    let cloud = cloudprox::cloud::PointCloud::from_sensor(
+        pts.clone(),
+        &SensorModel::DepthCamera(nguyen),
+        &vp,
+    )
+    .unwrap();
+    let mut shares: Vec<f64> = pts
+        .iter()
+        .map(|p| nguyen.noise_correlation(p.coords.norm()))
+        .collect();
+    shares.sort_by(f64::total_cmp);
+    assert!(close(
+        cloud.element_settings().noise_correlation,
+        shares[25],
+        1e-12
+    ));
+    let laser = cloudprox::cloud::PointCloud::from_sensor(
+        pts.clone(),
+        &SensorModel::Lidar(Lidar::default()),
+        &vp,
+    )
+    .unwrap();
+    assert_eq!(laser.element_settings().noise_correlation, 0.0);
+    let plain = cloudprox::cloud::PointCloud::from_sigma(pts, 0.01).unwrap();
+    assert_eq!(plain.element_settings().noise_correlation, 0.0);
+    // Bad parameters are named.
+    let bad = DepthCamera {
+        baseline_m: 0.0,
+        ..cam
+    };
+    assert!(bad
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("baseline_m"));
+}

@@ -108,12 +108,16 @@ class Draw:
         Noisy points (piano frame, world frame).
     piano_sensor_cov, room_sensor_cov : ndarray, shape (n, 3, 3)
         Sensor covariances.
+    room_noise_correlation : float
+        Correlation of the room's sensor noise within a surface element (0:
+        independent; a depth camera's from its model).
     """
 
     piano_points: FloatArray
     piano_sensor_cov: FloatArray
     room_points: FloatArray
     room_sensor_cov: FloatArray
+    room_noise_correlation: float = 0.0
     _cache: dict[str, object] = field(default_factory=dict, repr=False)
 
     def clouds(self) -> tuple[PointCloud, PointCloud]:
@@ -121,7 +125,12 @@ class Draw:
         if "clouds" not in self._cache:
             self._cache["clouds"] = (
                 PointCloud(self.piano_points, cov=self.piano_sensor_cov, discretization=True),
-                PointCloud(self.room_points, cov=self.room_sensor_cov, discretization=True),
+                PointCloud(
+                    self.room_points,
+                    cov=self.room_sensor_cov,
+                    discretization=True,
+                    noise_correlation=self.room_noise_correlation,
+                ),
             )
         return self._cache["clouds"]  # type: ignore[return-value]
 

@@ -52,6 +52,7 @@ from cloudprox._native import (
     DepthCamera,
     ExactShape,
     Mesh,
+    PointCloud,
     exact_intersects_many,
     exact_proximity_many,
 )
@@ -359,7 +360,18 @@ def run_scan(
     draws = []
     for offset in (0, STRIDE // 2):
         pts = full[_grid(frame, offset)]
-        draws.append(m.Draw(g_pts, g_cov, pts, kinect_covariances(pts, focal)))
+        # The core's Kinect model gives the covariances and how much of the
+        # noise the points of one surface share (the depth quantization).
+        seen = PointCloud(pts, sensor=kinect_camera(focal), sensor_pose=np.eye(4))
+        draws.append(
+            m.Draw(
+                g_pts,
+                g_cov,
+                pts,
+                np.asarray(seen.sensor_covariances),
+                room_noise_correlation=seen.noise_correlation,
+            )
+        )
     spacing = m.sampling_spacing(draws[0].room_points)
     answers: dict[str, list[m.MethodAnswer]] = {}
     for model, surface, agg in variants:

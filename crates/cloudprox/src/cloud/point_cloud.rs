@@ -106,7 +106,13 @@ impl PointCloud {
     pub fn new(points: Vec<Point3>, noise: &NoiseModel) -> Result<Self> {
         validate_points(&points)?;
         let covariances = noise.covariances(&points)?;
-        Ok(Self::from_parts(points, covariances))
+        let rho = match noise {
+            NoiseModel::Sensor(model, viewpoint) => model.noise_correlation(&points, viewpoint)?,
+            _ => 0.0,
+        };
+        let mut cloud = Self::from_parts(points, covariances);
+        cloud.element_settings.noise_correlation = rho;
+        Ok(cloud)
     }
 
     /// A cloud with the same isotropic standard deviation `sigma` (metres) everywhere.
@@ -125,7 +131,9 @@ impl PointCloud {
     }
 
     /// A cloud seen by a range sensor: covariances anisotropic along each
-    /// point's viewing ray from `viewpoint` (see [`crate::uncertainty::sensor`]).
+    /// point's viewing ray from `viewpoint` (see [`crate::uncertainty::sensor`]),
+    /// and its surface elements built with the sensor's noise correlation
+    /// ([`crate::uncertainty::SensorModel::noise_correlation`]).
     pub fn from_sensor(
         points: Vec<Point3>,
         model: &crate::uncertainty::SensorModel,

@@ -15,6 +15,7 @@ impl SurfaceElements {
         settings.validate()?;
         let points = cloud.points();
         let sensor = cloud.sensor_covariances();
+        let spacing = cloud.spacing();
         let n = points.len();
         let mut indices: Vec<u32> = (0..n as u32).collect();
         let mut elements = Vec::new();
@@ -25,13 +26,14 @@ impl SurfaceElements {
                 let fit = fit_element(
                     points,
                     sensor,
+                    spacing,
                     &indices[range.clone()],
                     first as u32,
                     settings,
                 );
                 match fit {
                     Fit::Element(e) => {
-                        elements.push(e);
+                        elements.push(*e);
                         continue;
                     }
                     Fit::Split(rule) => {
@@ -74,6 +76,7 @@ impl SurfaceElements {
                     height: [0.0; 3],
                     height_cov: nalgebra::SMatrix::zeros(),
                     common_var: 0.0,
+                    footprint: Vec::new(),
                 });
             }
         }
@@ -86,12 +89,12 @@ impl SurfaceElements {
                 (g, e)
             })
             .collect();
-        let groups = merge_neighbours(points, sensor, settings, groups);
+        let groups = merge_neighbours(points, sensor, spacing, settings, groups);
         let mut indices = Vec::with_capacity(n);
         let mut elements = Vec::with_capacity(groups.len());
-        let spacing = cloud.spacing();
         for (g, mut e) in groups {
             e.first = indices.len() as u32;
+            // (The same mean as the fit's for a multi-point element.)
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
             indices.extend_from_slice(&g);
             elements.push(e);

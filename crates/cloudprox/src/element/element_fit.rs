@@ -2,7 +2,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::element::{ElementSettings, SurfaceElement};
+use crate::element::element_types::footprint_cell;
+use crate::element::{ElementSettings, FootprintPoint, SurfaceElement};
 use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
 use crate::probability::normal_quantile;
 use crate::uncertainty::directional_std_of;
@@ -21,7 +22,7 @@ pub fn chi_square_quantile(dof: usize, p: Real) -> Real {
 /// What the tests say of a group.
 pub(crate) enum Fit {
     /// The group is an element.
-    Element(SurfaceElement),
+    Element(Box<SurfaceElement>),
     /// It is not; split it as the rule says.
     Split(SplitRule),
 }
@@ -71,6 +72,7 @@ type Mat3 = SMatrix<Real, 3, 3>;
 pub(crate) fn fit_element(
     points: &[Point3],
     sensor: &[Matrix3],
+    spacing: &[Real],
     idx: &[u32],
     first: u32,
     settings: &ElementSettings,
@@ -142,10 +144,38 @@ pub(crate) fn fit_element(
     // quadric's extra coefficients would only add their noise).
     match weighted_fit(&local, plane_row) {
         Some(p) if spans_a_plane(&p) => {
-            Fit::Element(element(&pa, idx, sensor, &local, first, settings, &p))
+            let e = element(&pa, idx, sensor, spacing, &local, first, settings, &p);
+            if covers_its_extent(&e, &local) {
+                Fit::Element(Box::new(e))
+            } else {
+                median()
+            }
         }
         _ => median(),
     }
+}
+
+/// Whether an element's points cover the surface its extent claims: at least
+/// half of the cells of side twice the points' mean sampling spacing over the
+/// extent's rectangle hold a point. Two coplanar patches apart (the faces of two
+/// objects on one plane, or what a crop or a voxel grid left of them) pass the
+/// residual and curvature tests together, but the plane between them was never
+/// sampled and must not be probed. A uniformly sampled surface leaves a cell of
+/// that side empty with probability about `exp(-24 / pi)`, 0.05 %.
+fn covers_its_extent(e: &SurfaceElement, local: &[(Real, Real, Real, Real)]) -> bool {
+    let cell = 2.0 * e.spacing;
+    if !(cell > 0.0 && cell.is_finite()) {
+        return true;
+    }
+    let cells = |k: usize| ((e.extent[k][1] - e.extent[k][0]) / cell).round().max(1.0);
+    let expected = cells(0) * cells(1);
+    let mut occupied: Vec<(i32, i32)> = local
+        .iter()
+        .map(|&(u, v, _, _)| footprint_cell(u, v, cell))
+        .collect();
+    occupied.sort_unstable();
+    occupied.dedup();
+    occupied.len() as Real >= 0.5 * expected
 }
 
 /// The most points of an element's surface probed in a query.
@@ -207,6 +237,7 @@ fn element(
     pa: &PrincipalAxes,
     idx: &[u32],
     sensor: &[Matrix3],
+    spacing: &[Real],
     local: &[(Real, Real, Real, Real)],
     first: u32,
     settings: &ElementSettings,
@@ -264,6 +295,20 @@ fn element(
         .collect();
     let height = fit.coef.into();
     let height_cov = fit.cov * (1.0 - rho);
+    // Where the surface was sampled, by cells of one mean spacing.
+    let h = idx.iter().map(|&i| spacing[i as usize]).sum::<Real>() / n;
+    let mut footprint: Vec<FootprintPoint> = if h > 0.0 {
+        local
+            .iter()
+            .map(|&(u, v, _, _)| {
+                let (i, j) = footprint_cell(u, v, h);
+                (i, j, u as f32, v as f32)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    footprint.sort_unstable_by_key(|a| (a.0, a.1));
     SurfaceElement {
         first,
         count: idx.len() as u32,
@@ -276,7 +321,8 @@ fn element(
         height,
         height_cov,
         common_var: rho * mean_var,
-        spacing: 0.0,
+        spacing: h,
+        footprint,
     }
 }
 

@@ -23,6 +23,7 @@ const MERGE_PASSES: usize = 12;
 pub(crate) fn merge_neighbours(
     points: &[Point3],
     sensor: &[Matrix3],
+    spacing: &[Real],
     settings: &ElementSettings,
     mut groups: Vec<(Vec<u32>, SurfaceElement)>,
 ) -> Vec<(Vec<u32>, SurfaceElement)> {
@@ -56,8 +57,8 @@ pub(crate) fn merge_neighbours(
             }
             let mut union = groups[i].0.clone();
             union.extend_from_slice(&groups[j].0);
-            if let Fit::Element(e) = fit_element(points, sensor, &union, 0, settings) {
-                groups[i] = (union, e);
+            if let Fit::Element(e) = fit_element(points, sensor, spacing, &union, 0, settings) {
+                groups[i] = (union, *e);
                 groups[j].0.clear();
                 touched[i] = true;
                 touched[j] = true;

@@ -104,6 +104,19 @@ pub struct SurfaceElement {
     /// Variance added to every fitted height by noise correlated between the
     /// points (see [`ElementSettings::noise_correlation`]).
     pub common_var: Real,
+    /// Where the surface was sampled: the points' tangential coordinates,
+    /// sorted by cells of side [`SurfaceElement::spacing`] (see
+    /// [`SurfaceElement::covers`]). Empty for a single point.
+    pub footprint: Vec<FootprintPoint>,
+}
+
+/// One point of an element's footprint: its cell `(i, j)` of side `spacing`
+/// and its tangential coordinates `(u, v)`.
+pub type FootprintPoint = (i32, i32, f32, f32);
+
+/// The cell of side `cell` holding tangential coordinates `(u, v)`.
+pub(crate) fn footprint_cell(u: Real, v: Real, cell: Real) -> (i32, i32) {
+    ((u / cell).floor() as i32, (v / cell).floor() as i32)
 }
 
 impl SurfaceElement {
@@ -127,6 +140,35 @@ impl SurfaceElement {
             self.mean + self.tangents[0] * u + self.tangents[1] * v + self.normal * h,
             var.max(0.0),
         )
+    }
+
+    /// Whether the surface was sampled at tangential coordinates `(u, v)`: some
+    /// point of the element lies within one sampling spacing of it in the
+    /// tangent plane. The extent's rectangle is only a summary (a square face
+    /// whose principal axes run along its diagonals gets a rectangle turned by
+    /// 45 degrees, whose corners stick out of the face); the footprint is where
+    /// the points are. Always true for a single point.
+    pub fn covers(&self, u: Real, v: Real) -> bool {
+        let h = self.spacing;
+        if self.footprint.is_empty() || h.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return true;
+        }
+        let (ci, cj) = footprint_cell(u, v, h);
+        let h2 = h * h;
+        for di in -1..=1 {
+            for dj in -1..=1 {
+                let key = (ci.saturating_add(di), cj.saturating_add(dj));
+                let start = self.footprint.partition_point(|p| (p.0, p.1) < key);
+                let hit = self.footprint[start..]
+                    .iter()
+                    .take_while(|p| (p.0, p.1) == key)
+                    .any(|p| (Real::from(p.2) - u).powi(2) + (Real::from(p.3) - v).powi(2) <= h2);
+                if hit {
+                    return true;
+                }
+            }
+        }
+        false
     }
 
     /// The covariance of a point of the fitted surface whose height variance is

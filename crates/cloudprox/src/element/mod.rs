@@ -54,4 +54,4 @@ mod element_samples;
 mod element_types;
 
 pub use element_fit::chi_square_quantile;
-pub use element_types::{ElementSettings, SurfaceElement, SurfaceElements};
+pub use element_types::{ElementSettings, FootprintPoint, SurfaceElement, SurfaceElements};

@@ -102,9 +102,14 @@ struct Facing {
     allowed: Real,
 }
 
-/// The facing pairs of `own`'s probes (see [`element_crossing_probabilities`]).
-fn facing_pairs(own: &[Posed<'_>], other: &[Posed<'_>]) -> Vec<Facing> {
-    let mut out = Vec::new();
+/// Calls `visit` on the facing pair of each of `own`'s probes that has one (see
+/// [`element_crossing_probabilities`]) until `visit` returns `false`; returns
+/// whether every pair was visited.
+fn for_each_facing(
+    own: &[Posed<'_>],
+    other: &[Posed<'_>],
+    mut visit: impl FnMut(&Facing) -> bool,
+) -> bool {
     let mut nearest: Vec<(Real, usize)> = Vec::with_capacity(other.len());
     for (k, p) in own.iter().enumerate() {
         for &[u, v] in &p.e.probes {
@@ -129,6 +134,10 @@ fn facing_pairs(own: &[Posed<'_>], other: &[Posed<'_>]) -> Vec<Facing> {
             for &(_, j) in &nearest[..c] {
                 let o = &other[j];
                 let (ou, ov) = o.coordinates(&x);
+                // Over the other element's surface only where it was sampled.
+                if !o.e.covers(ou, ov) {
+                    continue;
+                }
                 let (y, var_y) = o.at(ou, ov);
                 let d = y - x;
                 let lateral = if o.e.is_point() {
@@ -152,10 +161,14 @@ fn facing_pairs(own: &[Posed<'_>], other: &[Posed<'_>]) -> Vec<Facing> {
                     });
                 }
             }
-            out.extend(best);
+            if let Some(f) = best {
+                if !visit(&f) {
+                    return false;
+                }
+            }
         }
     }
-    out
+    true
 }
 
 /// Whether some probe of either side faces the other side within the noise's
@@ -165,10 +178,11 @@ fn facing_pairs(own: &[Posed<'_>], other: &[Posed<'_>]) -> Vec<Facing> {
 pub fn elements_within_reach(a: &ElementSide<'_>, b: &ElementSide<'_>, reach_sds: Real) -> bool {
     let pa: Vec<Posed<'_>> = a.elements.iter().map(|e| Posed::new(e, &a.pose)).collect();
     let pb: Vec<Posed<'_>> = b.elements.iter().map(|e| Posed::new(e, &b.pose)).collect();
+    // Stops at the first pair within reach.
     let reaches = |own: &[Posed<'_>], other: &[Posed<'_>]| {
-        facing_pairs(own, other).iter().any(|f| {
+        !for_each_facing(own, other, |f| {
             let s = (own[f.own].var_bound(f.var_x) + other[f.other].var_bound(f.var_y)).sqrt();
-            (f.y - f.x).norm() <= f.allowed + reach_sds * s
+            (f.y - f.x).norm() > f.allowed + reach_sds * s
         })
     };
     reaches(&pa, &pb) || reaches(&pb, &pa)
@@ -206,11 +220,11 @@ pub fn element_crossing_probabilities(
         .map(|e| Posed::new(e, &other.pose))
         .collect();
     let mut out = vec![0.0; po.len()];
-    for f in facing_pairs(&po, &pt) {
+    for_each_facing(&po, &pt, |f| {
         let (_, g) = sep.value_and_gradient_local(&nalgebra::center(&f.x, &f.y));
         let gn = g.norm();
         if gn <= 0.0 || !gn.is_finite() {
-            continue;
+            return true;
         }
         // From A towards B: f decreases from A's side to B's. (Measured along
         // the facing element's own normal instead, the piano scene of
@@ -221,11 +235,11 @@ pub fn element_crossing_probabilities(
         let sd = (po[f.own].var_along(f.var_x, &u) + pt[f.other].var_along(f.var_y, &u))
             .max(0.0)
             .sqrt();
-        if (f.y - f.x).norm() > f.allowed + reach_sds * sd {
-            continue;
+        if (f.y - f.x).norm() <= f.allowed + reach_sds * sd {
+            out[f.own] = Real::max(out[f.own], wrong_side(gap, sd));
         }
-        out[f.own] = Real::max(out[f.own], wrong_side(gap, sd));
-    }
+        true
+    });
     out
 }
 

@@ -3,22 +3,23 @@
 use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
-use crate::classify::{Separator, SocpSolver, SolveStatus};
+use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::PointCloud;
-use crate::element::SurfaceElements;
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{
-    crossing_probabilities, element_crossing_probabilities, elements_within_reach, normal_quantile,
-    point_probability, surface_probability, Aggregation, ElementSide,
-};
+use crate::probability::{crossing_probabilities, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
+use crate::query::collide::elements::{
+    element_crossings, element_points, element_sides_within_reach, has_surface_element,
+};
 use crate::query::collide::near::near_set;
+use crate::query::collide::probabilities::{
+    core_values, indexed, point_probabilities, surface_probabilities,
+};
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactRegion, QueryModel, QueryStats,
 };
-use crate::uncertainty::directional_std_of;
 use crate::Real;
 
 /// The probabilistic collision query between cloud `a` at world pose `pose_a` and
@@ -122,12 +123,20 @@ pub(crate) fn collide_with_workspace(
             covs.extend(covsb);
             let ia: Vec<u32> = patch.a.iter().map(|&k| component.a[k as usize]).collect();
             let ib: Vec<u32> = patch.b.iter().map(|&k| component.b[k as usize]).collect();
-            // Decide-only: where no element of either side faces the other
-            // within the noise's reach, the surfaces cannot cross, and no
-            // separating surface is needed to say so.
-            if let (true, Some((ea, eb))) = (request.decide_only, elements) {
+            // Where no element of either side faces the other within the
+            // noise's reach, the surfaces cannot cross (every pair would count
+            // 0 in [`element_crossings`]): the patch is pruned like a node
+            // pair, without a separating surface, and its points keep
+            // `p_i = 0`.
+            // A patch where neither side has a surface element (lone points:
+            // outliers, sparse corners, single-point clouds) has no surfaces to
+            // compare: its points are judged as in the points model (Eq. 3).
+            let surfaces = elements
+                .filter(|&(ea, eb)| has_surface_element(ea, &ia) || has_surface_element(eb, &ib));
+            if let Some((ea, eb)) = surfaces {
                 let reach = -normal_quantile(0.5 * request.prune_epsilon);
                 if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
+                    stats.patches_beyond_reach += 1;
                     continue;
                 }
             }
@@ -164,14 +173,13 @@ pub(crate) fn collide_with_workspace(
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
             let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
-            let (qa, qb) = match (request.model, request.aggregation) {
-                (QueryModel::Elements, _) => {
-                    let (ea, eb) = elements.expect("the elements model has elements");
+            let (qa, qb) = match (surfaces, request.aggregation) {
+                (Some((ea, eb)), _) => {
                     let id = Pose::identity();
                     let reach = -normal_quantile(0.5 * request.prune_epsilon);
                     element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
                 }
-                (QueryModel::Points, Aggregation::Surface) => {
+                (None, Aggregation::Surface) if elements.is_none() => {
                     let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
                         q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
                     };
@@ -186,7 +194,7 @@ pub(crate) fn collide_with_workspace(
                         ),
                     )
                 }
-                (QueryModel::Points, _) => (
+                (None, _) => (
                     fit.probabilities[..na].to_vec(),
                     fit.probabilities[na..].to_vec(),
                 ),
@@ -268,175 +276,6 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
-}
-
-/// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
-/// in the separator's frame; `ib` of B's), that the fitted surface of the
-/// element it stands for crosses the other side's
-/// ([`element_crossing_probabilities`]).
-#[allow(clippy::too_many_arguments)]
-fn element_crossings(
-    ea: &SurfaceElements,
-    ia: &[u32],
-    pose_a: &Pose,
-    eb: &SurfaceElements,
-    ib: &[u32],
-    pose_b: &Pose,
-    sep: &Separator,
-    reach_sds: Real,
-) -> (Vec<Real>, Vec<Real>) {
-    let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
-    let (sa, sb) = (
-        element_side(ea, &ua, pose_a, 1.0),
-        element_side(eb, &ub, pose_b, -1.0),
-    );
-    let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
-    let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
-    let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
-        let owner = els.sample_owner();
-        idx.iter()
-            .map(|&s| {
-                q[unique
-                    .binary_search(&owner[s as usize])
-                    .expect("owner listed")]
-            })
-            .collect::<Vec<Real>>()
-    };
-    (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
-}
-
-/// Whether the elements of a patch's samples (`ia` of `ea` at `pose_a` in B's
-/// frame, `ib` of `eb`) face each other within `reach_sds` noise standard
-/// deviations ([`elements_within_reach`]).
-fn element_sides_within_reach(
-    ea: &SurfaceElements,
-    ia: &[u32],
-    pose_a: &Pose,
-    eb: &SurfaceElements,
-    ib: &[u32],
-    reach_sds: Real,
-) -> bool {
-    let sa = element_side(ea, &unique_owners(ea, ia), pose_a, 1.0);
-    let sb = element_side(eb, &unique_owners(eb, ib), &Pose::identity(), -1.0);
-    elements_within_reach(&sa, &sb, reach_sds)
-}
-
-/// The elements `unique` of `els` as one side of a patch.
-fn element_side<'a>(
-    els: &'a SurfaceElements,
-    unique: &[u32],
-    pose: &Pose,
-    label: Real,
-) -> ElementSide<'a> {
-    ElementSide {
-        elements: unique
-            .iter()
-            .map(|&e| &els.elements()[e as usize])
-            .collect(),
-        pose: *pose,
-        label,
-    }
-}
-
-/// The elements (sorted, each once) that the samples `samples` stand for.
-fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
-    let owner = elements.sample_owner();
-    let mut unique: Vec<u32> = samples.iter().map(|&s| owner[s as usize]).collect();
-    unique.sort_unstable();
-    unique.dedup();
-    unique
-}
-
-/// The point indices of the elements that the samples `samples` stand for, each
-/// element once, in the order of first appearance.
-fn element_points(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
-    unique_owners(elements, samples)
-        .iter()
-        .flat_map(|&e| elements.element_points(e).iter().copied())
-        .collect()
-}
-
-/// Eq. 3 of each point `idx` of `cloud` (moved by `pose` into the separator's
-/// frame) against `sep`, with label `label`; the larger of it and what `out`
-/// already holds (a point can be in several patches).
-fn point_probabilities(
-    sep: &Separator,
-    pose: &Pose,
-    cloud: &PointCloud,
-    idx: &[u32],
-    label: Real,
-    out: &mut [Real],
-) {
-    let r = pose.rotation.to_rotation_matrix();
-    let r = r.matrix();
-    for &i in idx {
-        let i = i as usize;
-        let x = pose * cloud.points()[i];
-        let cov = r * cloud.covariances()[i] * r.transpose();
-        let (f, g) = sep.value_and_gradient_local(&x);
-        out[i] = out[i].max(point_probability(f, &g, &cov, label));
-    }
-}
-
-/// The values of the `(point index, value)` pairs whose point is a core point.
-/// Only they count towards `P`: a context point is beyond the noise's reach of
-/// the other cloud, so a surface that puts it on the wrong side misfits; that is
-/// no evidence of a collision.
-fn core_values<'a>(
-    points: impl Iterator<Item = (usize, Real)> + 'a,
-    core: &'a [bool],
-) -> impl Iterator<Item = Real> + 'a {
-    points.filter(|&(i, _)| core[i]).map(|(_, v)| v)
-}
-
-/// `(point index, value)` pairs of a patch's points `idx` and their `values`.
-fn indexed<'a>(idx: &'a [u32], values: &'a [Real]) -> impl Iterator<Item = (usize, Real)> + 'a {
-    idx.iter().map(|&i| i as usize).zip(values.iter().copied())
-}
-
-/// Neighbours behind a surface probability: the point and its 6 nearest.
-const SURFACE_NEIGHBOURS: usize = 7;
-
-/// The surface probability `q_i` ([`surface_probability`]) of each of one side's
-/// points of a patch (`pts`, `covs` in the separator's frame, label `label`),
-/// from the point and its nearest neighbours among that side's patch points
-/// (neighbours beyond the patch belong to surfaces the separator was not
-/// fitted to, e.g. the far face of a thin plate).
-fn surface_probabilities(
-    sep: &Separator,
-    pts: &[Point3],
-    covs: &[Matrix3],
-    label: Real,
-) -> Vec<Real> {
-    let (margins, stds): (Vec<Real>, Vec<Real>) = pts
-        .iter()
-        .zip(covs)
-        .map(|(x, c)| {
-            let (f, g) = sep.value_and_gradient_local(x);
-            (label * f, directional_std_of(c, &g))
-        })
-        .unzip();
-    let k = SURFACE_NEIGHBOURS.min(pts.len());
-    let mut by_distance: Vec<(Real, usize)> = Vec::with_capacity(pts.len());
-    let (mut m, mut s) = (Vec::with_capacity(k), Vec::with_capacity(k));
-    pts.iter()
-        .map(|x| {
-            by_distance.clear();
-            by_distance.extend(
-                pts.iter()
-                    .enumerate()
-                    .map(|(j, y)| ((x - y).norm_squared(), j)),
-            );
-            by_distance.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-            m.clear();
-            s.clear();
-            for &(_, j) in &by_distance[..k] {
-                m.push(margins[j]);
-                s.push(stds[j]);
-            }
-            surface_probability(&m, &s)
-        })
-        .collect()
 }
 
 /// Patches are cut on a misfit only while both halves keep this many points of

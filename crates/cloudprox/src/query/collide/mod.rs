@@ -1,7 +1,7 @@
 //! The probabilistic collision query between two noisy point clouds.
 //!
-//! 0. the samples: each cloud's surface elements ([`crate::element`], the
-//!    default model) or its points (the paper's), see [`QueryModel`];
+//! 0. the samples: each cloud's points (the paper's model, the default) or its
+//!    surface elements ([`crate::element`]), see [`QueryModel`];
 //! 1. the near set: traverse the two hierarchies under the relative pose,
 //!    pruning node pairs whose crossing bound is below `prune_epsilon`
 //!    ([`crate::bvh`]), and keep the samples within the noise's reach of the
@@ -10,15 +10,22 @@
 //!    patches along the contact ([`region`]);
 //! 3. train a robust separating surface per patch ([`crate::classify`]), and
 //!    estimate the contact point, normal and separation (`contact.rs`);
-//! 4. probabilities: per sample and per point by Eq. 3, and the pair's `P`
-//!    from them ([`crate::probability`]), with a state.
+//! 4. with surface elements, whether a patch's element surfaces can reach each
+//!    other at all (if not, it is pruned without a classifier) and the
+//!    probability that they cross (`elements.rs`);
+//! 5. probabilities: per point by Eq. 3, and the pair's `P` from the core
+//!    samples ([`crate::probability`], `probabilities.rs`), with a state.
+//!
+//! `collide.rs` runs these stages in order; each lives in its own file.
 
 #[allow(clippy::module_inception)]
 mod collide;
 mod collide_many;
 mod collide_mesh_cloud;
 mod contact;
+mod elements;
 mod near;
+mod probabilities;
 pub mod region;
 mod request;
 mod result;

@@ -19,7 +19,7 @@ pub enum QueryModel {
     /// surface) are still reported.
     Elements,
     /// Every point is a sample of the classifier and a candidate for `P` (the
-    /// paper's method, with the aggregations [`Aggregation`]).
+    /// paper's method, with the aggregations [`Aggregation`]). The default.
     #[default]
     Points,
 }

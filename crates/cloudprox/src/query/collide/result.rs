@@ -52,6 +52,10 @@ pub struct QueryStats {
     /// Patches cut in two because their surface put a point beyond the noise's
     /// reach of the other cloud on the wrong side.
     pub misfit_cuts: usize,
+    /// Patches of the elements model pruned without a classifier: no element
+    /// of either side faces the other within the noise's reach (their points
+    /// keep `p_i = 0`).
+    pub patches_beyond_reach: usize,
     /// Points of both clouds that went into a classifier.
     pub points_classified: usize,
     /// Interior-point iterations over all patches.

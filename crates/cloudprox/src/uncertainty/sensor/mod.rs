@@ -29,7 +29,7 @@ mod depth_camera;
 mod lidar;
 mod stereo;
 
-pub use depth_camera::DepthCamera;
+pub use depth_camera::{DepthCamera, KINECT_BASELINE_M, KINECT_DISPARITY_STEP_PX};
 pub use lidar::Lidar;
 pub use stereo::StereoCamera;
 
@@ -130,6 +130,31 @@ impl SensorModel {
             SensorModel::Stereo(m) => m.sigmas(ray),
             SensorModel::Lidar(m) => m.sigmas(ray),
         }
+    }
+
+    /// The correlation of the noise between the points of one surface element
+    /// ([`crate::element::ElementSettings::noise_correlation`]): for a depth
+    /// camera the median over `points` of [`DepthCamera::noise_correlation`] at
+    /// each point's depth; 0 (independent) for the stereo camera and the laser.
+    ///
+    /// # Errors
+    /// As [`SensorModel::covariances`].
+    pub fn noise_correlation(&self, points: &[Point3], viewpoint: &Viewpoint) -> Result<Real> {
+        let SensorModel::DepthCamera(cam) = self else {
+            return Ok(0.0);
+        };
+        self.validate()?;
+        let vp = viewpoint.validated()?;
+        let mut rho = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| Ok(cam.noise_correlation(ray_of(i, p, &vp)?.depth)))
+            .collect::<Result<Vec<Real>>>()?;
+        if rho.is_empty() {
+            return Ok(0.0);
+        }
+        let mid = rho.len() / 2;
+        Ok(*rho.select_nth_unstable_by(mid, Real::total_cmp).1)
     }
 
     /// The sensor covariance of every point seen from `viewpoint`.

@@ -1,0 +1,103 @@
+//! The surface-element stage of a query: which elements a patch's samples
+//! stand for, whether their fitted surfaces can reach each other at all, and
+//! the probability that they cross ([`crate::probability::element`]).
+
+use crate::classify::Separator;
+use crate::element::SurfaceElements;
+use crate::math::Pose;
+use crate::probability::{element_crossing_probabilities, elements_within_reach, ElementSide};
+use crate::Real;
+
+/// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
+/// in the separator's frame; `ib` of B's), that the fitted surface of the
+/// element it stands for crosses the other side's
+/// ([`element_crossing_probabilities`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn element_crossings(
+    ea: &SurfaceElements,
+    ia: &[u32],
+    pose_a: &Pose,
+    eb: &SurfaceElements,
+    ib: &[u32],
+    pose_b: &Pose,
+    sep: &Separator,
+    reach_sds: Real,
+) -> (Vec<Real>, Vec<Real>) {
+    let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
+    let (sa, sb) = (
+        element_side(ea, &ua, pose_a, 1.0),
+        element_side(eb, &ub, pose_b, -1.0),
+    );
+    let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
+    let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
+    let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
+        let owner = els.sample_owner();
+        idx.iter()
+            .map(|&s| {
+                q[unique
+                    .binary_search(&owner[s as usize])
+                    .expect("owner listed")]
+            })
+            .collect::<Vec<Real>>()
+    };
+    (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
+}
+
+/// Whether some sample of `samples` stands for an element of more than one point.
+pub(crate) fn has_surface_element(elements: &SurfaceElements, samples: &[u32]) -> bool {
+    let owner = elements.sample_owner();
+    samples
+        .iter()
+        .any(|&s| !elements.elements()[owner[s as usize] as usize].is_point())
+}
+
+/// Whether the elements of a patch's samples (`ia` of `ea` at `pose_a` in B's
+/// frame, `ib` of `eb`) face each other within `reach_sds` noise standard
+/// deviations ([`elements_within_reach`]).
+pub(crate) fn element_sides_within_reach(
+    ea: &SurfaceElements,
+    ia: &[u32],
+    pose_a: &Pose,
+    eb: &SurfaceElements,
+    ib: &[u32],
+    reach_sds: Real,
+) -> bool {
+    let sa = element_side(ea, &unique_owners(ea, ia), pose_a, 1.0);
+    let sb = element_side(eb, &unique_owners(eb, ib), &Pose::identity(), -1.0);
+    elements_within_reach(&sa, &sb, reach_sds)
+}
+
+/// The elements `unique` of `els` as one side of a patch.
+fn element_side<'a>(
+    els: &'a SurfaceElements,
+    unique: &[u32],
+    pose: &Pose,
+    label: Real,
+) -> ElementSide<'a> {
+    ElementSide {
+        elements: unique
+            .iter()
+            .map(|&e| &els.elements()[e as usize])
+            .collect(),
+        pose: *pose,
+        label,
+    }
+}
+
+/// The elements (sorted, each once) that the samples `samples` stand for.
+fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
+    let owner = elements.sample_owner();
+    let mut unique: Vec<u32> = samples.iter().map(|&s| owner[s as usize]).collect();
+    unique.sort_unstable();
+    unique.dedup();
+    unique
+}
+
+/// The point indices of the elements that the samples `samples` stand for, each
+/// element once, in the order of first appearance.
+pub(crate) fn element_points(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
+    unique_owners(elements, samples)
+        .iter()
+        .flat_map(|&e| elements.element_points(e).iter().copied())
+        .collect()
+}
