@@ -1,7 +1,6 @@
 //! Sensor noise models: `DepthCamera`, `StereoCamera`, `Lidar`.
 
 use cloudprox::math::Point3;
-use cloudprox::uncertainty::sensor::{KINECT_BASELINE_M, KINECT_DISPARITY_STEP_PX};
 use cloudprox::uncertainty::{DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray3};
@@ -89,10 +88,13 @@ pub struct PyDepthCamera {
 
 #[pymethods]
 impl PyDepthCamera {
+    // Literal defaults (the core's KINECT_BASELINE_M and KINECT_DISPARITY_STEP_PX):
+    // a constant's name would show as `...` in the text signature that
+    // mypy.stubtest compares with the stub.
     #[new]
     #[pyo3(signature = (
         *, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0,
-        sigma_px=0.8, baseline_m=KINECT_BASELINE_M, disparity_step_px=KINECT_DISPARITY_STEP_PX
+        sigma_px=0.8, baseline_m=0.075, disparity_step_px=0.125
     ))]
     fn new(
         py: Python<'_>,
