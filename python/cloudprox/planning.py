@@ -56,7 +56,9 @@ class PlanResult:
         (``None`` when not solved). Consecutive waypoints are joined by straight
         joint-space motions that the motion check accepted.
     planning_time : float
-        Wall time of the planner and of the path's simplification (seconds).
+        Wall time of the planner until the first solution or the time limit (seconds).
+    simplify_time : float
+        Wall time of the path's simplification (seconds; 0 without it).
     states_checked : int
         Calls of the state validity checker.
     motions_checked : int
@@ -66,6 +68,7 @@ class PlanResult:
     solved: bool
     path: FloatArray | None
     planning_time: float
+    simplify_time: float
     states_checked: int
     motions_checked: int
 
@@ -93,15 +96,17 @@ class ChanceConstraint:
         probability at most this (and no self-collision).
     **options
         Options of :func:`cloudprox.collide_robot`, plus ``resolution`` of
-        :func:`cloudprox.check_motion`. Unless given, ``decide_only`` is on when
-        ``max_probability`` is below the collision threshold: a query may then
-        stop at the first patch that reaches that threshold, which is above the
-        constraint anyway, and its answer for the constraint does not change.
+        :func:`cloudprox.check_motion`. Unless ``decide_only`` is given, it is on
+        when ``max_probability`` is below 0.5, with ``threshold_collision`` 0.5
+        unless given: a query may then stop at the first patch that reaches
+        that threshold, which is above the constraint anyway, so its answer for
+        the constraint does not change.
 
     Raises
     ------
     ValueError
-        If ``max_probability`` is not in ``[0, 1)``.
+        If ``max_probability`` is not in ``[0, 1)``, or ``decide_only`` is on and
+        ``max_probability`` is not below ``threshold_collision``.
     """
 
     def __init__(
@@ -115,11 +120,19 @@ class ChanceConstraint:
     ) -> None:
         if not (np.isfinite(max_probability) and 0.0 <= max_probability < 1.0):
             raise ValueError(f"max_probability must be in [0, 1), got {max_probability}")
+        if max_probability < 0.5 and "decide_only" not in options:
+            # A query may stop at the first patch whose probability reaches the
+            # collision threshold: 0.5 (its lowest) unless given, above the constraint.
+            options.setdefault("threshold_collision", 0.5)
+            options["decide_only"] = True
         threshold = float(
             options.get("threshold_collision", default_options()["threshold_collision"])
         )
-        if max_probability < threshold:
-            options.setdefault("decide_only", True)
+        if options.get("decide_only") and max_probability >= threshold:
+            raise ValueError(
+                f"decide_only needs max_probability ({max_probability}) below "
+                f"threshold_collision ({threshold}): a query may stop at that probability"
+            )
         self.robot = robot
         self.cloud = cloud
         self.base_pose = None if base_pose is None else np.asarray(base_pose, dtype=float)
@@ -187,6 +200,7 @@ def plan_joint_space(
     planner: str = "RRTConnect",
     seed: int | None = None,
     simplify: bool = True,
+    simplify_time: float | None = None,
 ) -> PlanResult:
     """Plan a path in a box of joint space with OMPL, given a state and a motion check.
 
@@ -200,7 +214,7 @@ def plan_joint_space(
     q_start, q_goal : array_like, shape (dof,)
         Start and goal; both must pass ``state_valid``.
     time_limit : float
-        Seconds the planner may use (the simplification gets at most as long again).
+        Seconds the planner may use.
     planner : str
         An OMPL geometric planner's class name (``"RRTConnect"``, ``"RRT"``, ...).
     seed : int, optional
@@ -209,6 +223,9 @@ def plan_joint_space(
     simplify : bool
         Shorten the solution with OMPL's path simplifier (its motions checked by
         ``motion_valid`` too).
+    simplify_time : float, optional
+        Seconds the simplifier may use (default ``time_limit``); OMPL checks its
+        budget between its steps, so one step may run past it.
 
     Returns
     -------
@@ -284,15 +301,18 @@ def plan_joint_space(
     setup.setPlanner(planner_class(info))
     t0 = time.perf_counter()
     setup.solve(float(time_limit))
+    elapsed = time.perf_counter() - t0
     solved = bool(setup.haveExactSolutionPath())
     path = None
+    simplified = 0.0
     if solved:
         if simplify:
-            setup.simplifySolution(float(time_limit))
+            t1 = time.perf_counter()
+            setup.simplifySolution(float(time_limit if simplify_time is None else simplify_time))
+            simplified = time.perf_counter() - t1
         p = setup.getSolutionPath()
         path = np.array([_values(p.getState(i), dof) for i in range(p.getStateCount())])
-    elapsed = time.perf_counter() - t0
-    return PlanResult(solved, path, elapsed, counters["states"], counters["motions"])
+    return PlanResult(solved, path, elapsed, simplified, counters["states"], counters["motions"])
 
 
 def plan(
@@ -307,6 +327,7 @@ def plan(
     planner: str = "RRTConnect",
     seed: int | None = None,
     simplify: bool = True,
+    simplify_time: float | None = None,
     **options: Any,
 ) -> PlanResult:
     """Plan a joint-space path for ``robot`` among a cloud's points under a chance constraint.
@@ -328,7 +349,7 @@ def plan(
         Pose of the robot's root link (identity by default).
     max_probability : float
         The chance constraint: the largest collision probability of a valid state.
-    time_limit, planner, seed, simplify
+    time_limit, planner, seed, simplify, simplify_time
         As in :func:`plan_joint_space`.
     **options
         Options of :func:`cloudprox.collide_robot` (and ``resolution`` of
@@ -360,4 +381,5 @@ def plan(
         planner=planner,
         seed=seed,
         simplify=simplify,
+        simplify_time=simplify_time,
     )
