@@ -115,6 +115,22 @@ def test_a_tighter_constraint_keeps_the_path_farther_from_the_points(
     assert not tight.motion_valid(Q0, Q1) and tight.motions_checked == 1
 
 
+def test_stopping_at_the_collision_threshold_keeps_the_constraint_answer(
+    ompl: None, arm: cp.Robot, cloud: cp.PointCloud
+) -> None:
+    from cloudprox.planning import ChanceConstraint
+
+    # Link 2 swept through the post and out: free, grazing and deep states.
+    qs = [np.array([a, b, 0.0, 0.0]) for a in np.linspace(-0.6, 0.6, 13) for b in (0.0, -0.2)]
+    for p in (0.01, 0.1):
+        fast = ChanceConstraint(arm, cloud, max_probability=p)
+        full = ChanceConstraint(arm, cloud, max_probability=p, decide_only=False)
+        assert fast.state_options["decide_only"] and not full.state_options["decide_only"]
+        answers = [fast.state_valid(q) for q in qs]
+        assert answers == [full.state_valid(q) for q in qs]
+        assert any(answers) and not all(answers)
+
+
 def test_bad_planning_input(ompl: None, arm: cp.Robot, cloud: cp.PointCloud) -> None:
     from cloudprox.planning import ChanceConstraint, plan, plan_joint_space
 
@@ -126,6 +142,8 @@ def test_bad_planning_input(ompl: None, arm: cp.Robot, cloud: cp.PointCloud) -> 
         plan(arm, cloud, Q0, Q1, time_limit=0.0)
     with pytest.raises(ValueError, match="max_probability"):
         ChanceConstraint(arm, cloud, max_probability=1.5)
+    with pytest.raises(ValueError, match="decide_only needs max_probability"):
+        ChanceConstraint(arm, cloud, max_probability=0.95, decide_only=True)
     with pytest.raises(ValueError, match=r"q_start must have shape \(4,\)"):
         plan(arm, cloud, [0.0, 0.0], Q1, time_limit=1.0)
     with pytest.raises(ValueError, match="finite joint limits"):
