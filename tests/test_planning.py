@@ -6,7 +6,11 @@ Skipped when OMPL's Python bindings cannot be imported, except on CI
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -175,3 +179,44 @@ def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None) -> None:
         assert all(motion_valid(a, b) for a, b in zip(r.path[:-1], r.path[1:]))
         assert r.length > 1.8
     np.testing.assert_array_equal(runs[0].path, runs[1].path)
+
+
+# ------------------------------------------------------------------ README
+
+
+def _readme_block(tag: str) -> str:
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    m = re.search(rf"<!-- readme-test: {tag} -->\n```\w+\n(.*?)```", text, re.S)
+    assert m, f"README has no block tagged readme-test: {tag}"
+    return m.group(1)
+
+
+def test_readme_robot_planning(ompl: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from cloudprox.examples import write_example_files
+    from tests.realfiles import RealFileUnavailable
+    from tests.robots import panda_urdf
+
+    try:
+        urdf = panda_urdf()
+    except RealFileUnavailable as exc:
+        if os.environ.get("CI") == "true":
+            pytest.fail(f"CI=true: the Panda URDF must be fetched, but {exc}")
+        pytest.skip(f"Panda URDF unavailable: {exc}")
+    shutil.copytree(urdf.parent, tmp_path / "panda")
+    write_example_files(tmp_path / "example")
+    monkeypatch.chdir(tmp_path)
+    code = _readme_block("robot-python") + _readme_block("robot-planning")
+    namespace: dict[str, object] = {}
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), namespace)
+    assert out.getvalue().splitlines()[-1] == "True"
+    robot, scan, base = namespace["robot"], namespace["scan"], namespace["base"]
+    path = namespace["result"].path  # type: ignore[attr-defined]
+    q0, q1 = np.asarray(namespace["q0"]), np.asarray(namespace["q1"])
+    np.testing.assert_allclose(path[[0, -1]], [q0, q1])
+    # The straight motion leaves the constraint (the hand sweeps through the box);
+    # every segment of the plan keeps it.
+    assert not cp.check_motion(robot, q0, q1, scan, base, max_probability=0.01).safe
+    for a, b in zip(path[:-1], path[1:]):
+        assert cp.check_motion(robot, a, b, scan, base, max_probability=0.01).safe
