@@ -135,6 +135,39 @@ def test_stopping_at_the_collision_threshold_keeps_the_constraint_answer(
         assert any(answers) and not all(answers)
 
 
+def test_the_constraint_installed_in_an_ompl_setup_of_ones_own(
+    ompl: None, arm: cp.Robot, cloud: cp.PointCloud
+) -> None:
+    import ompl.base as ob
+    import ompl.geometric as og
+
+    from cloudprox.planning import ChanceConstraint
+
+    space = ob.RealVectorStateSpace(arm.dof)
+    bounds = ob.RealVectorBounds(arm.dof)
+    for i, (lo, hi) in enumerate(arm.joint_limits):
+        bounds.setLow(i, float(lo))
+        bounds.setHigh(i, float(hi))
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+    info = setup.getSpaceInformation()
+    constraint = ChanceConstraint(arm, cloud, max_probability=0.1)
+    constraint.install(info)
+
+    def state(q: np.ndarray) -> object:
+        s = space.allocState()
+        for i, v in enumerate(q):
+            s[i] = float(v)
+        return s
+
+    through = np.array([0.0, 0.0, 0.0, 0.0])  # link 2 inside the post
+    assert info.isValid(state(Q0)) and not info.isValid(state(through))
+    assert not info.checkMotion(state(Q0), state(Q1))
+    above = np.array([-0.6, -0.5, 0.0, 0.0])
+    assert info.checkMotion(state(Q0), state(above))
+    assert constraint.states_checked == 2 and constraint.motions_checked == 2
+
+
 def test_bad_planning_input(ompl: None, arm: cp.Robot, cloud: cp.PointCloud) -> None:
     from cloudprox.planning import ChanceConstraint, plan, plan_joint_space
 
@@ -158,7 +191,8 @@ def test_bad_planning_input(ompl: None, arm: cp.Robot, cloud: cp.PointCloud) -> 
         plan(arm, cloud, Q0, Q1, time_limit=1.0, no_such_option=1)
 
 
-def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None) -> None:
+@pytest.mark.parametrize("planner", ["RRTConnect", "KPIECE1"])
+def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None, planner: str) -> None:
     from cloudprox.planning import plan_joint_space
 
     # A square with a disc in the middle: the straight motion from left to right
@@ -171,7 +205,9 @@ def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None) -> None:
 
     lim = [[-1.0, 1.0], [-1.0, 1.0]]
     runs = [
-        plan_joint_space(lim, state_valid, motion_valid, [-0.9, 0.0], [0.9, 0.0], seed=3)
+        plan_joint_space(
+            lim, state_valid, motion_valid, [-0.9, 0.0], [0.9, 0.0], seed=3, planner=planner
+        )
         for _ in range(2)
     ]
     for r in runs:
