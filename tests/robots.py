@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
+import re
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from cloudprox.reproduce.data import _write_atomically, cache_dir
-from tests.realfiles import Package, RealFileMismatch, fetch_archive
+from tests.realfiles import Package, RealFileMismatch, RealFileUnavailable, fetch_archive
 
 GYM_IGNITION_MODELS = Package(
     "pypi",
@@ -108,6 +110,26 @@ def panda_urdf() -> Path:
                 )
             _write_atomically(root / rel, content)
     return root / "panda.urdf"
+
+
+def panda_urdf_or_skip() -> Path:
+    """:func:`panda_urdf`, or skip the test when PyPI cannot be reached (fail on CI)."""
+    import pytest
+
+    try:
+        return panda_urdf()
+    except RealFileUnavailable as exc:
+        if os.environ.get("CI") == "true":
+            pytest.fail(f"CI=true: the Panda URDF must be fetched, but {exc}")
+        pytest.skip(f"Panda URDF unavailable: {exc}")
+
+
+def readme_block(tag: str) -> str:
+    """Return the README's fenced code block that follows ``<!-- readme-test: TAG -->``."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    m = re.search(rf"<!-- readme-test: {tag} -->\n```\w+\n(.*?)```", text, re.S)
+    assert m, f"README has no block tagged readme-test: {tag}"
+    return m.group(1)
 
 
 #: A three-joint arm on a box base (the same as the Rust tests'):

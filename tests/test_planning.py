@@ -9,7 +9,6 @@ from __future__ import annotations
 import contextlib
 import io
 import os
-import re
 import shutil
 from pathlib import Path
 
@@ -17,7 +16,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.robots import ARM_URDF
+from tests.robots import ARM_URDF, panda_urdf_or_skip, readme_block
 
 SIGMA = 0.002
 BOX_HALF = (0.01, 0.01, 0.05)
@@ -220,28 +219,14 @@ def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None, planner:
 # ------------------------------------------------------------------ README
 
 
-def _readme_block(tag: str) -> str:
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    m = re.search(rf"<!-- readme-test: {tag} -->\n```\w+\n(.*?)```", text, re.S)
-    assert m, f"README has no block tagged readme-test: {tag}"
-    return m.group(1)
-
-
 def test_readme_robot_planning(ompl: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from cloudprox.examples import write_example_files
-    from tests.realfiles import RealFileUnavailable
-    from tests.robots import panda_urdf
 
-    try:
-        urdf = panda_urdf()
-    except RealFileUnavailable as exc:
-        if os.environ.get("CI") == "true":
-            pytest.fail(f"CI=true: the Panda URDF must be fetched, but {exc}")
-        pytest.skip(f"Panda URDF unavailable: {exc}")
+    urdf = panda_urdf_or_skip()
     shutil.copytree(urdf.parent, tmp_path / "panda")
     write_example_files(tmp_path / "example")
     monkeypatch.chdir(tmp_path)
-    code = _readme_block("robot-python") + _readme_block("robot-planning")
+    code = readme_block("robot-python") + readme_block("robot-planning")
     namespace: dict[str, object] = {}
     out = io.StringIO()
     with contextlib.redirect_stdout(out):

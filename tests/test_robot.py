@@ -11,8 +11,6 @@ from __future__ import annotations
 import contextlib
 import io
 import json
-import os
-import re
 import shlex
 import shutil
 from pathlib import Path
@@ -21,8 +19,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.realfiles import RealFileUnavailable
-from tests.robots import ARM_URDF, arm_poses, panda_urdf, wall
+from tests.robots import ARM_URDF, arm_poses, panda_urdf_or_skip, readme_block, wall
 
 SIGMA = 0.002
 
@@ -41,12 +38,7 @@ def arm(arm_path: Path) -> cp.Robot:
 
 @pytest.fixture(scope="module")
 def panda() -> tuple[cp.Robot, Path]:
-    try:
-        path = panda_urdf()
-    except RealFileUnavailable as exc:
-        if os.environ.get("CI") == "true":
-            pytest.fail(f"CI=true: the Panda URDF must be fetched, but {exc}")
-        pytest.skip(f"Panda URDF unavailable: {exc}")
+    path = panda_urdf_or_skip()
     return cp.Robot.from_urdf(path), path
 
 
@@ -433,13 +425,6 @@ def test_cli_errors_exit_2(
 # ------------------------------------------------------------------ README
 
 
-def _readme_block(tag: str) -> str:
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    m = re.search(rf"<!-- readme-test: {tag} -->\n```\w+\n(.*?)```", text, re.S)
-    assert m, f"README has no block tagged readme-test: {tag}"
-    return m.group(1)
-
-
 @pytest.fixture(scope="module")
 def readme_folder(panda: tuple[cp.Robot, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
     from cloudprox.examples import write_example_files
@@ -451,7 +436,7 @@ def readme_folder(panda: tuple[cp.Robot, Path], tmp_path_factory: pytest.TempPat
 
 
 def test_readme_robot_python(readme_folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    code = _readme_block("robot-python")
+    code = readme_block("robot-python")
     assert len([ln for ln in code.splitlines() if ln.strip()]) <= 6
     monkeypatch.chdir(readme_folder)
     out = io.StringIO()
@@ -467,7 +452,7 @@ def test_readme_robot_cli(
 ) -> None:
     from cloudprox.cli import main
 
-    line = _readme_block("robot-cli").strip()
+    line = readme_block("robot-cli").strip()
     argv = shlex.split(line)
     assert argv[0] == "cloudprox" and "\n" not in line
     monkeypatch.chdir(readme_folder)
