@@ -238,6 +238,43 @@ def test_check_motion_finds_a_collision_between_two_free_waypoints(arm: cp.Robot
     assert coarse.states_total < m.states_total
 
 
+def exact_clearance_along(
+    arm: cp.Robot, q0: np.ndarray, q1: np.ndarray, box: cp.ExactShape, box_pose: np.ndarray
+) -> float:
+    """Smallest exact distance (0 when touching) of any link to the box along the motion."""
+    qs = q0 + np.linspace(0.0, 1.0, 1201)[:, None] * (q1 - q0)
+    best = np.inf
+    for name in arm.link_names:
+        mesh = arm.link_mesh(name)
+        if mesh is None:
+            continue
+        poses = np.stack([arm.link_poses(q)[name] for q in qs])
+        d = cp.exact_proximity_many(cp.ExactShape([mesh]), box, poses, box_pose)
+        best = min(best, float(np.min(np.where(d["intersecting"], 0.0, d["distance"]))))
+    return best
+
+
+@pytest.mark.parametrize("gap_sigmas", [-1.0, 0.0, 1.0, 6.0, 10.0])
+def test_check_motion_misses_no_grazing_contact(arm: cp.Robot, gap_sigmas: float) -> None:
+    # Link 2 (its underside at z = 0.28 when j2 = 0) sweeps over a post whose top
+    # lies gap_sigmas below it: the exact link grazes the exact post only between
+    # the motion's ends, both far from it.
+    half = (0.01, 0.01, 0.05)
+    centre = (0.2, 0.0, 0.28 - gap_sigmas * SIGMA - half[2])
+    pts = cp.sample_box_surface(half, 0.004, center=centre)
+    cloud = cp.PointCloud(cp.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
+    box_pose = np.eye(4)
+    box_pose[:3, 3] = centre
+    q0, q1 = np.array([-0.6, 0.0, 0.0, 0.0]), np.array([0.6, 0.0, 0.0, 0.0])
+    clearance = exact_clearance_along(arm, q0, q1, cp.ExactShape([cp.Mesh.cuboid(*half)]), box_pose)
+    assert clearance == pytest.approx(max(gap_sigmas, 0.0) * SIGMA, abs=0.2 * SIGMA)
+    m = cp.check_motion(arm, q0, q1, cloud)
+    if clearance == 0.0:  # touching or through: never passed as safe
+        assert not m.safe and m.first_unsafe is not None
+    if clearance > 5.0 * SIGMA:
+        assert m.safe
+
+
 def test_self_collision_on_a_folded_arm(arm: cp.Robot) -> None:
     folded = [0.0, np.pi / 2, 0.0, 0.0]
     assert ("base", "link2") in arm.self_collisions(folded)
