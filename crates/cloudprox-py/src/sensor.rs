@@ -1,6 +1,7 @@
 //! Sensor noise models: `DepthCamera`, `StereoCamera`, `Lidar`.
 
 use cloudprox::math::Point3;
+use cloudprox::uncertainty::sensor::{KINECT_BASELINE_M, KINECT_DISPARITY_STEP_PX};
 use cloudprox::uncertainty::{DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray3};
@@ -86,11 +87,12 @@ pub struct PyDepthCamera {
     inner: DepthCamera,
 }
 
+// The signature below spells the Kinect defaults as literals (Python shows them);
+// they must stay the core's constants.
+const _: () = assert!(KINECT_BASELINE_M == 0.075 && KINECT_DISPARITY_STEP_PX == 0.125);
+
 #[pymethods]
 impl PyDepthCamera {
-    // Literal defaults (the core's KINECT_BASELINE_M and KINECT_DISPARITY_STEP_PX):
-    // a constant's name would show as `...` in the text signature that
-    // mypy.stubtest compares with the stub.
     #[new]
     #[pyo3(signature = (
         *, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0,
