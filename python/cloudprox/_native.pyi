@@ -1052,13 +1052,14 @@ class LinkCollision:
         """The link's name."""
     @property
     def probability(self) -> float:
-        """The link's collision probability (0 when the broad phase skipped it)."""
+        """The link's collision probability (0 when the broad phase skipped it, NaN when a
+        ``decide_only`` query was decided before it)."""
     @property
     def state(self) -> _StateName:
         """The link's state."""
     @property
     def queried(self) -> bool:
-        """Whether the link was queried (it passed the broad phase)."""
+        """Whether the link was queried (it passed the broad phase, before any decision)."""
     @property
     def result(self) -> CollisionResult | None:
         """The link's full query result (side A: the link's sample), ``None`` when skipped."""
@@ -1086,8 +1087,10 @@ class RobotCollisionResult:
     def stats(self) -> dict[str, int | float]:
         """Counters and timings of the query.
 
-        Keys: ``links_with_geometry``, ``links_queried``, ``broad_phase_nodes``,
-        ``self_pairs_checked``, ``node_pairs_visited`` (int), ``time_seconds`` (float).
+        Keys: ``links_with_geometry``, ``links_queried``, ``links_after_decision``
+        (with ``decide_only``, the links left once one reached the collision
+        threshold), ``broad_phase_nodes``, ``self_pairs_checked``,
+        ``node_pairs_visited`` (int), ``time_seconds`` (float).
         """
 
 @final
@@ -1147,8 +1150,11 @@ def collide_robot(
     half the cloud's median spacing) into a cloud without sensor noise. A broad
     phase (``broad_phase=True``) skips links whose bounding box is beyond the noise's
     reach of every node of the cloud's hierarchy: their query would read 0. Every
-    other link is queried as :func:`collide` does. Self-collision between
-    non-adjacent links (exact meshes, ``self_collision=True``) is reported apart.
+    other link is queried as :func:`collide` does; with ``decide_only=True`` the
+    links after the first whose probability reaches ``threshold_collision`` are
+    left (probability NaN, ``stats["links_after_decision"]``): the state is
+    collision whatever they hold. Self-collision between non-adjacent links
+    (exact meshes, ``self_collision=True``) is reported apart.
     ``options`` are those of :func:`collide` plus ``mesh_spacing``,
     ``broad_phase`` and ``self_collision``; unknown names raise
     :class:`InvalidInputError`. The GIL is released.

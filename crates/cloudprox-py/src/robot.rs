@@ -497,6 +497,7 @@ impl PyRobotCollisionResult {
         let RobotStats {
             links_with_geometry,
             links_queried,
+            links_after_decision,
             broad_phase_nodes,
             self_pairs_checked,
             node_pairs_visited,
@@ -505,6 +506,7 @@ impl PyRobotCollisionResult {
         let d = PyDict::new(py);
         d.set_item("links_with_geometry", links_with_geometry)?;
         d.set_item("links_queried", links_queried)?;
+        d.set_item("links_after_decision", links_after_decision)?;
         d.set_item("broad_phase_nodes", broad_phase_nodes)?;
         d.set_item("self_pairs_checked", self_pairs_checked)?;
         d.set_item("node_pairs_visited", node_pairs_visited)?;

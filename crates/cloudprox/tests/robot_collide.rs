@@ -431,3 +431,53 @@ fn bad_queries_are_rejected() {
     };
     assert!(collide_robot(&robot, &[0.0; 4], &Pose::identity(), &cloud, &bad).is_err());
 }
+
+#[test]
+fn a_decide_only_query_leaves_the_links_after_one_that_collides() {
+    let robot = arm();
+    // The plane x = 0.25 cuts link2 (x from 0 to 0.3); link3's sphere (x 0.27
+    // to 0.33) and the tool are within its noise's reach.
+    let cloud = wall(0.25, 0.3, 0.1, SIGMA, 5);
+    let q = [0.0, 0.0, 0.0, 0.0];
+    let full = collide_robot(
+        &robot,
+        &q,
+        &Pose::identity(),
+        &cloud,
+        &RobotRequest::default(),
+    )
+    .unwrap();
+    let mut req = RobotRequest::default();
+    req.collide.decide_only = true;
+    let fast = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
+    assert_eq!(full.state, CollisionState::Collision);
+    assert_eq!(fast.state, full.state);
+    assert!(fast.probability >= req.collide.thresholds.collision);
+    assert!(link_p(&full, 2) >= req.collide.thresholds.collision);
+    // Every link after link2 is left: unknown probability, not queried.
+    let after: Vec<_> = fast.links.iter().filter(|l| l.link > 2).collect();
+    assert!(!after.is_empty());
+    assert!(after
+        .iter()
+        .all(|l| l.probability.is_nan() && !l.queried && l.result.is_none()));
+    assert_eq!(fast.stats.links_after_decision, after.len());
+    assert_eq!(full.stats.links_after_decision, 0);
+    // The full query did query some of them (they are within reach).
+    assert!(full.links.iter().any(|l| l.link > 2 && l.queried));
+    // Links before the decision read as in the full query.
+    for l in fast.links.iter().filter(|l| l.link <= 2) {
+        assert_eq!(
+            l.queried,
+            full.links
+                .iter()
+                .find(|e| e.link == l.link)
+                .unwrap()
+                .queried
+        );
+    }
+    // A free configuration is answered in full.
+    let away = [1.5, 0.0, 0.0, 0.0];
+    let f = collide_robot(&robot, &away, &Pose::identity(), &cloud, &req).unwrap();
+    assert_eq!(f.stats.links_after_decision, 0);
+    assert!(f.links.iter().all(|l| !l.probability.is_nan()));
+}

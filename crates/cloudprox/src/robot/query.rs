@@ -70,7 +70,8 @@ impl RobotRequest {
 pub struct LinkCollision {
     /// The link's index ([`Robot::link_names`]).
     pub link: usize,
-    /// The link's collision probability (0 when the broad phase skipped it).
+    /// The link's collision probability (0 when the broad phase skipped it;
+    /// NaN when a `decide_only` query had decided before reaching it).
     pub probability: Real,
     /// Its state.
     pub state: CollisionState,
@@ -95,8 +96,12 @@ pub struct SelfCollision {
 pub struct RobotStats {
     /// Links with geometry.
     pub links_with_geometry: usize,
-    /// Links queried against the cloud (the others were skipped by the broad phase).
+    /// Links queried against the cloud (the others were skipped by the broad
+    /// phase, or left once the query was decided).
     pub links_queried: usize,
+    /// Links left unqueried because an earlier link's probability had reached
+    /// the collision threshold (`decide_only` only).
+    pub links_after_decision: usize,
     /// Hierarchy nodes of the cloud visited by the broad phase.
     pub broad_phase_nodes: usize,
     /// Link pairs tested for self-collision.
@@ -190,6 +195,18 @@ fn aggregate(aggregation: Aggregation, p: &[Real]) -> Real {
     }
 }
 
+/// A link left unqueried by a decided `decide_only` query: its probability is
+/// unknown (NaN), its state undecided.
+fn after_decision(link: usize) -> LinkCollision {
+    LinkCollision {
+        link,
+        probability: Real::NAN,
+        state: CollisionState::Contact,
+        queried: false,
+        result: None,
+    }
+}
+
 /// Self-collision at `poses`: the checked pairs whose exact shapes intersect.
 pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollision> {
     robot
@@ -231,11 +248,19 @@ pub(crate) fn collide_robot_prepared(
     // The broad phase reproduces the near rule on the points; the elements
     // model applies it to the elements' samples, which it does not bound.
     let broad_phase = request.broad_phase && request.collide.model == QueryModel::Points;
+    // Every aggregation is at least the largest link probability: once a link
+    // reaches the collision threshold, a decide_only query is decided.
+    let mut decided = false;
     for (l, link_cloud) in samples.clouds.iter().enumerate() {
         let Some(link_cloud) = link_cloud else {
             continue;
         };
         stats.links_with_geometry += 1;
+        if decided {
+            stats.links_after_decision += 1;
+            links.push(after_decision(l));
+            continue;
+        }
         let near = !broad_phase || {
             let local = robot.links[l]
                 .geometry
@@ -273,6 +298,8 @@ pub(crate) fn collide_robot_prepared(
         ) {
             Ok(r) => {
                 stats.node_pairs_visited += r.stats.node_pairs_visited;
+                decided = request.collide.decide_only
+                    && r.probability >= request.collide.thresholds.collision;
                 links.push(LinkCollision {
                     link: l,
                     probability: r.probability,
@@ -290,7 +317,11 @@ pub(crate) fn collide_robot_prepared(
             }),
         }
     }
-    let p: Vec<Real> = links.iter().map(|l| l.probability).collect();
+    let p: Vec<Real> = links
+        .iter()
+        .map(|l| l.probability)
+        .filter(|p| !p.is_nan())
+        .collect();
     let probability = aggregate(request.collide.aggregation, &p);
     let self_collisions = if request.self_collision {
         stats.self_pairs_checked = robot.self_pairs.len();
