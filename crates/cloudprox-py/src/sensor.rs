@@ -87,12 +87,16 @@ pub struct PyDepthCamera {
     inner: DepthCamera,
 }
 
+// The signature below spells the Kinect defaults as literals (Python shows them);
+// they must stay the core's constants.
+const _: () = assert!(KINECT_BASELINE_M == 0.075 && KINECT_DISPARITY_STEP_PX == 0.125);
+
 #[pymethods]
 impl PyDepthCamera {
     #[new]
     #[pyo3(signature = (
         *, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0,
-        sigma_px=0.8, baseline_m=KINECT_BASELINE_M, disparity_step_px=KINECT_DISPARITY_STEP_PX
+        sigma_px=0.8, baseline_m=0.075, disparity_step_px=0.125
     ))]
     fn new(
         py: Python<'_>,
