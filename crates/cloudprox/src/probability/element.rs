@@ -83,6 +83,13 @@ impl<'a> Posed<'a> {
         var * n * n + dir.dot(&(self.across * dir))
     }
 
+    /// Whether tangential coordinates `(u, v)` lie within the extent (the
+    /// fitted surface is then evaluated there, not at the extent's edge).
+    fn is_over(&self, u: Real, v: Real) -> bool {
+        let [[u0, u1], [v0, v1]] = self.e.extent;
+        (u0..=u1).contains(&u) && (v0..=v1).contains(&v)
+    }
+
     /// A bound on the variance along any direction.
     fn var_bound(&self, var: Real) -> Real {
         var + self.across.trace()
@@ -100,6 +107,9 @@ struct Facing {
     var_y: Real,
     /// Half a sampling spacing: how far apart samples of touching surfaces can be.
     allowed: Real,
+    /// Whether `x` lies beside the other element rather than over it, then the
+    /// squared distance: the best facing pair has the smallest.
+    key: (bool, Real),
 }
 
 /// Calls `visit` on the facing pair of each of `own`'s probes that has one (see
@@ -146,11 +156,17 @@ fn for_each_facing(
                     (d - o.normal * o.normal.dot(&d)).norm()
                 };
                 let allowed = FACING_SPACINGS * p.e.spacing.max(o.e.spacing);
-                let closer = best
-                    .as_ref()
-                    .is_none_or(|b| d.norm_squared() < (b.y - b.x).norm_squared());
-                if lateral <= allowed && closer {
+                // An element that `x` lies over (within its extent, so `y`
+                // is straight across) beats one it lies beside (`y` clamped
+                // to the extent's edge, offset sideways): the gap of a pair
+                // beside says little about a crossing, and the closest
+                // element is often the one beside.
+                let over = o.e.is_point() || o.is_over(ou, ov);
+                let key = (!over, d.norm_squared());
+                let better = best.as_ref().is_none_or(|b| key < b.key);
+                if lateral <= allowed && better {
                     best = Some(Facing {
+                        key,
                         own: k,
                         x,
                         var_x,
@@ -193,7 +209,8 @@ pub fn elements_within_reach(a: &ElementSide<'_>, b: &ElementSide<'_>, reach_sds
 ///
 /// At each of its probes `x` (see [`SurfaceElement::probes`]), the other side's
 /// facing surface point `y` is the point of one of its nearest elements at
-/// `x`'s tangential coordinates (clamped to that element's range) that lies
+/// `x`'s tangential coordinates (clamped to that element's range; an element
+/// `x` lies over is preferred to one it lies beside) that lies
 /// within half a sampling spacing of `x` across its surface. The two surfaces
 /// there are `g = (y - x) . u` apart along the separating surface's unit normal
 /// `u` at their midpoint (oriented from A to B: only the direction of `sep` is
