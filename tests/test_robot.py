@@ -150,6 +150,23 @@ def test_far_from_the_cloud_no_link_is_queried(arm: cp.Robot) -> None:
     assert r.stats["broad_phase_nodes"] == 6  # one hierarchy root per link
 
 
+def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
+    cloud = wall_cloud(x0=0.27, seed=5)  # cuts link2; link3, link4 and the tool within reach
+    q = [0.0, 0.0, 0.0, 0.0]
+    full = cp.collide_robot(arm, q, cloud)
+    fast = cp.collide_robot(arm, q, cloud, decide_only=True)
+    assert full.state == fast.state == "collision"
+    assert fast.probability >= 0.9 and full.links["link2"].probability >= 0.9
+    after = [fast.links[n] for n in ("link3", "link4", "tool")]
+    assert all(np.isnan(x.probability) and not x.queried and x.result is None for x in after)
+    assert fast.stats["links_after_decision"] == 3 and full.stats["links_after_decision"] == 0
+    assert all(full.links[n].queried for n in ("link3", "link4", "tool"))
+    batch = cp.collide_robot_many(arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True)
+    assert list(batch.states) == ["collision", "free"]
+    assert np.isnan(batch.link_probabilities[0, 3:6]).all()  # link3, link4, tool
+    assert not np.isnan(batch.link_probabilities[1]).any()
+
+
 def test_broad_phase_changes_the_cost_not_the_answer(arm: cp.Robot) -> None:
     cloud = wall_cloud(seed=3)
     qs = np.array([[0, 0, c, 0] for c in np.linspace(0.0, 0.1, 9)] + [[1.5, 0, 0.1, 0]])
