@@ -1052,8 +1052,7 @@ class LinkCollision:
         """The link's name."""
     @property
     def probability(self) -> float:
-        """The link's collision probability (0 when the broad phase skipped it, NaN when a
-        ``decide_only`` query was decided before it)."""
+        """The link's collision probability (0 when the broad phase skipped it; NaN when a ``decide_only`` query was decided before it)."""
     @property
     def state(self) -> _StateName:
         """The link's state."""
