@@ -154,6 +154,14 @@ impl SurfaceElement {
             return true;
         }
         let (ci, cj) = footprint_cell(u, v, h);
+        // The cells are sorted by row: rows beyond the first or last cannot hit.
+        let (first, last) = (
+            self.footprint[0].0,
+            self.footprint[self.footprint.len() - 1].0,
+        );
+        if ci.saturating_add(1) < first || ci.saturating_sub(1) > last {
+            return false;
+        }
         let h2 = h * h;
         for di in -1..=1 {
             for dj in -1..=1 {

@@ -1,5 +1,6 @@
 //! The probability that the fitted surfaces of two clouds' elements cross.
 
+use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::classify::Separator;
 use crate::element::SurfaceElement;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
@@ -112,6 +113,49 @@ struct Facing {
     key: (bool, Real),
 }
 
+/// The other side's elements nearest to a probe by mean: a hierarchy over the
+/// means when there are many (a patch holds hundreds of elements, each with 25
+/// probes), every mean otherwise.
+struct Candidates {
+    means: Vec<Point3>,
+    tree: Option<Bvh>,
+}
+
+/// Above this many elements the candidates come from a hierarchy over the means.
+const CANDIDATE_TREE_MIN: usize = 32;
+
+impl Candidates {
+    fn new(means: Vec<Point3>) -> Self {
+        let tree = if means.len() > CANDIDATE_TREE_MIN {
+            Bvh::build(&means, &vec![0.0; means.len()], &BvhSettings::default()).ok()
+        } else {
+            None
+        };
+        Self { means, tree }
+    }
+
+    /// The [`FACING_CANDIDATES`] means nearest to `x`, as `(squared distance,
+    /// index)`, into `out`.
+    fn nearest(&self, x: &Point3, ws: &mut BvhWorkspace, out: &mut Vec<(Real, u32)>) {
+        let c = FACING_CANDIDATES.min(self.means.len());
+        if let Some(tree) = &self.tree {
+            tree.nearest_k(&self.means, x, c, ws, out);
+            return;
+        }
+        out.clear();
+        out.extend(
+            self.means
+                .iter()
+                .enumerate()
+                .map(|(j, m)| ((m - x).norm_squared(), j as u32)),
+        );
+        if c > 0 {
+            out.select_nth_unstable_by(c - 1, |a, b| a.0.total_cmp(&b.0));
+        }
+        out.truncate(c);
+    }
+}
+
 /// Calls `visit` on the facing pair of each of `own`'s probes that has one (see
 /// [`element_crossing_probabilities`]) until `visit` returns `false`; returns
 /// whether every pair was visited.
@@ -120,7 +164,9 @@ fn for_each_facing(
     other: &[Posed<'_>],
     mut visit: impl FnMut(&Facing) -> bool,
 ) -> bool {
-    let mut nearest: Vec<(Real, usize)> = Vec::with_capacity(other.len());
+    let candidates = Candidates::new(other.iter().map(|o| o.mean).collect());
+    let mut nearest: Vec<(Real, u32)> = Vec::with_capacity(other.len());
+    let mut ws = BvhWorkspace::default();
     for (k, p) in own.iter().enumerate() {
         for &[u, v] in &p.e.probes {
             let (x, var_x) = if p.e.is_point() {
@@ -128,26 +174,12 @@ fn for_each_facing(
             } else {
                 p.at(u, v)
             };
-            nearest.clear();
-            nearest.extend(
-                other
-                    .iter()
-                    .enumerate()
-                    .map(|(j, o)| ((o.mean - x).norm_squared(), j)),
-            );
-            let c = FACING_CANDIDATES.min(nearest.len());
-            if c == 0 {
-                continue;
-            }
-            nearest.select_nth_unstable_by(c - 1, |a, b| a.0.total_cmp(&b.0));
+            candidates.nearest(&x, &mut ws, &mut nearest);
             let mut best: Option<Facing> = None;
-            for &(_, j) in &nearest[..c] {
+            for &(_, j) in &nearest {
+                let j = j as usize;
                 let o = &other[j];
                 let (ou, ov) = o.coordinates(&x);
-                // Over the other element's surface only where it was sampled.
-                if !o.e.covers(ou, ov) {
-                    continue;
-                }
                 let (y, var_y) = o.at(ou, ov);
                 let d = y - x;
                 let lateral = if o.e.is_point() {
@@ -164,7 +196,9 @@ fn for_each_facing(
                 let over = o.e.is_point() || o.is_over(ou, ov);
                 let key = (!over, d.norm_squared());
                 let better = best.as_ref().is_none_or(|b| key < b.key);
-                if lateral <= allowed && better {
+                // Over the other element's surface only where it was sampled
+                // (the costliest test, so the last).
+                if lateral <= allowed && better && o.e.covers(ou, ov) {
                     best = Some(Facing {
                         key,
                         own: k,
@@ -265,6 +299,36 @@ mod tests {
     use super::*;
 
     use crate::probability::normal_cdf;
+
+    #[test]
+    fn candidates_from_the_tree_are_the_nearest_means() {
+        // A deterministic scatter of 500 means; queries inside and outside it.
+        let mean = |i: usize| {
+            let t = i as Real;
+            Point3::new(
+                (t * 0.618).fract(),
+                (t * 0.414).fract(),
+                (t * 0.732).fract() * 0.1,
+            )
+        };
+        let means: Vec<Point3> = (0..500).map(mean).collect();
+        let tree = Candidates::new(means.clone());
+        assert!(tree.tree.is_some());
+        let brute = Candidates {
+            means: means.clone(),
+            tree: None,
+        };
+        let mut ws = BvhWorkspace::default();
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for q in 0..50 {
+            let x = Point3::new(q as Real * 0.031 - 0.2, 0.5, q as Real * 0.007);
+            tree.nearest(&x, &mut ws, &mut a);
+            brute.nearest(&x, &mut ws, &mut b);
+            b.sort_by(|p, q| p.0.total_cmp(&q.0));
+            assert_eq!(a.len(), FACING_CANDIDATES);
+            assert_eq!(a, b, "query {q}");
+        }
+    }
 
     #[test]
     fn crossing_is_the_gaussian_tail_and_exact_without_noise() {
