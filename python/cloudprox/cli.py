@@ -181,23 +181,25 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------ collide
 
 
+#: The sensor models' parameters with flags of their own on `collide` (the
+#: `robot` command has no such flags: they are None there, the model's defaults).
+_SENSOR_PARAMETERS = (
+    "axial_offset",
+    "axial_quadratic",
+    "axial_depth0",
+    "focal_px",
+    "sigma_px",
+    "baseline",
+    "sigma_disparity_px",
+    "sigma_range",
+    "sigma_angle",
+)
+
+
 def _sensor_spec(args: argparse.Namespace) -> Any:
     from cloudprox.pipeline import sensor_spec
 
-    params = {
-        k: getattr(args, k)
-        for k in (
-            "axial_offset",
-            "axial_quadratic",
-            "axial_depth0",
-            "focal_px",
-            "sigma_px",
-            "baseline",
-            "sigma_disparity_px",
-            "sigma_range",
-            "sigma_angle",
-        )
-    }
+    params = {k: getattr(args, k) for k in _SENSOR_PARAMETERS}
     return sensor_spec(
         args.sensor,
         sigma=args.sigma,
@@ -861,19 +863,7 @@ def _parser() -> argparse.ArgumentParser:
     rob.add_argument("--json", action="store_true", help="print the result as JSON")
     rob.set_defaults(
         func=_cmd_robot,
-        **dict.fromkeys(
-            (
-                "axial_offset",
-                "axial_quadratic",
-                "axial_depth0",
-                "focal_px",
-                "sigma_px",
-                "baseline",
-                "sigma_disparity_px",
-                "sigma_range",
-                "sigma_angle",
-            )
-        ),
+        **dict.fromkeys(_SENSOR_PARAMETERS),
     )
 
     ex = sub.add_parser(
