@@ -22,6 +22,7 @@ FACTORS = (0.25, 0.5, 1.0)
 
 
 def main() -> None:
+    """Print P for a cube against a plane cloud at each gap and mesh spacing factor."""
     cube = cp.Mesh.cuboid(0.05, 0.05, 0.05)
     g = np.stack(np.meshgrid(np.linspace(-0.5, 0.5, 50), np.linspace(-0.5, 0.5, 50)), -1)
     g = g.reshape(-1, 2)

@@ -23,8 +23,8 @@ step "build and install the Python package"
 python3 -m pip install --quiet --disable-pip-version-check -e '.[test]'
 
 step "ruff"
-python3 -m ruff check python tests
-python3 -m ruff format --check python tests
+python3 -m ruff check python tests benches
+python3 -m ruff format --check python tests benches
 
 step "stubs match the compiled module (mypy.stubtest)"
 python3 -m mypy.stubtest cloudprox._native
