@@ -6,6 +6,9 @@
 ``cloudprox collide A B [--sigma S | --sensor ...] [--pose-a P] [--filter STEP]``
     One query between two files: point clouds (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ)
     or meshes (STL, OBJ, OFF, PLY with faces).
+``cloudprox view A B [--html FILE] [--rerun FILE.rrd] [--no-open]``
+    The query of ``collide``, shown in 3D in the web browser (``collide`` and
+    ``robot`` write the same view with ``--html`` / ``--rerun``).
 ``cloudprox info FILE``
     A summary of a point-cloud or mesh file.
 ``cloudprox example [DIR]``
@@ -157,10 +160,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # The figure: touching, and the first undecided case (else the 4 sigma one).
     touching = next(r for r in runs if r[0] == 0.0)
     undecided = next((r for r in runs if r[2].state == "contact"), runs[DEMO_GAPS_SIGMA.index(4.0)])
-    top_lo, top_hi = scene.table_top().mesh.bounds()
-    centre = (top_lo + top_hi) / 2.0
-    lo = np.array([centre[0] - 1.0, centre[1] - 1.1, top_hi[2] - 0.3])
-    hi = np.array([centre[0] + 1.0, centre[1] + 1.3, top_hi[2] + 0.9])
     out.mkdir(parents=True, exist_ok=True)
     png = out / "demo.png"
     panels = [
@@ -172,7 +171,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         )
         for gap, pose, result in (touching, undecided)
     ]
-    plot_collisions(panels, png, bounds=(lo, hi), labels=("piano", "room"))
+    plot_collisions(panels, png, bounds="contact", labels=("piano", "room"), elev=25.0)
     console.print(f"Figure written to {png.resolve()}")
     console.print(f"Total time {time.perf_counter() - t_start:.2f} s.")
     return 0
@@ -233,7 +232,23 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     }
     if args.decide_only:
         options["decide_only"] = True
+    _check_view_arguments(args)
     result = collide(sides[0].obj, sides[1].obj, poses[0], poses[1], **options)
+
+    def scene() -> Any:
+        from cloudprox.view import collision_scene
+
+        return collision_scene(
+            result,
+            sides[0].obj,
+            sides[1].obj,
+            poses[0],
+            poses[1],
+            labels=(f"A {Path(args.a).name}", f"B {Path(args.b).name}"),
+            surfaces=args.surfaces,
+        )
+
+    _write_views(args, scene)
     if args.json:
         doc = result_to_dict(result) | {"a": sides[0].summary(), "b": sides[1].summary()}
         print(json.dumps(doc, indent=2))
@@ -272,6 +287,55 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     )
     console.print(f"stats: {stats}")
     return 0
+
+
+def _check_view_arguments(args: argparse.Namespace) -> None:
+    if args.surfaces < 0:
+        raise CliError(f"--surfaces must be >= 0, got {args.surfaces}")
+    for flag, path, suffix in (("--html", args.html, ".html"), ("--rerun", args.rerun, ".rrd")):
+        if path is None:
+            continue
+        if not Path(path).suffix:
+            raise CliError(f"{flag} {path}: give a file name ending in {suffix}")
+        parent = Path(path).resolve().parent
+        if not parent.is_dir():
+            raise CliError(f"{flag} {path}: no such folder {parent}")
+    modules = [("--html", args.html, "plotly", "view"), ("--rerun", args.rerun, "rerun", "rerun")]
+    for flag, path, module, extra in modules:
+        if path is None:
+            continue
+        import importlib.util
+
+        if importlib.util.find_spec(module) is None:
+            raise CliError(f"{flag} needs the '{module}' package: pip install 'cloudprox[{extra}]'")
+
+
+def _write_views(args: argparse.Namespace, make_scene: Any) -> None:
+    """Write the ``--html`` and ``--rerun`` views of a scene made by ``make_scene()``."""
+    if args.html is None and args.rerun is None:
+        return
+    from cloudprox import view
+
+    scene = make_scene()
+    console = _console(stderr=bool(getattr(args, "json", False)))
+    if args.html is not None:
+        path = view.write_html(scene, args.html)
+        size = path.stat().st_size / 1e6
+        console.print(f"view written to {path.resolve()} ({size:.1f} MB; open it in a browser)")
+    if args.rerun is not None:
+        path = view.write_rerun(scene, args.rerun)
+        console.print(f"Rerun recording written to {path.resolve()} (rerun {path})")
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    if args.html is None:
+        args.html = "cloudprox-view.html"
+    status = _cmd_collide(args)
+    if status == 0 and not args.no_open:
+        import webbrowser
+
+        webbrowser.open(Path(args.html).resolve().as_uri())
+    return status
 
 
 # ------------------------------------------------------------------------ robot
@@ -348,8 +412,27 @@ def _cmd_robot(args: argparse.Namespace) -> int:
     if side.cloud is None:
         raise CliError(f"{args.scan}: the scan must be a point cloud, not a mesh")
     options: dict[str, Any] = {"mesh_spacing": args.mesh_spacing}
+    _check_view_arguments(args)
+    if args.q is None and (args.html is not None or args.rerun is not None):
+        raise CliError("--html and --rerun show one configuration: give --q, not --q-file")
     if args.q is not None:
         result = collide_robot(robot, qs[0], side.cloud, base, **options)
+        cloud = side.cloud
+
+        def scene() -> Any:
+            from cloudprox.view import robot_scene
+
+            return robot_scene(
+                robot,
+                qs[0],
+                cloud,
+                result,
+                base,
+                label=Path(args.scan).name,
+                surfaces=args.surfaces,
+            )
+
+        _write_views(args, scene)
         if args.json:
             doc = {
                 "probability": result.probability,
@@ -684,45 +767,10 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- main
 
 
-def _parser() -> argparse.ArgumentParser:
-    defaults = default_options()
-    names = option_names()
-    parser = argparse.ArgumentParser(
-        prog="cloudprox",
-        description="Probabilistic collision queries between noisy point clouds.",
-    )
-    parser.add_argument("--version", action="version", version=f"cloudprox {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-
-    demo = sub.add_parser("demo", help="piano over a table in a room, at several exact gaps")
-    demo.add_argument(
-        "--out", default="cloudprox-demo", help="directory for demo.png (default: %(default)s)"
-    )
-    demo.add_argument(
-        "--sigma",
-        type=float,
-        default=0.005,
-        help="noise standard deviation in metres (default: %(default)s)",
-    )
-    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    demo.add_argument(
-        "--points",
-        type=int,
-        default=10_000,
-        help="approximate number of piano points (default: %(default)s)",
-    )
-    demo.set_defaults(func=_cmd_demo)
-
-    col = sub.add_parser(
-        "collide",
-        help="one query between two files (point clouds or meshes)",
-        description=(
-            "One query between A and B. Each is a point-cloud file (PLY, PCD, XYZ/CSV, NPY, "
-            "LAS/LAZ) or a mesh file (STL, OBJ, OFF, PLY with faces). Cloud sides get their "
-            "noise from --sigma, --sensor, or the covariances stored in the file, then go "
-            "through the --filter steps in order."
-        ),
-    )
+def _add_query_arguments(
+    col: argparse.ArgumentParser, defaults: dict[str, Any], names: dict[str, Any]
+) -> None:
+    """Add the arguments of one query between two files (``collide`` and ``view``)."""
     col.add_argument("a", metavar="A", help="point-cloud or mesh file of side A")
     col.add_argument("b", metavar="B", help="point-cloud or mesh file of side B")
     col.add_argument(
@@ -809,7 +857,91 @@ def _parser() -> argparse.ArgumentParser:
         help=f"SOCP solver (default: {defaults['solver']})",
     )
     col.add_argument("--json", action="store_true", help="print the result as JSON")
+    _add_view_arguments(col)
+
+
+def _add_view_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--html`` and ``--rerun``: where a command writes its interactive view."""
+    group = parser.add_argument_group("interactive view")
+    group.add_argument(
+        "--html",
+        metavar="FILE",
+        default=None,
+        help="write the interactive 3D view: one HTML file that opens without a server "
+        "(needs cloudprox[view])",
+    )
+    group.add_argument(
+        "--rerun",
+        metavar="FILE.rrd",
+        default=None,
+        help="log the same scene to a Rerun recording (needs cloudprox[rerun])",
+    )
+    group.add_argument(
+        "--surfaces",
+        type=int,
+        default=5,
+        metavar="N",
+        help="separating surfaces of the N most probable regions in the view, hidden until "
+        "clicked in the legend (default: %(default)s)",
+    )
+
+
+def _parser() -> argparse.ArgumentParser:
+    defaults = default_options()
+    names = option_names()
+    parser = argparse.ArgumentParser(
+        prog="cloudprox",
+        description="Probabilistic collision queries between noisy point clouds.",
+    )
+    parser.add_argument("--version", action="version", version=f"cloudprox {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    demo = sub.add_parser("demo", help="piano over a table in a room, at several exact gaps")
+    demo.add_argument(
+        "--out", default="cloudprox-demo", help="directory for demo.png (default: %(default)s)"
+    )
+    demo.add_argument(
+        "--sigma",
+        type=float,
+        default=0.005,
+        help="noise standard deviation in metres (default: %(default)s)",
+    )
+    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    demo.add_argument(
+        "--points",
+        type=int,
+        default=10_000,
+        help="approximate number of piano points (default: %(default)s)",
+    )
+    demo.set_defaults(func=_cmd_demo)
+
+    col = sub.add_parser(
+        "collide",
+        help="one query between two files (point clouds or meshes)",
+        description=(
+            "One query between A and B. Each is a point-cloud file (PLY, PCD, XYZ/CSV, NPY, "
+            "LAS/LAZ) or a mesh file (STL, OBJ, OFF, PLY with faces). Cloud sides get their "
+            "noise from --sigma, --sensor, or the covariances stored in the file, then go "
+            "through the --filter steps in order."
+        ),
+    )
+    _add_query_arguments(col, defaults, names)
     col.set_defaults(func=_cmd_collide)
+
+    vw = sub.add_parser(
+        "view",
+        help="one query between two files, shown in 3D in the web browser",
+        description=(
+            "The query of `cloudprox collide A B` (same options), written as an interactive "
+            "3D view (--html, default cloudprox-view.html: one file that opens without a "
+            "server or the internet) and opened in the web browser."
+        ),
+    )
+    _add_query_arguments(vw, defaults, names)
+    vw.add_argument(
+        "--no-open", action="store_true", help="write the view but do not open the browser"
+    )
+    vw.set_defaults(func=_cmd_view)
 
     rob = sub.add_parser(
         "robot",
@@ -861,6 +993,7 @@ def _parser() -> argparse.ArgumentParser:
         help="sampling spacing of the links (m; default half the scan's spacing)",
     )
     rob.add_argument("--json", action="store_true", help="print the result as JSON")
+    _add_view_arguments(rob)
     rob.set_defaults(
         func=_cmd_robot,
         **dict.fromkeys(_SENSOR_PARAMETERS),
@@ -944,7 +1077,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_usage(sys.stderr)
         print(
             "cloudprox: error: a command is required "
-            "(demo, collide, robot, info, example, bench or reproduce)",
+            "(demo, collide, view, robot, info, example, bench or reproduce)",
             file=sys.stderr,
         )
         return 2

@@ -1,11 +1,17 @@
 //! `CollisionResult` and `ContactRegion`: the answer of a query, as plain data.
 
+use std::sync::Arc;
+
+use cloudprox::cloud::PointCloud;
+use cloudprox::math::Pose;
 use cloudprox::query::{CollisionResult, ContactRegion, QueryStats};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
 
-use crate::convert::{indices_to_py, points_from, rows3_to_py, vec_to_py, vector3_to_py};
+use crate::convert::{
+    indices_to_py, points_from, points_to_py, rows3_to_py, vec_to_py, vector3_to_py,
+};
 use crate::error::guard;
 
 /// The values `(m,)` and gradients `(m, 3)` of a separating surface.
@@ -142,6 +148,20 @@ pub struct PyCollisionResult {
     probabilities_b: Vec<f64>,
     regions: Vec<Py<PyContactRegion>>,
     stats: QueryStats,
+    sides: Option<QueriedSides>,
+}
+
+/// The two sides of a query as queried (a mesh side: its samples) with their
+/// poses, kept (shared, not copied) so a result can give its points.
+pub struct QueriedSides {
+    /// Side A's cloud in its own frame.
+    pub a: Arc<PointCloud>,
+    /// Side B's cloud in its own frame.
+    pub b: Arc<PointCloud>,
+    /// Side A's pose.
+    pub pose_a: Pose,
+    /// Side B's pose.
+    pub pose_b: Pose,
 }
 
 impl PyCollisionResult {
@@ -159,7 +179,32 @@ impl PyCollisionResult {
             probabilities_b: r.probabilities_b,
             regions,
             stats: r.stats,
+            sides: None,
         })
+    }
+
+    /// Wraps a core result and the sides it was computed on.
+    pub fn with_sides(py: Python<'_>, r: CollisionResult, sides: QueriedSides) -> PyResult<Self> {
+        let mut out = Self::new(py, r)?;
+        out.sides = Some(sides);
+        Ok(out)
+    }
+
+    fn world_points<'py>(
+        &self,
+        py: Python<'py>,
+        side_a: bool,
+    ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let Some(s) = &self.sides else {
+            return Ok(None);
+        };
+        let (cloud, pose) = if side_a {
+            (&s.a, &s.pose_a)
+        } else {
+            (&s.b, &s.pose_b)
+        };
+        let moved: Vec<_> = cloud.points().iter().map(|p| pose * p).collect();
+        points_to_py(py, &moved).map(Some)
     }
 }
 
@@ -187,6 +232,36 @@ impl PyCollisionResult {
     #[getter]
     fn probabilities_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vec_to_py(py, &self.probabilities_b)
+    }
+
+    /// Side A's points as queried (a mesh side: its samples), world frame, shape
+    /// `(n_a, 3)`; `None` when the result does not record them (robot links).
+    #[getter]
+    fn points_a<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.world_points(py, true)
+    }
+
+    /// Side B's points as queried, world frame, shape `(n_b, 3)`, or `None`.
+    #[getter]
+    fn points_b<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.world_points(py, false)
+    }
+
+    /// Writes the interactive HTML view of the result and opens it in the web
+    /// browser (`cloudprox.view.show`; needs `cloudprox[view]`). Returns the path.
+    #[pyo3(signature = (path=None, **options))]
+    fn show<'py>(
+        slf: &Bound<'py, Self>,
+        path: Option<&Bound<'py, PyAny>>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let show = py.import("cloudprox.view")?.getattr("show")?;
+        let path = match path {
+            Some(p) => p.clone(),
+            None => py.None().into_bound(py),
+        };
+        show.call(PyTuple::new(py, [slf.clone().into_any(), path])?, options)
     }
 
     /// The classified patches (a new list of the same region objects each time).
