@@ -10,6 +10,7 @@ object's own frame to the world; ``None`` means identity.
 
 import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, Final, Literal, TypedDict, final
 
 import numpy as np
@@ -284,6 +285,23 @@ class CollisionResult:
     @property
     def probabilities_b(self) -> _FloatArray:
         """Per-point probability of B's points being on the wrong side, shape ``(n_b,)``."""
+    @property
+    def points_a(self) -> _FloatArray | None:
+        """Side A's points as queried (a mesh side: its samples), world frame, ``(n_a, 3)``.
+
+        ``None`` when the result does not record them (the per-link results of
+        robot queries). The result shares the clouds it was computed on.
+        """
+    @property
+    def points_b(self) -> _FloatArray | None:
+        """Side B's points as queried, world frame, shape ``(n_b, 3)``, or ``None``."""
+    def show(self, path: str | os.PathLike[str] | None = None, **options: Any) -> Path:
+        """Write the interactive HTML view and open it in the web browser.
+
+        Calls :func:`cloudprox.view.show` (needs ``cloudprox[view]``): ``path``
+        (default: a new temporary file), ``open_browser`` and the options of
+        :func:`cloudprox.view.collision_scene`. Returns the file written.
+        """
     @property
     def regions(self) -> list[ContactRegion]:
         """The classified patches of the near regions."""

@@ -248,8 +248,8 @@ def _cmd_collide(args: argparse.Namespace) -> int:
             surfaces=args.surfaces,
         )
 
-    _write_views(args, scene)
     if args.json:
+        _write_views(args, scene)
         doc = result_to_dict(result) | {"a": sides[0].summary(), "b": sides[1].summary()}
         print(json.dumps(doc, indent=2))
         return 0
@@ -286,6 +286,7 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
     )
     console.print(f"stats: {stats}")
+    _write_views(args, scene)
     return 0
 
 
@@ -432,8 +433,8 @@ def _cmd_robot(args: argparse.Namespace) -> int:
                 surfaces=args.surfaces,
             )
 
-        _write_views(args, scene)
         if args.json:
+            _write_views(args, scene)
             doc = {
                 "probability": result.probability,
                 "state": result.state,
@@ -467,6 +468,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         if result.self_collisions:
             pairs = ", ".join(f"{a}-{b}" for a, b in result.self_collisions)
             console.print(f"self-collision: {pairs}")
+        _write_views(args, scene)
         return 0
     chunk = 256
     parts = []

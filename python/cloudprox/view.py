@@ -548,7 +548,30 @@ def to_figure(scene: Scene) -> Any:
         "thickness": 18,
         "x": 1.0,
     }
-    shown_scale = False
+    # The colour bar has a trace of its own (one invisible point inside the
+    # scene): it shows even when no point reaches quiet_below.
+    lo, hi = _bounds(scene)
+    fig.add_trace(
+        go.Scatter3d(
+            x=[float(lo[0])],
+            y=[float(lo[1])],
+            z=[float(lo[2])],
+            mode="markers",
+            marker={
+                "size": 0.1,
+                "opacity": 0.0,
+                "color": [0.0],
+                "colorscale": COLORSCALE,
+                "cmin": 0.0,
+                "cmax": 1.0,
+                "showscale": True,
+                "colorbar": colorbar,
+            },
+            showlegend=False,
+            hoverinfo="skip",
+            name="colour bar",
+        )
+    )
     for layer in scene.points:
         pts, prob = layer.points, layer.probabilities
         quiet = prob < scene.quiet_below
@@ -582,14 +605,11 @@ def to_figure(scene: Scene) -> Any:
                     "colorscale": COLORSCALE,
                     "cmin": 0.0,
                     "cmax": 1.0,
-                    "showscale": not shown_scale,
-                    "colorbar": colorbar,
                 },
                 customdata=prob[loud],
                 hovertemplate=_hover(layer.name),
             )
         )
-        shown_scale = True
     for m in scene.meshes:
         common = {
             "x": m.vertices[:, 0],
@@ -613,12 +633,10 @@ def to_figure(scene: Scene) -> Any:
                     colorscale=COLORSCALE,
                     cmin=0.0,
                     cmax=1.0,
-                    showscale=not shown_scale,
-                    colorbar=colorbar,
+                    showscale=False,
                     **common,
                 )
             )
-            shown_scale = True
     if scene.regions:
         length = 0.08 * extent if focus is None else max(0.4 * focus[1], 0.005 * extent)
         xs: list[float | None] = []
@@ -681,7 +699,6 @@ def to_figure(scene: Scene) -> Any:
                 )
             )
     axis = {"showbackground": True, "backgroundcolor": "#f4f4f4", "gridcolor": "#d0d0d0"}
-    lo, hi = _bounds(scene)
     pad = 0.02 * float((hi - lo).max()) + 1e-9
     lo, hi = lo - pad, hi + pad
     size = float((hi - lo).max())
