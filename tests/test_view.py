@@ -351,3 +351,25 @@ def test_cli_robot_html_needs_one_configuration(capsys, tmp_path, arm_files) -> 
         str(tmp_path / "x.html"),
     )
     assert code == 2 and "give --q, not --q-file" in err
+
+
+def test_readme_view_line(tmp_path) -> None:
+    from tests.robots import readme_block
+
+    line = readme_block("view-cli").strip()
+    assert "\n" not in line, "the README promises one command line"
+    script = shutil.which("cloudprox")
+    launcher = [script] if script else [sys.executable, "-m", "cloudprox"]
+    for command in line.split("&&"):
+        argv = command.split()
+        assert argv[0] == "cloudprox"
+        done = subprocess.run(
+            [*launcher, *argv[1:]], cwd=tmp_path, capture_output=True, text=True, check=False
+        )
+        assert done.returncode == 0, done.stderr
+    html = tmp_path / "grasp.html"
+    assert "state: collision" in done.stdout and str(html.resolve()) in done.stdout.replace(
+        "\n", ""
+    )
+    text = html.read_text()
+    assert not re.search(r"<script[^>]*\bsrc=", text) and "state: collision" in text

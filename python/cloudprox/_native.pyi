@@ -103,6 +103,8 @@ class SolverError(CloudproxError, RuntimeError):
 class PointCloud:
     """Points with a 3x3 covariance each, in the cloud's own frame.
 
+    It pickles exactly (its root's points and sensor covariances, discretization
+    neighbours, noise correlation and moves; the hierarchy is rebuilt on use).
     The covariance of a point is its sensor covariance (from ``sigma``, ``cov``
     or a ``sensor`` model seen from ``origin`` / ``sensor_pose``) plus, with ``discretization=True``, the k-nearest-neighbour
     discretization covariance. The bounding volume hierarchy over the points is
@@ -187,6 +189,9 @@ class PointCloud:
     @property
     def sensor_covariances(self) -> _FloatArray:
         """Per-point sensor covariances (without the discretization part), ``(n, 3, 3)``."""
+    @staticmethod
+    def _from_state(state: tuple[Any, ...]) -> PointCloud:
+        """Rebuild a pickled cloud (pickle support; the state comes from ``__reduce__``)."""
     def transformed(self, transform: npt.ArrayLike) -> PointCloud:
         """Return a copy moved by a rigid transform.
 
@@ -1003,6 +1008,9 @@ def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> tuple[Mesh, i
 class Robot:
     """A robot loaded from a URDF file, prepared once for many queries.
 
+    It pickles as its URDF text: the mesh files it names are read again on
+    unpickling, at the same paths.
+
     A configuration ``q`` holds one value per independent moving joint (revolute,
     continuous, prismatic; mimic joints follow their master), in the order of
     :attr:`joint_names`. A configuration outside the joint limits, of the wrong
@@ -1126,6 +1134,11 @@ class RobotBatchResult:
     @property
     def link_probabilities(self) -> _FloatArray:
         """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order."""
+    @staticmethod
+    def _from_state(
+        state: tuple[list[float], list[str], list[bool], list[float], int],
+    ) -> RobotBatchResult:
+        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links)``."""
     def __len__(self) -> int: ...
 
 @final

@@ -2,8 +2,10 @@
 
 use std::sync::Arc;
 
+use cloudprox::classify::{Separator, SolveStatus, Surface};
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
+use cloudprox::math::{Point3, Vector3};
 use cloudprox::query::{CollisionResult, ContactRegion, QueryStats};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -33,6 +35,140 @@ fn fmt_g(x: f64) -> String {
             s
         }
     }
+}
+
+/// The `&'static str` of a state name (`"free"`, `"contact"`, `"collision"`).
+pub(crate) fn state_name(py: Python<'_>, s: &str) -> PyResult<&'static str> {
+    match s {
+        "free" => Ok("free"),
+        "contact" => Ok("contact"),
+        "collision" => Ok("collision"),
+        other => Err(crate::error::invalid_input(
+            py,
+            format!("unknown collision state '{other}'"),
+        )),
+    }
+}
+
+/// The pickled form of a separator: surface name, weights, offset, centre,
+/// scale and frame (see [`crate::cloud::pose_to_7`]).
+type SeparatorState = (String, Vec<f64>, f64, [f64; 3], f64, [f64; 7]);
+
+/// The pickled form of a `ContactRegion`.
+type RegionState = (
+    u32,
+    Vec<u32>,
+    Vec<u32>,
+    [f64; 3],
+    [f64; 3],
+    f64,
+    f64,
+    SeparatorState,
+    String,
+    u32,
+);
+
+/// The pickled form of query statistics (the fields of `QueryStats`, in order).
+type StatsState = (
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    u64,
+    usize,
+    usize,
+    f64,
+    f64,
+);
+
+/// The pickled form of a `CollisionResult` (without the clouds it was computed on).
+type ResultState = (
+    f64,
+    String,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<RegionState>,
+    StatsState,
+);
+
+fn region_to_state(r: &ContactRegion) -> RegionState {
+    let sep = &r.separator;
+    (
+        r.component,
+        r.indices_a.clone(),
+        r.indices_b.clone(),
+        [r.point.x, r.point.y, r.point.z],
+        [r.normal.x, r.normal.y, r.normal.z],
+        r.separation,
+        r.probability,
+        (
+            sep.surface.name().to_string(),
+            sep.w.clone(),
+            sep.b,
+            [sep.center.x, sep.center.y, sep.center.z],
+            sep.scale,
+            crate::cloud::pose_to_7(&sep.frame),
+        ),
+        r.status.name().to_string(),
+        r.iterations,
+    )
+}
+
+fn surface_from(py: Python<'_>, name: &str) -> PyResult<Surface> {
+    Surface::from_name(name).ok_or_else(|| {
+        crate::error::invalid_input(py, format!("unknown surface '{name}' in a pickled region"))
+    })
+}
+
+fn region_from_state(py: Python<'_>, s: RegionState) -> PyResult<ContactRegion> {
+    let (
+        component,
+        indices_a,
+        indices_b,
+        point,
+        normal,
+        separation,
+        probability,
+        sep,
+        status,
+        iterations,
+    ) = s;
+    let (surface, w, b, center, scale, frame) = sep;
+    let surface = surface_from(py, &surface)?;
+    let status = match status.as_str() {
+        "solved" => SolveStatus::Solved,
+        "almost_solved" => SolveStatus::AlmostSolved,
+        "fallback" => SolveStatus::Fallback,
+        other => {
+            return Err(crate::error::invalid_input(
+                py,
+                format!("unknown solve status '{other}' in a pickled region"),
+            ))
+        }
+    };
+    Ok(ContactRegion {
+        component,
+        indices_a,
+        indices_b,
+        point: Point3::new(point[0], point[1], point[2]),
+        normal: Vector3::new(normal[0], normal[1], normal[2]),
+        separation,
+        probability,
+        separator: Separator {
+            surface,
+            w,
+            b,
+            center: Point3::new(center[0], center[1], center[2]),
+            scale,
+            frame: crate::cloud::pose_from_7(&frame),
+        },
+        surface,
+        status,
+        iterations,
+    })
 }
 
 /// One patch of a near region with its own separating surface (world frame).
@@ -120,6 +256,22 @@ impl PyContactRegion {
             guard(|| points.iter().map(|p| sep.value_and_gradient(p)).unzip())
                 .map_err(crate::error::Panicked::into_py_err)?;
         Ok((vec_to_py(py, &f), rows3_to_py(py, g.into_iter())?))
+    }
+
+    /// Pickle support: every field, the separating surface included.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (RegionState,))> {
+        Ok((
+            slf.getattr("_from_state")?,
+            (region_to_state(&slf.get().inner),),
+        ))
+    }
+
+    /// Rebuilds a pickled region (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: RegionState) -> PyResult<Self> {
+        Ok(Self {
+            inner: region_from_state(py, state)?,
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -262,6 +414,102 @@ impl PyCollisionResult {
             None => py.None().into_bound(py),
         };
         show.call(PyTuple::new(py, [slf.clone().into_any(), path])?, options)
+    }
+
+    /// Pickle support: `P`, the state, the per-point probabilities, the regions
+    /// and the statistics; not the clouds (`points_a` and `points_b` are `None`
+    /// once unpickled).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ResultState,))> {
+        let py = slf.py();
+        let me = slf.get();
+        let regions = me
+            .regions
+            .iter()
+            .map(|r| region_to_state(&r.get().inner))
+            .collect();
+        let QueryStats {
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds,
+        } = me.stats.clone();
+        let _ = py;
+        let state = (
+            me.probability,
+            me.state.to_string(),
+            me.probabilities_a.clone(),
+            me.probabilities_b.clone(),
+            regions,
+            (
+                node_pairs_visited,
+                leaf_pairs,
+                near_regions,
+                patches,
+                misfit_cuts,
+                patches_beyond_reach,
+                points_classified,
+                solver_iterations,
+                barrier_fallbacks,
+                solver_fallbacks,
+                pruned_bound,
+                time_seconds,
+            ),
+        );
+        Ok((slf.getattr("_from_state")?, (state,)))
+    }
+
+    /// Rebuilds a pickled result (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: ResultState) -> PyResult<Self> {
+        let (probability, state_text, probabilities_a, probabilities_b, regions, stats) = state;
+        let regions = regions
+            .into_iter()
+            .map(|r| Py::new(py, PyContactRegion::wrap(region_from_state(py, r)?)))
+            .collect::<PyResult<Vec<_>>>()?;
+        let (
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds,
+        ) = stats;
+        Ok(Self {
+            probability,
+            state: state_name(py, &state_text)?,
+            probabilities_a,
+            probabilities_b,
+            regions,
+            stats: QueryStats {
+                node_pairs_visited,
+                leaf_pairs,
+                near_regions,
+                patches,
+                misfit_cuts,
+                patches_beyond_reach,
+                points_classified,
+                solver_iterations,
+                barrier_fallbacks,
+                solver_fallbacks,
+                pruned_bound,
+                time_seconds,
+            },
+            sides: None,
+        })
     }
 
     /// The classified patches (a new list of the same region objects each time).
