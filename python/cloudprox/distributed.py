@@ -90,7 +90,7 @@ def default_batch_size(m: int, cpus: float) -> int:
 
 
 def _local(ref_box: list[Any]) -> Any:
-    """The object behind an object ref, unpickled once per worker process."""
+    """Return the object behind an object ref, unpickled once per worker process."""
     import ray
 
     ref = ref_box[0]
