@@ -120,7 +120,7 @@ def test_robot_and_batch_roundtrip(tmp_path) -> None:
     q = np.array([0.3, -0.2, 0.05, 1.0])
     for name, pose in robot.link_poses(q).items():
         np.testing.assert_array_equal(back.link_poses(q)[name], pose)
-    cloud = cp.PointCloud(wall(0.62, 0.3, 0.15, 0.002, seed=3), sigma=0.002)
+    cloud = cp.PointCloud(wall(0.36, 0.3, 0.15, 0.002, seed=3), sigma=0.002)
     qs = np.array([[0.0, 0.0, 0.0, 0.0], [0.0, -0.3, 0.1, 0.0], [1.5, 0.0, 0.0, 0.0]])
     local = cp.collide_robot_many(robot, qs, cloud)
     again = cp.collide_robot_many(back, qs, cloud)

@@ -227,16 +227,16 @@ def test_rerun_recording_reads_back(tmp_path, spheres_near) -> None:
 def arm_files(tmp_path_factory) -> dict[str, str]:
     d = tmp_path_factory.mktemp("arm-view")
     (d / "arm.urdf").write_text(ARM_URDF)
-    np.save(d / "wall.npy", wall(0.62, 0.3, 0.15, 0.002, seed=3))
+    np.save(d / "wall.npy", wall(0.36, 0.3, 0.15, 0.002, seed=3))
     return {"urdf": str(d / "arm.urdf"), "scan": str(d / "wall.npy"), "dir": str(d)}
 
 
 def test_robot_scene(arm_files) -> None:
     robot = cp.Robot.from_urdf(arm_files["urdf"])
     cloud = cp.PointCloud(np.load(arm_files["scan"]), sigma=0.002)
-    q = np.array([0.0, 0.0, 0.0])
-    q = np.zeros(robot.dof)
+    q = np.array([0.0, 0.0, 0.08, 0.0])  # link3 into the wall
     result = cp.collide_robot(robot, q, cloud)
+    assert result.state == "collision" and result.links["link3"].state == "collision"
     scene = view.robot_scene(robot, q, cloud, result, label="wall")
     names = [m.name for m in scene.meshes]
     assert names == [n for n in robot.link_names if robot.link_mesh(n) is not None]
@@ -312,7 +312,7 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
         "--sigma",
         "0.002",
         "--q",
-        "0,0,0,0",
+        "0,0,0.08,0",
         "--html",
         str(robot_html),
     )

@@ -69,9 +69,7 @@ def ensure_ray(address: str | None = None) -> ray_module:
     try:
         import ray
     except ImportError:
-        raise ImportError(
-            "cloudprox.distributed needs Ray: pip install 'cloudprox[ray]'"
-        ) from None
+        raise ImportError("cloudprox.distributed needs Ray: pip install 'cloudprox[ray]'") from None
     if not ray.is_initialized():
         ray.init(address=address, ignore_reinit_error=True)
     return ray
@@ -170,7 +168,20 @@ def _run(
             done, pending = ray.wait(pending, num_returns=1)
             for ref in done:
                 k = order[ref]
-                out[k] = ray.get(ref)
+                try:
+                    out[k] = ray.get(ref)
+                except ray.exceptions.RayTaskError as e:
+                    for r in pending:
+                        ray.cancel(r)
+                    cause = getattr(e, "cause", None)
+                    if not isinstance(cause, Exception):
+                        raise
+                    end = min(starts[k] + size, m)
+                    # Indices in the cause's message count from the batch's start.
+                    raise type(cause)(
+                        f"{what} {starts[k]} to {end - 1} (indices below count from "
+                        f"{starts[k]}): {cause}"
+                    ) from None
                 bar.update(job, advance=min(size, m - starts[k]))
     return out
 
