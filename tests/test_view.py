@@ -358,7 +358,9 @@ def test_readme_view_line(tmp_path) -> None:
 
     line = readme_block("view-cli").strip()
     assert "\n" not in line, "the README promises one command line"
-    script = shutil.which("cloudprox")
+    # The command installed beside this Python (a virtualenv's), else on PATH.
+    beside = Path(sys.executable).parent / "cloudprox"
+    script = str(beside) if beside.is_file() else shutil.which("cloudprox")
     launcher = [script] if script else [sys.executable, "-m", "cloudprox"]
     for command in line.split("&&"):
         argv = command.split()
