@@ -103,3 +103,26 @@ def test_errors(clouds) -> None:
         match=r"poses 20 to 29 .*count from 20.*poses_a\[3\]: .*not a rotation",
     ):
         distributed.collide_many(a, b, bad, batch_size=10, progress=False)
+
+
+def test_readme_ray_lines(tmp_path, monkeypatch) -> None:
+    import contextlib
+    import io
+
+    from cloudprox.examples import write_example_files
+    from tests.robots import readme_block
+
+    write_example_files(tmp_path / "example")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict[str, object] = {}
+    with contextlib.redirect_stdout(io.StringIO()):
+        exec(readme_block("python"), namespace)
+    block = readme_block("ray-python")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(block, namespace)
+    promised = block.split("# ")[-1].strip()
+    assert out.getvalue().strip() == promised
+    scan, gripper = namespace["scan"], namespace["gripper"]
+    poses = [cp.io.read_pose(f"example/grasp-{k}.txt") for k in ("free", "collision")]
+    assert str([r.state for r in cp.collide_many(gripper, scan, poses)]) == promised
