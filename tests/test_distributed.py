@@ -126,3 +126,39 @@ def test_readme_ray_lines(tmp_path, monkeypatch) -> None:
     scan, gripper = namespace["scan"], namespace["gripper"]
     poses = [cp.io.read_pose(f"example/grasp-{k}.txt") for k in ("free", "collision")]
     assert str([r.state for r in cp.collide_many(gripper, scan, poses)]) == promised
+
+
+def test_reproduce_query_loop_on_ray(tmp_path, monkeypatch) -> None:
+    import dataclasses
+    import importlib
+
+    from cloudprox.cli import main
+
+    run_module = importlib.import_module("cloudprox.reproduce.run")
+    monkeypatch.setattr(run_module, "reconstruction_available", lambda: False)
+    config = run_module.Config(
+        piano_points=600, poses=12, levels=(0.02,), anisotropic_levels=(), scan_poses=0
+    )
+    local = run_module.run(config, tmp_path / "local")
+    remote = run_module.run(
+        config,
+        tmp_path / "ray",
+        many=lambda *a, **k: distributed.collide_many(*a, progress=False, **k),
+    )
+    cloudprox_rows = [key for key in local.metrics if key[1].startswith("cloudprox")]
+    assert cloudprox_rows
+    for key in cloudprox_rows:
+        x, y = dataclasses.asdict(local.metrics[key]), dataclasses.asdict(remote.metrics[key])
+        x.pop("median_ms"), y.pop("median_ms")
+        assert x == y, key
+
+    # `cloudprox reproduce --ray` hands distributed.collide_many to the run.
+    seen = {}
+
+    def fake_run(config, out, progress, many):
+        seen["many"] = many
+        return run_module.Summary(config)
+
+    monkeypatch.setattr(run_module, "run", fake_run)
+    assert main(["reproduce", "--quick", "--ray", "--out", str(tmp_path / "cli")]) == 0
+    assert seen["many"].func is distributed.collide_many

@@ -15,7 +15,7 @@
     Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 ``cloudprox bench``
     cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
-``cloudprox reproduce [--quick] [--out DIR]``
+``cloudprox reproduce [--quick] [--out DIR] [--ray [ADDRESS]]``
     The paper's experiments against exact ground truth and the baselines: figures,
     a metrics table and the raw per-query results.
 
@@ -710,6 +710,19 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
             raise CliError(f"--points must be >= 500, got {args.points}")
         config = replace(config, piano_points=args.points)
     out = Path(args.out)
+    many = None
+    if args.ray is not None:
+        from functools import partial
+
+        from cloudprox import distributed
+
+        try:
+            ray = distributed.ensure_ray(args.ray or None)
+        except ImportError as e:
+            raise CliError(str(e)) from None
+        many = partial(distributed.collide_many, progress=False)
+        cpus = ray.cluster_resources().get("CPU", 0)
+        _console().print(f"cloudprox's queries run as Ray tasks ({cpus:g} CPUs in the cluster).")
     console = _console()
     console.print(
         f"Reproducing on the piano-in-room scene: {config.piano_points} piano points, "
@@ -736,7 +749,9 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         transient=False,
     ) as bar:
         task = bar.add_task("starting", total=steps(config))
-        summary = run(config, out, lambda desc, n: bar.update(task, advance=n, description=desc))
+        summary = run(
+            config, out, lambda desc, n: bar.update(task, advance=n, description=desc), many
+        )
     table = Table(
         title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma / "
         "FN < -3 sigma"
@@ -1052,6 +1067,15 @@ def _parser() -> argparse.ArgumentParser:
         type=int,
         default=None,
         help="gripper poses on the real Kinect frame (overrides; 0 skips the experiment)",
+    )
+    rep.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="run cloudprox's queries as Ray tasks: on the cluster at ADDRESS, else the "
+        "running one, else a local one (needs cloudprox[ray])",
     )
     rep.set_defaults(func=_cmd_reproduce)
     return parser
