@@ -57,3 +57,25 @@ def test_world_points() -> None:
     t[:3, 3] = [1.0, 0.0, 0.0]
     np.testing.assert_allclose(world_points(p, t), [[0.0, 0.0, 2.0], [-3.0, 3.0, 5.0]])
     np.testing.assert_array_equal(world_points(p), p)
+
+
+def test_contact_bounds_zoom_on_the_probable_points(tmp_path, spheres, sphere_points) -> None:
+    from cloudprox.plots import contact_bounds
+
+    a, b = spheres
+    pose_b = sphere_gap_pose(0.0)
+    r = cp.collide(a, b, pose_b=pose_b)
+    pa, pb = sphere_points[0], world_points(sphere_points[1], pose_b)
+    lo, hi = contact_bounds(pa, pb, r)
+    loud = np.concatenate([pa[r.probabilities_a >= 1e-3], pb[r.probabilities_b >= 1e-3]])
+    assert len(loud) and np.all((loud >= lo) & (loud <= hi))
+    everything = np.concatenate([pa, pb])
+    # Zoomed in along the line of centres, where the spheres touch.
+    assert hi[0] - lo[0] < 0.5 * np.ptp(everything[:, 0])
+    assert np.prod(hi - lo) < 0.5 * np.prod(np.ptp(everything, axis=0))
+    far = cp.collide(a, b, pose_b=sphere_gap_pose(40.0))
+    assert contact_bounds(pa, world_points(sphere_points[1], sphere_gap_pose(40.0)), far) is None
+    fig = plot_collision(pa, pb, r, tmp_path / "zoom.png", bounds="contact")
+    assert fig.axes[0].get_xlim()[1] - fig.axes[0].get_xlim()[0] < np.ptp(everything[:, 0])
+    with pytest.raises(ValueError, match="bounds must be"):
+        plot_collision(pa, pb, r, bounds="everything")

@@ -10,6 +10,7 @@ object's own frame to the world; ``None`` means identity.
 
 import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, Final, Literal, TypedDict, final
 
 import numpy as np
@@ -102,6 +103,8 @@ class SolverError(CloudproxError, RuntimeError):
 class PointCloud:
     """Points with a 3x3 covariance each, in the cloud's own frame.
 
+    It pickles exactly (its root's points and sensor covariances, discretization
+    neighbours, noise correlation and moves; the hierarchy is rebuilt on use).
     The covariance of a point is its sensor covariance (from ``sigma``, ``cov``
     or a ``sensor`` model seen from ``origin`` / ``sensor_pose``) plus, with ``discretization=True``, the k-nearest-neighbour
     discretization covariance. The bounding volume hierarchy over the points is
@@ -186,6 +189,9 @@ class PointCloud:
     @property
     def sensor_covariances(self) -> _FloatArray:
         """Per-point sensor covariances (without the discretization part), ``(n, 3, 3)``."""
+    @staticmethod
+    def _from_state(state: tuple[Any, ...]) -> PointCloud:
+        """Rebuild a pickled cloud (pickle support; the state comes from ``__reduce__``)."""
     def transformed(self, transform: npt.ArrayLike) -> PointCloud:
         """Return a copy moved by a rigid transform.
 
@@ -284,6 +290,23 @@ class CollisionResult:
     @property
     def probabilities_b(self) -> _FloatArray:
         """Per-point probability of B's points being on the wrong side, shape ``(n_b,)``."""
+    @property
+    def points_a(self) -> _FloatArray | None:
+        """Side A's points as queried (a mesh side: its samples), world frame, ``(n_a, 3)``.
+
+        ``None`` when the result does not record them (the per-link results of
+        robot queries). The result shares the clouds it was computed on.
+        """
+    @property
+    def points_b(self) -> _FloatArray | None:
+        """Side B's points as queried, world frame, shape ``(n_b, 3)``, or ``None``."""
+    def show(self, path: str | os.PathLike[str] | None = None, **options: Any) -> Path:
+        """Write the interactive HTML view and open it in the web browser.
+
+        Calls :func:`cloudprox.view.show` (needs ``cloudprox[view]``): ``path``
+        (default: a new temporary file), ``open_browser`` and the options of
+        :func:`cloudprox.view.collision_scene`. Returns the file written.
+        """
     @property
     def regions(self) -> list[ContactRegion]:
         """The classified patches of the near regions."""
@@ -985,6 +1008,9 @@ def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> tuple[Mesh, i
 class Robot:
     """A robot loaded from a URDF file, prepared once for many queries.
 
+    It pickles as its URDF text: the mesh files it names are read again on
+    unpickling, at the same paths.
+
     A configuration ``q`` holds one value per independent moving joint (revolute,
     continuous, prismatic; mimic joints follow their master), in the order of
     :attr:`joint_names`. A configuration outside the joint limits, of the wrong
@@ -1108,6 +1134,11 @@ class RobotBatchResult:
     @property
     def link_probabilities(self) -> _FloatArray:
         """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order."""
+    @staticmethod
+    def _from_state(
+        state: tuple[list[float], list[str], list[bool], list[float], int],
+    ) -> RobotBatchResult:
+        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links)``."""
     def __len__(self) -> int: ...
 
 @final

@@ -6,13 +6,16 @@
 ``cloudprox collide A B [--sigma S | --sensor ...] [--pose-a P] [--filter STEP]``
     One query between two files: point clouds (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ)
     or meshes (STL, OBJ, OFF, PLY with faces).
+``cloudprox view A B [--html FILE] [--rerun FILE.rrd] [--no-open]``
+    The query of ``collide``, shown in 3D in the web browser (``collide`` and
+    ``robot`` write the same view with ``--html`` / ``--rerun``).
 ``cloudprox info FILE``
     A summary of a point-cloud or mesh file.
 ``cloudprox example [DIR]``
     Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 ``cloudprox bench``
     cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
-``cloudprox reproduce [--quick] [--out DIR]``
+``cloudprox reproduce [--quick] [--out DIR] [--ray [ADDRESS]]``
     The paper's experiments against exact ground truth and the baselines: figures,
     a metrics table and the raw per-query results.
 
@@ -157,10 +160,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # The figure: touching, and the first undecided case (else the 4 sigma one).
     touching = next(r for r in runs if r[0] == 0.0)
     undecided = next((r for r in runs if r[2].state == "contact"), runs[DEMO_GAPS_SIGMA.index(4.0)])
-    top_lo, top_hi = scene.table_top().mesh.bounds()
-    centre = (top_lo + top_hi) / 2.0
-    lo = np.array([centre[0] - 1.0, centre[1] - 1.1, top_hi[2] - 0.3])
-    hi = np.array([centre[0] + 1.0, centre[1] + 1.3, top_hi[2] + 0.9])
     out.mkdir(parents=True, exist_ok=True)
     png = out / "demo.png"
     panels = [
@@ -172,7 +171,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         )
         for gap, pose, result in (touching, undecided)
     ]
-    plot_collisions(panels, png, bounds=(lo, hi), labels=("piano", "room"))
+    plot_collisions(panels, png, bounds="contact", labels=("piano", "room"), elev=25.0)
     console.print(f"Figure written to {png.resolve()}")
     console.print(f"Total time {time.perf_counter() - t_start:.2f} s.")
     return 0
@@ -233,8 +232,24 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     }
     if args.decide_only:
         options["decide_only"] = True
+    _check_view_arguments(args)
     result = collide(sides[0].obj, sides[1].obj, poses[0], poses[1], **options)
+
+    def scene() -> Any:
+        from cloudprox.view import collision_scene
+
+        return collision_scene(
+            result,
+            sides[0].obj,
+            sides[1].obj,
+            poses[0],
+            poses[1],
+            labels=(f"A {Path(args.a).name}", f"B {Path(args.b).name}"),
+            surfaces=args.surfaces,
+        )
+
     if args.json:
+        _write_views(args, scene)
         doc = result_to_dict(result) | {"a": sides[0].summary(), "b": sides[1].summary()}
         print(json.dumps(doc, indent=2))
         return 0
@@ -271,7 +286,57 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
     )
     console.print(f"stats: {stats}")
+    _write_views(args, scene)
     return 0
+
+
+def _check_view_arguments(args: argparse.Namespace) -> None:
+    if args.surfaces < 0:
+        raise CliError(f"--surfaces must be >= 0, got {args.surfaces}")
+    for flag, path, suffix in (("--html", args.html, ".html"), ("--rerun", args.rerun, ".rrd")):
+        if path is None:
+            continue
+        if not Path(path).suffix:
+            raise CliError(f"{flag} {path}: give a file name ending in {suffix}")
+        parent = Path(path).resolve().parent
+        if not parent.is_dir():
+            raise CliError(f"{flag} {path}: no such folder {parent}")
+    modules = [("--html", args.html, "plotly", "view"), ("--rerun", args.rerun, "rerun", "rerun")]
+    for flag, path, module, extra in modules:
+        if path is None:
+            continue
+        import importlib.util
+
+        if importlib.util.find_spec(module) is None:
+            raise CliError(f"{flag} needs the '{module}' package: pip install 'cloudprox[{extra}]'")
+
+
+def _write_views(args: argparse.Namespace, make_scene: Any) -> None:
+    """Write the ``--html`` and ``--rerun`` views of a scene made by ``make_scene()``."""
+    if args.html is None and args.rerun is None:
+        return
+    from cloudprox import view
+
+    scene = make_scene()
+    console = _console(stderr=bool(getattr(args, "json", False)))
+    if args.html is not None:
+        path = view.write_html(scene, args.html)
+        size = path.stat().st_size / 1e6
+        console.print(f"view written to {path.resolve()} ({size:.1f} MB; open it in a browser)")
+    if args.rerun is not None:
+        path = view.write_rerun(scene, args.rerun)
+        console.print(f"Rerun recording written to {path.resolve()} (rerun {path})")
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    if args.html is None:
+        args.html = "cloudprox-view.html"
+    status = _cmd_collide(args)
+    if status == 0 and not args.no_open:
+        import webbrowser
+
+        webbrowser.open(Path(args.html).resolve().as_uri())
+    return status
 
 
 # ------------------------------------------------------------------------ robot
@@ -348,9 +413,28 @@ def _cmd_robot(args: argparse.Namespace) -> int:
     if side.cloud is None:
         raise CliError(f"{args.scan}: the scan must be a point cloud, not a mesh")
     options: dict[str, Any] = {"mesh_spacing": args.mesh_spacing}
+    _check_view_arguments(args)
+    if args.q is None and (args.html is not None or args.rerun is not None):
+        raise CliError("--html and --rerun show one configuration: give --q, not --q-file")
     if args.q is not None:
         result = collide_robot(robot, qs[0], side.cloud, base, **options)
+        cloud = side.cloud
+
+        def scene() -> Any:
+            from cloudprox.view import robot_scene
+
+            return robot_scene(
+                robot,
+                qs[0],
+                cloud,
+                result,
+                base,
+                label=Path(args.scan).name,
+                surfaces=args.surfaces,
+            )
+
         if args.json:
+            _write_views(args, scene)
             doc = {
                 "probability": result.probability,
                 "state": result.state,
@@ -384,6 +468,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         if result.self_collisions:
             pairs = ", ".join(f"{a}-{b}" for a, b in result.self_collisions)
             console.print(f"self-collision: {pairs}")
+        _write_views(args, scene)
         return 0
     chunk = 256
     parts = []
@@ -625,6 +710,19 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
             raise CliError(f"--points must be >= 500, got {args.points}")
         config = replace(config, piano_points=args.points)
     out = Path(args.out)
+    many = None
+    if args.ray is not None:
+        from functools import partial
+
+        from cloudprox import distributed
+
+        try:
+            ray = distributed.ensure_ray(args.ray or None)
+        except ImportError as e:
+            raise CliError(str(e)) from None
+        many = partial(distributed.collide_many, progress=False)
+        cpus = ray.cluster_resources().get("CPU", 0)
+        _console().print(f"cloudprox's queries run as Ray tasks ({cpus:g} CPUs in the cluster).")
     console = _console()
     console.print(
         f"Reproducing on the piano-in-room scene: {config.piano_points} piano points, "
@@ -651,7 +749,9 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         transient=False,
     ) as bar:
         task = bar.add_task("starting", total=steps(config))
-        summary = run(config, out, lambda desc, n: bar.update(task, advance=n, description=desc))
+        summary = run(
+            config, out, lambda desc, n: bar.update(task, advance=n, description=desc), many
+        )
     table = Table(
         title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma / "
         "FN < -3 sigma"
@@ -684,45 +784,10 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- main
 
 
-def _parser() -> argparse.ArgumentParser:
-    defaults = default_options()
-    names = option_names()
-    parser = argparse.ArgumentParser(
-        prog="cloudprox",
-        description="Probabilistic collision queries between noisy point clouds.",
-    )
-    parser.add_argument("--version", action="version", version=f"cloudprox {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-
-    demo = sub.add_parser("demo", help="piano over a table in a room, at several exact gaps")
-    demo.add_argument(
-        "--out", default="cloudprox-demo", help="directory for demo.png (default: %(default)s)"
-    )
-    demo.add_argument(
-        "--sigma",
-        type=float,
-        default=0.005,
-        help="noise standard deviation in metres (default: %(default)s)",
-    )
-    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    demo.add_argument(
-        "--points",
-        type=int,
-        default=10_000,
-        help="approximate number of piano points (default: %(default)s)",
-    )
-    demo.set_defaults(func=_cmd_demo)
-
-    col = sub.add_parser(
-        "collide",
-        help="one query between two files (point clouds or meshes)",
-        description=(
-            "One query between A and B. Each is a point-cloud file (PLY, PCD, XYZ/CSV, NPY, "
-            "LAS/LAZ) or a mesh file (STL, OBJ, OFF, PLY with faces). Cloud sides get their "
-            "noise from --sigma, --sensor, or the covariances stored in the file, then go "
-            "through the --filter steps in order."
-        ),
-    )
+def _add_query_arguments(
+    col: argparse.ArgumentParser, defaults: dict[str, Any], names: dict[str, Any]
+) -> None:
+    """Add the arguments of one query between two files (``collide`` and ``view``)."""
     col.add_argument("a", metavar="A", help="point-cloud or mesh file of side A")
     col.add_argument("b", metavar="B", help="point-cloud or mesh file of side B")
     col.add_argument(
@@ -809,7 +874,91 @@ def _parser() -> argparse.ArgumentParser:
         help=f"SOCP solver (default: {defaults['solver']})",
     )
     col.add_argument("--json", action="store_true", help="print the result as JSON")
+    _add_view_arguments(col)
+
+
+def _add_view_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--html`` and ``--rerun``: where a command writes its interactive view."""
+    group = parser.add_argument_group("interactive view")
+    group.add_argument(
+        "--html",
+        metavar="FILE",
+        default=None,
+        help="write the interactive 3D view: one HTML file that opens without a server "
+        "(needs cloudprox[view])",
+    )
+    group.add_argument(
+        "--rerun",
+        metavar="FILE.rrd",
+        default=None,
+        help="log the same scene to a Rerun recording (needs cloudprox[rerun])",
+    )
+    group.add_argument(
+        "--surfaces",
+        type=int,
+        default=5,
+        metavar="N",
+        help="separating surfaces of the N most probable regions in the view, hidden until "
+        "clicked in the legend (default: %(default)s)",
+    )
+
+
+def _parser() -> argparse.ArgumentParser:
+    defaults = default_options()
+    names = option_names()
+    parser = argparse.ArgumentParser(
+        prog="cloudprox",
+        description="Probabilistic collision queries between noisy point clouds.",
+    )
+    parser.add_argument("--version", action="version", version=f"cloudprox {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    demo = sub.add_parser("demo", help="piano over a table in a room, at several exact gaps")
+    demo.add_argument(
+        "--out", default="cloudprox-demo", help="directory for demo.png (default: %(default)s)"
+    )
+    demo.add_argument(
+        "--sigma",
+        type=float,
+        default=0.005,
+        help="noise standard deviation in metres (default: %(default)s)",
+    )
+    demo.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    demo.add_argument(
+        "--points",
+        type=int,
+        default=10_000,
+        help="approximate number of piano points (default: %(default)s)",
+    )
+    demo.set_defaults(func=_cmd_demo)
+
+    col = sub.add_parser(
+        "collide",
+        help="one query between two files (point clouds or meshes)",
+        description=(
+            "One query between A and B. Each is a point-cloud file (PLY, PCD, XYZ/CSV, NPY, "
+            "LAS/LAZ) or a mesh file (STL, OBJ, OFF, PLY with faces). Cloud sides get their "
+            "noise from --sigma, --sensor, or the covariances stored in the file, then go "
+            "through the --filter steps in order."
+        ),
+    )
+    _add_query_arguments(col, defaults, names)
     col.set_defaults(func=_cmd_collide)
+
+    vw = sub.add_parser(
+        "view",
+        help="one query between two files, shown in 3D in the web browser",
+        description=(
+            "The query of `cloudprox collide A B` (same options), written as an interactive "
+            "3D view (--html, default cloudprox-view.html: one file that opens without a "
+            "server or the internet) and opened in the web browser."
+        ),
+    )
+    _add_query_arguments(vw, defaults, names)
+    vw.add_argument(
+        "--no-open", action="store_true", help="write the view but do not open the browser"
+    )
+    vw.set_defaults(func=_cmd_view)
 
     rob = sub.add_parser(
         "robot",
@@ -861,6 +1010,7 @@ def _parser() -> argparse.ArgumentParser:
         help="sampling spacing of the links (m; default half the scan's spacing)",
     )
     rob.add_argument("--json", action="store_true", help="print the result as JSON")
+    _add_view_arguments(rob)
     rob.set_defaults(
         func=_cmd_robot,
         **dict.fromkeys(_SENSOR_PARAMETERS),
@@ -918,6 +1068,15 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="gripper poses on the real Kinect frame (overrides; 0 skips the experiment)",
     )
+    rep.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="run cloudprox's queries as Ray tasks: on the cluster at ADDRESS, else the "
+        "running one, else a local one (needs cloudprox[ray])",
+    )
     rep.set_defaults(func=_cmd_reproduce)
     return parser
 
@@ -944,7 +1103,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_usage(sys.stderr)
         print(
             "cloudprox: error: a command is required "
-            "(demo, collide, robot, info, example, bench or reproduce)",
+            "(demo, collide, view, robot, info, example, bench or reproduce)",
             file=sys.stderr,
         )
         return 2

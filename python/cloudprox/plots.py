@@ -20,9 +20,63 @@ if TYPE_CHECKING:
 
     from cloudprox._native import CollisionResult
 
-__all__ = ["Panel", "plot_collision", "plot_collisions", "world_points"]
+__all__ = [
+    "SIDE_COLORS",
+    "Panel",
+    "contact_bounds",
+    "plot_collision",
+    "plot_collisions",
+    "world_points",
+]
 
 _CMAP = "plasma"
+#: Colours of the two clouds' points below ``quiet_below`` (A, B); the same as the
+#: interactive view's (:mod:`cloudprox.view`).
+SIDE_COLORS = ("#2ca58d", "#8d99ae")
+
+
+def contact_bounds(
+    points_a: npt.ArrayLike,
+    points_b: npt.ArrayLike,
+    result: CollisionResult,
+    quiet_below: float = 1e-3,
+    margin: float = 0.5,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Return the box around the contact: the points with ``p_i >= quiet_below``.
+
+    Parameters
+    ----------
+    points_a, points_b : array_like, shapes (n_a, 3) and (n_b, 3)
+        The clouds in the world frame.
+    result : CollisionResult
+        The query's result.
+    quiet_below : float, default 1e-3
+        Points below this probability do not count.
+    margin : float, default 0.5
+        Each side of the box grows by this fraction of its length, plus 3 % of the
+        clouds' extent (so a flat contact keeps some depth).
+
+    Returns
+    -------
+    tuple of two ndarray of shape (3,), or None
+        ``(lo, hi)``; ``None`` when no point reaches ``quiet_below``.
+    """
+    pa = np.asarray(points_a, dtype=float)
+    pb = np.asarray(points_b, dtype=float)
+    loud = [
+        pa[np.asarray(result.probabilities_a) >= quiet_below],
+        pb[np.asarray(result.probabilities_b) >= quiet_below],
+    ]
+    loud += [np.asarray(r.point, dtype=float)[None] for r in result.regions]
+    near = np.concatenate([x for x in loud if len(x)] or [np.zeros((0, 3))])
+    near = near[np.all(np.isfinite(near), axis=1)]
+    if not len(near):
+        return None
+    everything = np.concatenate([pa, pb])
+    floor = 0.03 * float(np.ptp(everything, axis=0).max())
+    lo, hi = near.min(axis=0), near.max(axis=0)
+    pad = margin * (hi - lo) + floor
+    return lo - pad, hi + pad
 
 
 def world_points(points: npt.ArrayLike, pose: npt.ArrayLike | None = None) -> np.ndarray:
@@ -71,11 +125,12 @@ class Panel:
 def _draw(
     ax: Any,
     panel: Panel,
-    bounds: tuple[npt.ArrayLike, npt.ArrayLike] | None,
+    bounds: tuple[npt.ArrayLike, npt.ArrayLike] | str | None,
     labels: tuple[str, str],
     quiet_below: float,
 ) -> None:
     from matplotlib.colors import Normalize
+    from matplotlib.ticker import MaxNLocator
 
     result = panel.result
     pa = np.asarray(panel.points_a, dtype=float)
@@ -88,6 +143,10 @@ def _draw(
             f"{len(prob_a)} and {len(prob_b)} probabilities"
         )
     lo, hi = np.full(3, -np.inf), np.full(3, np.inf)
+    if isinstance(bounds, str):
+        if bounds != "contact":
+            raise ValueError(f"bounds must be (lo, hi), 'contact' or None, got {bounds!r}")
+        bounds = contact_bounds(pa, pb, result, quiet_below)
     if bounds is not None:
         lo, hi = (np.asarray(b, dtype=float) for b in bounds)
         keep_a = np.all((pa >= lo) & (pa <= hi), axis=1)
@@ -95,17 +154,20 @@ def _draw(
         pa, prob_a, pb, prob_b = pa[keep_a], prob_a[keep_a], pb[keep_b], prob_b[keep_b]
 
     norm = Normalize(vmin=0.0, vmax=1.0)
-    clouds = ((pa, prob_a, "o", labels[0], "0.6"), (pb, prob_b, "^", labels[1], "0.3"))
+    clouds = (
+        (pa, prob_a, "o", labels[0], SIDE_COLORS[0]),
+        (pb, prob_b, "^", labels[1], SIDE_COLORS[1]),
+    )
     for pts, prob, marker, label, grey in clouds:
-        # Points safely on their side are small and grey; the doubtful ones are
-        # coloured by p_i, larger, and drawn last so they stay on top.
+        # Points safely on their side are small, in their cloud's colour; the
+        # doubtful ones are coloured by p_i, larger, and drawn last so they stay on top.
         quiet = prob < quiet_below
         if np.any(quiet):
             ax.scatter(
                 *pts[quiet].T,
                 color=grey,
-                s=2.0,
-                alpha=0.35,
+                s=3.0,
+                alpha=0.45,
                 marker=marker,
                 depthshade=False,
                 label=f"{label}: {len(pts)} points",
@@ -132,6 +194,8 @@ def _draw(
     everything = np.concatenate([pa, pb]) if len(pa) + len(pb) else np.zeros((1, 3))
     extent = everything.max(axis=0) - everything.min(axis=0)
     ax.set_box_aspect(np.maximum(extent, 0.05 * (float(extent.max()) or 1.0)))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(4))
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
@@ -144,7 +208,7 @@ def plot_collisions(
     panels: Sequence[Panel],
     path: str | Path | None = None,
     *,
-    bounds: tuple[npt.ArrayLike, npt.ArrayLike] | None = None,
+    bounds: tuple[npt.ArrayLike, npt.ArrayLike] | str | None = None,
     labels: tuple[str, str] = ("A", "B"),
     quiet_below: float = 1e-3,
     elev: float = 12.0,
@@ -159,8 +223,10 @@ def plot_collisions(
         The queries, one panel each, in a row.
     path : str or Path, optional
         Where to write the figure (format from the suffix, e.g. ``.png``).
-    bounds : tuple of two array_like of shape (3,), optional
-        Only points inside this axis-aligned box ``(lo, hi)`` are drawn.
+    bounds : tuple of two array_like of shape (3,), or "contact", optional
+        Only points inside this axis-aligned box ``(lo, hi)`` are drawn;
+        ``"contact"``: the box around each panel's points with ``p_i >=
+        quiet_below`` (see :func:`contact_bounds`), everything when there are none.
     labels : tuple of str, default ("A", "B")
         Names of the two clouds in the legends.
     quiet_below : float, default 1e-3
@@ -192,7 +258,7 @@ def plot_collisions(
         ScalarMappable(norm=Normalize(vmin=0.0, vmax=1.0), cmap=_CMAP),
         ax=axes,
         shrink=0.6,
-        pad=0.04,
+        pad=0.08,
         label="per-point collision probability $p_i$",
     )
     if path is not None:

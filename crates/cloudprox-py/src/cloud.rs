@@ -87,7 +87,59 @@ pub(crate) fn noise_from(
 #[pyclass(name = "PointCloud", frozen, module = "cloudprox._native")]
 pub struct PyPointCloud {
     pub(crate) inner: Arc<PointCloud>,
+    recipe: Recipe,
 }
+
+/// How a cloud was made, to rebuild it bit for bit after pickling: the root
+/// cloud's points and sensor covariances (read from `root`), the discretization
+/// neighbours (`None`: none added), then the rigid transforms applied in order.
+/// The points' order, the covariances and the noise correlation are kept; the
+/// hierarchy, spacing and surface elements are rebuilt lazily, deterministically.
+#[derive(Clone)]
+struct Recipe {
+    root: Arc<PointCloud>,
+    disc_k: Option<usize>,
+    poses: Vec<cloudprox::math::Pose>,
+}
+
+/// A pose as 7 numbers: the unit quaternion's `(i, j, k, w)` and the translation.
+pub(crate) fn pose_to_7(p: &cloudprox::math::Pose) -> [f64; 7] {
+    let q = p.rotation.coords;
+    let t = p.translation.vector;
+    [q[0], q[1], q[2], q[3], t[0], t[1], t[2]]
+}
+
+/// The pose of [`pose_to_7`]'s numbers, exactly.
+pub(crate) fn pose_from_7(v: &[f64; 7]) -> cloudprox::math::Pose {
+    let q = nalgebra::Quaternion::new(v[3], v[0], v[1], v[2]);
+    nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(v[4], v[5], v[6]),
+        nalgebra::UnitQuaternion::new_unchecked(q),
+    )
+}
+
+/// The pickled form of a `PointCloud` (see [`Recipe`]).
+type CloudState<'py> = (
+    u32,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray3<f64>>,
+    Option<usize>,
+    f64,
+    Vec<[f64; 7]>,
+);
+
+/// [`CloudState`] as read back (arrays as any array-like).
+type CloudStateIn<'py> = (
+    u32,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Option<usize>,
+    f64,
+    Vec<[f64; 7]>,
+);
+
+/// Version of [`CloudState`].
+const CLOUD_STATE_VERSION: u32 = 1;
 
 impl PyPointCloud {
     /// A cloud from points and noise, with the discretization part if asked for
@@ -116,6 +168,7 @@ impl PyPointCloud {
         } else {
             None
         };
+        let disc_k = disc.map(|d| d.k);
         let cloud = run_detached(py, move || {
             let cloud = match noise {
                 Noise::Sensor(model, vp) => PointCloud::from_sensor(points, &model, &vp),
@@ -136,8 +189,14 @@ impl PyPointCloud {
             }
             Ok(cloud)
         })?;
+        let inner = Arc::new(cloud);
         Ok(Self {
-            inner: Arc::new(cloud),
+            recipe: Recipe {
+                root: Arc::clone(&inner),
+                disc_k,
+                poses: Vec::new(),
+            },
+            inner,
         })
     }
 }
@@ -212,8 +271,75 @@ impl PyPointCloud {
         let pose = pose_from(py, Some(transform), "transform")?;
         let inner = Arc::clone(&self.inner);
         let moved = run_detached(py, move || Ok(inner.transformed(&pose)))?;
+        let mut recipe = self.recipe.clone();
+        recipe.poses.push(pose);
         Ok(Self {
             inner: Arc::new(moved),
+            recipe,
+        })
+    }
+
+    /// Pickle support: the cloud is rebuilt from its root's points and sensor
+    /// covariances, its discretization neighbours, noise correlation and moves.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (CloudState<'py>,))> {
+        let py = slf.py();
+        let me = slf.get();
+        let root = &me.recipe.root;
+        let state = (
+            CLOUD_STATE_VERSION,
+            points_to_py(py, root.points())?,
+            matrices3_to_py(py, root.sensor_covariances())?,
+            me.recipe.disc_k,
+            root.element_settings().noise_correlation,
+            me.recipe.poses.iter().map(pose_to_7).collect(),
+        );
+        Ok((slf.getattr("_from_state")?, (state,)))
+    }
+
+    /// Rebuilds a pickled cloud (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (version, points, sensor, disc_k, rho, poses): CloudStateIn<'_> = state.extract()?;
+        if version != CLOUD_STATE_VERSION {
+            return Err(invalid_input(
+                py,
+                format!("cannot unpickle a PointCloud of state version {version}"),
+            ));
+        }
+        let points = points_from(&points, "pickled points")?;
+        let sensor = matrices3_from(&sensor, "pickled covariances")?;
+        let poses: Vec<_> = poses.iter().map(pose_from_7).collect();
+        let moves = poses.clone();
+        let (root, cloud) = run_detached(py, move || {
+            let mut root = PointCloud::from_covariances(points, sensor)?;
+            if let Some(k) = disc_k {
+                let settings = DiscretizationSettings {
+                    k,
+                    ..DiscretizationSettings::default()
+                };
+                root = root.with_discretization(&settings)?;
+            }
+            let settings = ElementSettings {
+                noise_correlation: rho,
+                ..*root.element_settings()
+            };
+            root.set_element_settings(settings)?;
+            let root = Arc::new(root);
+            let mut cloud = Arc::clone(&root);
+            for pose in &moves {
+                cloud = Arc::new(cloud.transformed(pose));
+            }
+            Ok((root, cloud))
+        })?;
+        Ok(Self {
+            inner: cloud,
+            recipe: Recipe {
+                root,
+                disc_k,
+                poses,
+            },
         })
     }
 

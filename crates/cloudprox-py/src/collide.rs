@@ -1,11 +1,13 @@
 //! The `collide` and `collide_many` functions.
 
+use std::sync::Arc;
+
 use pyo3::prelude::*;
 
 use crate::convert::{pose_from, poses_from};
 use crate::error::run_detached;
 use crate::request::RequestOptions;
-use crate::result::PyCollisionResult;
+use crate::result::{PyCollisionResult, QueriedSides};
 use crate::side::resolve_pair;
 
 /// The probabilistic collision query between cloud `a` at `pose_a` and cloud `b`
@@ -64,10 +66,16 @@ pub fn collide(
     let pose_a = pose_from(py, pose_a, "pose_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
     let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
+    let sides = QueriedSides {
+        a: Arc::clone(&ca),
+        b: Arc::clone(&cb),
+        pose_a,
+        pose_b,
+    };
     let result = run_detached(py, move || {
         cloudprox::query::collide(&pose_a, &ca, &pose_b, &cb, &request)
     })?;
-    PyCollisionResult::new(py, result)
+    PyCollisionResult::with_sides(py, result, sides)
 }
 
 /// `collide` for cloud `a` at each of the `(m, 4, 4)` poses `poses_a` against cloud
@@ -122,11 +130,21 @@ pub fn collide_many(
     let poses_a = poses_from(poses_a, "poses_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
     let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
+    let (sa, sb, poses) = (Arc::clone(&ca), Arc::clone(&cb), poses_a.clone());
     let results = run_detached(py, move || {
         cloudprox::query::collide_many(&poses_a, &ca, &pose_b, &cb, &request)
     })?;
     results
         .into_iter()
-        .map(|r| PyCollisionResult::new(py, r))
+        .zip(poses)
+        .map(|(r, pose_a)| {
+            let sides = QueriedSides {
+                a: Arc::clone(&sa),
+                b: Arc::clone(&sb),
+                pose_a,
+                pose_b,
+            };
+            PyCollisionResult::with_sides(py, r, sides)
+        })
         .collect()
 }

@@ -250,6 +250,19 @@ impl PyMesh {
         ))
     }
 
+    /// Pickle support: `Mesh(vertices, faces)` (the samples cache is not kept).
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>),
+    )> {
+        let py = slf.py();
+        let me = slf.get();
+        Ok((slf.get_type().into_any(), (me.vertices(py)?, me.faces(py)?)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Mesh with {} vertices and {} faces.",

@@ -1,11 +1,19 @@
 //! `CollisionResult` and `ContactRegion`: the answer of a query, as plain data.
 
+use std::sync::Arc;
+
+use cloudprox::classify::{Separator, SolveStatus, Surface};
+use cloudprox::cloud::PointCloud;
+use cloudprox::math::Pose;
+use cloudprox::math::{Point3, Vector3};
 use cloudprox::query::{CollisionResult, ContactRegion, QueryStats};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
 
-use crate::convert::{indices_to_py, points_from, rows3_to_py, vec_to_py, vector3_to_py};
+use crate::convert::{
+    indices_to_py, points_from, points_to_py, rows3_to_py, vec_to_py, vector3_to_py,
+};
 use crate::error::guard;
 
 /// The values `(m,)` and gradients `(m, 3)` of a separating surface.
@@ -27,6 +35,140 @@ fn fmt_g(x: f64) -> String {
             s
         }
     }
+}
+
+/// The `&'static str` of a state name (`"free"`, `"contact"`, `"collision"`).
+pub(crate) fn state_name(py: Python<'_>, s: &str) -> PyResult<&'static str> {
+    match s {
+        "free" => Ok("free"),
+        "contact" => Ok("contact"),
+        "collision" => Ok("collision"),
+        other => Err(crate::error::invalid_input(
+            py,
+            format!("unknown collision state '{other}'"),
+        )),
+    }
+}
+
+/// The pickled form of a separator: surface name, weights, offset, centre,
+/// scale and frame (see [`crate::cloud::pose_to_7`]).
+type SeparatorState = (String, Vec<f64>, f64, [f64; 3], f64, [f64; 7]);
+
+/// The pickled form of a `ContactRegion`.
+type RegionState = (
+    u32,
+    Vec<u32>,
+    Vec<u32>,
+    [f64; 3],
+    [f64; 3],
+    f64,
+    f64,
+    SeparatorState,
+    String,
+    u32,
+);
+
+/// The pickled form of query statistics (the fields of `QueryStats`, in order).
+type StatsState = (
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    usize,
+    u64,
+    usize,
+    usize,
+    f64,
+    f64,
+);
+
+/// The pickled form of a `CollisionResult` (without the clouds it was computed on).
+type ResultState = (
+    f64,
+    String,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<RegionState>,
+    StatsState,
+);
+
+fn region_to_state(r: &ContactRegion) -> RegionState {
+    let sep = &r.separator;
+    (
+        r.component,
+        r.indices_a.clone(),
+        r.indices_b.clone(),
+        [r.point.x, r.point.y, r.point.z],
+        [r.normal.x, r.normal.y, r.normal.z],
+        r.separation,
+        r.probability,
+        (
+            sep.surface.name().to_string(),
+            sep.w.clone(),
+            sep.b,
+            [sep.center.x, sep.center.y, sep.center.z],
+            sep.scale,
+            crate::cloud::pose_to_7(&sep.frame),
+        ),
+        r.status.name().to_string(),
+        r.iterations,
+    )
+}
+
+fn surface_from(py: Python<'_>, name: &str) -> PyResult<Surface> {
+    Surface::from_name(name).ok_or_else(|| {
+        crate::error::invalid_input(py, format!("unknown surface '{name}' in a pickled region"))
+    })
+}
+
+fn region_from_state(py: Python<'_>, s: RegionState) -> PyResult<ContactRegion> {
+    let (
+        component,
+        indices_a,
+        indices_b,
+        point,
+        normal,
+        separation,
+        probability,
+        sep,
+        status,
+        iterations,
+    ) = s;
+    let (surface, w, b, center, scale, frame) = sep;
+    let surface = surface_from(py, &surface)?;
+    let status = match status.as_str() {
+        "solved" => SolveStatus::Solved,
+        "almost_solved" => SolveStatus::AlmostSolved,
+        "fallback" => SolveStatus::Fallback,
+        other => {
+            return Err(crate::error::invalid_input(
+                py,
+                format!("unknown solve status '{other}' in a pickled region"),
+            ))
+        }
+    };
+    Ok(ContactRegion {
+        component,
+        indices_a,
+        indices_b,
+        point: Point3::new(point[0], point[1], point[2]),
+        normal: Vector3::new(normal[0], normal[1], normal[2]),
+        separation,
+        probability,
+        separator: Separator {
+            surface,
+            w,
+            b,
+            center: Point3::new(center[0], center[1], center[2]),
+            scale,
+            frame: crate::cloud::pose_from_7(&frame),
+        },
+        surface,
+        status,
+        iterations,
+    })
 }
 
 /// One patch of a near region with its own separating surface (world frame).
@@ -116,6 +258,22 @@ impl PyContactRegion {
         Ok((vec_to_py(py, &f), rows3_to_py(py, g.into_iter())?))
     }
 
+    /// Pickle support: every field, the separating surface included.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (RegionState,))> {
+        Ok((
+            slf.getattr("_from_state")?,
+            (region_to_state(&slf.get().inner),),
+        ))
+    }
+
+    /// Rebuilds a pickled region (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: RegionState) -> PyResult<Self> {
+        Ok(Self {
+            inner: region_from_state(py, state)?,
+        })
+    }
+
     fn __repr__(&self) -> String {
         let r = &self.inner;
         format!(
@@ -142,6 +300,20 @@ pub struct PyCollisionResult {
     probabilities_b: Vec<f64>,
     regions: Vec<Py<PyContactRegion>>,
     stats: QueryStats,
+    sides: Option<QueriedSides>,
+}
+
+/// The two sides of a query as queried (a mesh side: its samples) with their
+/// poses, kept (shared, not copied) so a result can give its points.
+pub struct QueriedSides {
+    /// Side A's cloud in its own frame.
+    pub a: Arc<PointCloud>,
+    /// Side B's cloud in its own frame.
+    pub b: Arc<PointCloud>,
+    /// Side A's pose.
+    pub pose_a: Pose,
+    /// Side B's pose.
+    pub pose_b: Pose,
 }
 
 impl PyCollisionResult {
@@ -159,7 +331,32 @@ impl PyCollisionResult {
             probabilities_b: r.probabilities_b,
             regions,
             stats: r.stats,
+            sides: None,
         })
+    }
+
+    /// Wraps a core result and the sides it was computed on.
+    pub fn with_sides(py: Python<'_>, r: CollisionResult, sides: QueriedSides) -> PyResult<Self> {
+        let mut out = Self::new(py, r)?;
+        out.sides = Some(sides);
+        Ok(out)
+    }
+
+    fn world_points<'py>(
+        &self,
+        py: Python<'py>,
+        side_a: bool,
+    ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let Some(s) = &self.sides else {
+            return Ok(None);
+        };
+        let (cloud, pose) = if side_a {
+            (&s.a, &s.pose_a)
+        } else {
+            (&s.b, &s.pose_b)
+        };
+        let moved: Vec<_> = cloud.points().iter().map(|p| pose * p).collect();
+        points_to_py(py, &moved).map(Some)
     }
 }
 
@@ -187,6 +384,132 @@ impl PyCollisionResult {
     #[getter]
     fn probabilities_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vec_to_py(py, &self.probabilities_b)
+    }
+
+    /// Side A's points as queried (a mesh side: its samples), world frame, shape
+    /// `(n_a, 3)`; `None` when the result does not record them (robot links).
+    #[getter]
+    fn points_a<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.world_points(py, true)
+    }
+
+    /// Side B's points as queried, world frame, shape `(n_b, 3)`, or `None`.
+    #[getter]
+    fn points_b<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.world_points(py, false)
+    }
+
+    /// Writes the interactive HTML view of the result and opens it in the web
+    /// browser (`cloudprox.view.show`; needs `cloudprox[view]`). Returns the path.
+    #[pyo3(signature = (path=None, **options))]
+    fn show<'py>(
+        slf: &Bound<'py, Self>,
+        path: Option<&Bound<'py, PyAny>>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let show = py.import("cloudprox.view")?.getattr("show")?;
+        let path = match path {
+            Some(p) => p.clone(),
+            None => py.None().into_bound(py),
+        };
+        show.call(PyTuple::new(py, [slf.clone().into_any(), path])?, options)
+    }
+
+    /// Pickle support: `P`, the state, the per-point probabilities, the regions
+    /// and the statistics; not the clouds (`points_a` and `points_b` are `None`
+    /// once unpickled).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ResultState,))> {
+        let py = slf.py();
+        let me = slf.get();
+        let regions = me
+            .regions
+            .iter()
+            .map(|r| region_to_state(&r.get().inner))
+            .collect();
+        let QueryStats {
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds,
+        } = me.stats.clone();
+        let _ = py;
+        let state = (
+            me.probability,
+            me.state.to_string(),
+            me.probabilities_a.clone(),
+            me.probabilities_b.clone(),
+            regions,
+            (
+                node_pairs_visited,
+                leaf_pairs,
+                near_regions,
+                patches,
+                misfit_cuts,
+                patches_beyond_reach,
+                points_classified,
+                solver_iterations,
+                barrier_fallbacks,
+                solver_fallbacks,
+                pruned_bound,
+                time_seconds,
+            ),
+        );
+        Ok((slf.getattr("_from_state")?, (state,)))
+    }
+
+    /// Rebuilds a pickled result (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: ResultState) -> PyResult<Self> {
+        let (probability, state_text, probabilities_a, probabilities_b, regions, stats) = state;
+        let regions = regions
+            .into_iter()
+            .map(|r| Py::new(py, PyContactRegion::wrap(region_from_state(py, r)?)))
+            .collect::<PyResult<Vec<_>>>()?;
+        let (
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds,
+        ) = stats;
+        Ok(Self {
+            probability,
+            state: state_name(py, &state_text)?,
+            probabilities_a,
+            probabilities_b,
+            regions,
+            stats: QueryStats {
+                node_pairs_visited,
+                leaf_pairs,
+                near_regions,
+                patches,
+                misfit_cuts,
+                patches_beyond_reach,
+                points_classified,
+                solver_iterations,
+                barrier_fallbacks,
+                solver_fallbacks,
+                pruned_bound,
+                time_seconds,
+            },
+            sides: None,
+        })
     }
 
     /// The classified patches (a new list of the same region objects each time).

@@ -157,6 +157,18 @@ fn matrix_to_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArra
 #[pyclass(name = "Robot", frozen, module = "cloudprox._native")]
 pub struct PyRobot {
     inner: Arc<Robot>,
+    source: RobotSource,
+}
+
+/// What a robot was loaded from, to load it again after pickling: the URDF's
+/// text and name, the folder relative mesh paths are resolved against, and the
+/// `package://` folders. Mesh files are read again on unpickling.
+#[derive(Clone)]
+struct RobotSource {
+    xml: String,
+    name: String,
+    base_dir: Option<PathBuf>,
+    package_dirs: Vec<PathBuf>,
 }
 
 impl PyRobot {
@@ -180,9 +192,71 @@ impl PyRobot {
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
         let dirs = package_dirs.unwrap_or_default();
-        let robot = run_detached(py, move || Robot::from_urdf_file(&path, &dirs))?;
+        let d = dirs.clone();
+        let (robot, xml, path) = run_detached(py, move || {
+            let robot = Robot::from_urdf_file(&path, &d)?;
+            // Read again for pickling (the load above just read it).
+            let xml = std::fs::read_to_string(&path).unwrap_or_default();
+            Ok((robot, xml, path))
+        })?;
+        let base_dir = path.parent().map(std::path::Path::to_path_buf);
         Ok(Self {
             inner: Arc::new(robot),
+            source: RobotSource {
+                xml,
+                name: path.display().to_string(),
+                base_dir,
+                package_dirs: dirs,
+            },
+        })
+    }
+
+    /// Pickle support: the URDF text, its name, the folder relative mesh paths
+    /// are resolved against and the package folders; the robot is loaded again
+    /// on unpickling (its mesh files must be readable at the same paths).
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (String, String, Option<PathBuf>, Vec<PathBuf>),
+    )> {
+        let s = &slf.get().source;
+        Ok((
+            slf.getattr("_from_urdf_text")?,
+            (
+                s.xml.clone(),
+                s.name.clone(),
+                s.base_dir.clone(),
+                s.package_dirs.clone(),
+            ),
+        ))
+    }
+
+    /// Loads a robot from URDF text (see `__reduce__`); `name` stands for the
+    /// file in errors, relative mesh paths are resolved against `base_dir`.
+    #[staticmethod]
+    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None))]
+    fn _from_urdf_text(
+        py: Python<'_>,
+        xml: String,
+        name: String,
+        base_dir: Option<PathBuf>,
+        package_dirs: Option<Vec<PathBuf>>,
+    ) -> PyResult<Self> {
+        let source = RobotSource {
+            xml,
+            name,
+            base_dir,
+            package_dirs: package_dirs.unwrap_or_default(),
+        };
+        let s = source.clone();
+        let robot = run_detached(py, move || {
+            Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)
+        })?;
+        Ok(Self {
+            inner: Arc::new(robot),
+            source,
         })
     }
 
@@ -565,8 +639,50 @@ pub struct PyRobotBatchResult {
     n_links: usize,
 }
 
+/// The pickled form of a `RobotBatchResult`.
+type BatchState = (Vec<f64>, Vec<String>, Vec<bool>, Vec<f64>, usize);
+
 #[pymethods]
 impl PyRobotBatchResult {
+    /// Pickle support: the arrays.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (BatchState,))> {
+        let me = slf.get();
+        let state = (
+            me.probabilities.clone(),
+            me.states.iter().map(|s| (*s).to_string()).collect(),
+            me.self_colliding.clone(),
+            me.link_probabilities.clone(),
+            me.n_links,
+        );
+        Ok((slf.getattr("_from_state")?, (state,)))
+    }
+
+    /// Rebuilds a pickled batch result (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: BatchState) -> PyResult<Self> {
+        let (probabilities, states, self_colliding, link_probabilities, n_links) = state;
+        let states = states
+            .iter()
+            .map(|s| crate::result::state_name(py, s))
+            .collect::<PyResult<Vec<_>>>()?;
+        if states.len() != probabilities.len()
+            || self_colliding.len() != probabilities.len()
+            || link_probabilities.len() != probabilities.len() * n_links
+        {
+            return Err(invalid_input(
+                py,
+                "a pickled RobotBatchResult of inconsistent lengths",
+            ));
+        }
+        Ok(Self {
+            probabilities,
+            states,
+            self_colliding,
+            link_probabilities,
+            n_links,
+        })
+    }
+
     /// `(m,)` collision probabilities.
     #[getter]
     fn probabilities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +41,7 @@ from scipy.spatial import cKDTree
 from scipy.special import ndtr
 
 from cloudprox._native import (
+    CollisionResult,
     ExactShape,
     PointCloud,
     collide_many,
@@ -201,15 +203,22 @@ def _world(points: FloatArray, pose: FloatArray) -> FloatArray:
 
 
 def cloudprox_answer(
-    draw: Draw, poses: FloatArray, surface: str, aggregation: str, model: str = "points"
+    draw: Draw,
+    poses: FloatArray,
+    surface: str,
+    aggregation: str,
+    model: str = "points",
+    many: Callable[..., list[CollisionResult]] | None = None,
 ) -> MethodAnswer:
     """Answer every pose with cloudprox (``collide_many``, in parallel).
 
     Default settings but for the surface family, the aggregation and the model
     (``"points"``, the paper's, or ``"elements"``, the surface elements).
+    ``many`` replaces :func:`cloudprox.collide_many` (e.g.
+    :func:`cloudprox.distributed.collide_many`: the same answers, as Ray tasks).
     """
     piano, room = draw.clouds()
-    results = collide_many(
+    results = (many or collide_many)(
         piano, room, poses, surface=surface, aggregation=aggregation, model=model
     )
     return MethodAnswer(

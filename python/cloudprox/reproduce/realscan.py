@@ -43,6 +43,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -331,10 +332,12 @@ def run_scan(
     seed: int,
     variants: tuple[tuple[str, str, str], ...],
     tick: Callable[[str, int], None],
+    many: Callable[..., Any] | None = None,
 ) -> ScanResult:
     """Run every method on the Kinect frame with ``n_poses`` gripper poses.
 
-    ``tick(description, advance)`` reports progress (:data:`SCAN_STEPS` steps).
+    ``tick(description, advance)`` reports progress (:data:`SCAN_STEPS` steps);
+    ``many`` replaces ``cloudprox.collide_many`` in cloudprox's queries.
     """
     rng = np.random.default_rng(seed)
     frame = load_kinect_frame()
@@ -376,7 +379,7 @@ def run_scan(
     answers: dict[str, list[m.MethodAnswer]] = {}
     for model, surface, agg in variants:
         key = m.variant_name(model, surface, agg)
-        answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model) for d in draws]
+        answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model, many) for d in draws]
         tick(f"kinect: {key}", 1)
     answers["nn-gap"] = [m.nn_gap_answer(d, q.poses) for d in draws]
     answers["collision-map"] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]

@@ -22,6 +22,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -236,7 +237,12 @@ def _markdown(summary: Summary) -> str:
     )
 
 
-def run(config: Config, out: Path, progress: Callable[[str, int], None] | None = None) -> Summary:
+def run(
+    config: Config,
+    out: Path,
+    progress: Callable[[str, int], None] | None = None,
+    many: Callable[..., Any] | None = None,
+) -> Summary:
     """Run every method at every level and write the outputs into ``out``.
 
     Parameters
@@ -248,6 +254,9 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
     progress : callable, optional
         Called as ``progress(description, advance)`` after each step; the total
         number of steps is :func:`steps`.
+    many : callable, optional
+        Replaces :func:`cloudprox.collide_many` in cloudprox's queries (e.g.
+        :func:`cloudprox.distributed.collide_many`, the same answers as Ray tasks).
 
     Returns
     -------
@@ -293,7 +302,9 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
         answers: dict[str, list[m.MethodAnswer]] = {}
         for model, surface, agg in VARIANTS:
             key = m.variant_name(model, surface, agg)
-            answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model) for d in draws]
+            answers[key] = [
+                m.cloudprox_answer(d, q.poses, surface, agg, model, many) for d in draws
+            ]
             tick(f"{name}: {key}", 1)
         answers[NN] = [m.nn_gap_answer(d, q.poses) for d in draws]
         answers[MAP] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
@@ -333,7 +344,7 @@ def run(config: Config, out: Path, progress: Callable[[str, int], None] | None =
             "which needs Open3D"
         )
     if config.scan_poses > 0 and with_reconstruction:
-        scan = run_scan(config.scan_poses, config.seed, SCAN_VARIANTS, tick)
+        scan = run_scan(config.scan_poses, config.seed, SCAN_VARIANTS, tick, many)
         summary.scan_facts = scan.facts
         unit = scan.poses.signed_distance / scan.poses.sigma
         for method, sc in scan.scores.items():

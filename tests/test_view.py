@@ -1,0 +1,377 @@
+"""The interactive view: HTML rendered by headless Chromium, Rerun read back, the CLI."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cloudprox as cp
+from cloudprox import view
+from cloudprox.cli import main
+from tests.helpers import translation
+from tests.robots import ARM_URDF, wall
+
+
+def _chromium() -> str:
+    for name in ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable"):
+        path = shutil.which(name)
+        if path:
+            return path
+    if os.environ.get("CI"):
+        pytest.fail("no chromium on CI: scripts/system-deps.sh installs it")
+    pytest.skip("no chromium here (scripts/system-deps.sh installs it)")
+
+
+def screenshot(html: Path, png: Path, size: tuple[int, int] = (1000, 800)) -> np.ndarray:
+    """Render ``html`` in headless Chromium; return the screenshot's RGB pixels (0-255)."""
+    from matplotlib.image import imread
+
+    done = subprocess.run(
+        [
+            _chromium(),
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            f"--user-data-dir={png.parent / 'chromium-profile'}",
+            f"--screenshot={png}",
+            f"--window-size={size[0]},{size[1]}",
+            "--virtual-time-budget=5000",
+            html.resolve().as_uri(),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert png.is_file(), done.stderr[-2000:]
+    return (imread(png)[:, :, :3] * 255.0).round()
+
+
+def _near(pixels: np.ndarray, rgb: tuple[int, int, int], tol: float = 30.0) -> int:
+    return int(np.sum(np.all(np.abs(pixels - np.array(rgb)) <= tol, axis=2)))
+
+
+def _hex(color: str) -> tuple[int, int, int]:
+    c = color.lstrip("#")
+    r, g, b = (int(c[i : i + 2], 16) for i in (0, 2, 4))
+    return r, g, b
+
+
+def _plot_area(pixels: np.ndarray) -> np.ndarray:
+    """The 3D scene without the legend (top left) and the colour bar (right)."""
+    h, w = pixels.shape[:2]
+    return pixels[int(0.40 * h) : int(0.95 * h), int(0.05 * w) : int(0.86 * w)]
+
+
+def hot(pixels: np.ndarray) -> int:
+    """Pixels of the plasma scale's top (p >~ 0.75: orange to yellow)."""
+    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    return int(np.sum((r > 220) & (g > 120) & (b < 110)))
+
+
+def cold(pixels: np.ndarray) -> int:
+    """Pixels of the plasma scale's bottom (p <~ 0.3: dark blue to purple)."""
+    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    return int(np.sum((r < 150) & (g < 40) & (b > 110)))
+
+
+@pytest.fixture(scope="module")
+def spheres_near() -> tuple[cp.PointCloud, cp.PointCloud, np.ndarray]:
+    base = cp.sample_sphere(1500, 0.1)
+    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
+    b = cp.PointCloud(cp.add_noise(base, 0.002, seed=2), sigma=0.002)
+    return a, b, translation(0.19)
+
+
+def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None:
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    assert result.state == "collision"
+    scene = view.collision_scene(result, labels=("left", "right"))
+    html = view.write_html(scene, tmp_path / "near.html")
+    text = html.read_text()
+    # Self-contained: plotly.js embedded, nothing fetched from elsewhere.
+    assert not re.search(r"<script[^>]*\bsrc=", text)
+    assert "Plotly.newPlot" in text and len(text) > 3_000_000
+    assert html.stat().st_size < 6_000_000
+    pixels = _plot_area(screenshot(html, tmp_path / "near.png"))
+    # The colliding caps are hot, their rims cold; both spheres keep their colours.
+    assert hot(pixels) > 200, hot(pixels)
+    assert cold(pixels) > 50, cold(pixels)
+    assert _near(pixels, _hex(view.SIDE_COLORS[0])) > 200
+    assert _near(pixels, _hex(view.SIDE_COLORS[1])) > 200
+
+    # The same spheres far apart: no hot pixel at all, the colour bar aside.
+    far = cp.collide(a, b, pose_b=translation(0.3))
+    assert far.state == "free"
+    html = view.write_html(view.collision_scene(far), tmp_path / "far.html")
+    pixels = screenshot(html, tmp_path / "far.png")
+    assert hot(_plot_area(pixels)) == 0
+    assert _near(_plot_area(pixels), _hex(view.SIDE_COLORS[0])) > 200
+    # ... while the colour bar on the right does show the hot end.
+    assert hot(pixels[:, int(0.86 * pixels.shape[1]) :]) > 50
+
+
+def test_scene_of_a_result(spheres_near) -> None:
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    # The result records its points, in the world frame.
+    np.testing.assert_array_equal(result.points_a, a.points)
+    np.testing.assert_allclose(result.points_b, b.points + pose_b[:3, 3], rtol=0, atol=1e-15)
+    scene = view.collision_scene(result, surfaces=2)
+    assert [len(x.points) for x in scene.points] == [len(a), len(b)]
+    np.testing.assert_array_equal(
+        scene.points[0].probabilities, result.probabilities_a.astype(np.float32)
+    )
+    assert len(scene.regions) == len(result.regions) >= 1
+    assert sorted(r.probability for r in scene.regions)[-1] == max(
+        r.probability for r in result.regions
+    )
+    with_surface = [r for r in scene.regions if r.surface is not None]
+    assert 1 <= len(with_surface) <= 2
+    # The separating surface passes through f = 0 (it is where f vanishes).
+    best = max(result.regions, key=lambda r: r.probability)
+    vertices, faces = view.separating_surface(best, 0.02)
+    f, _ = best.evaluate(vertices)
+    assert np.max(np.abs(f)) < 1e-6 and faces.max() == len(vertices) - 1
+    # The same view from the clouds and poses, and from world points.
+    again = view.collision_scene(result, a, b, None, pose_b, points_a=a.points)
+    np.testing.assert_allclose(again.points[1].points, scene.points[1].points, atol=1e-6)
+
+
+def test_mesh_side_is_drawn_with_its_samples(tmp_path, spheres_near) -> None:
+    a, _, _ = spheres_near
+    box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
+    pose = translation(0.14)
+    result = cp.collide(box, a, pose_a=pose)
+    assert result.points_a.shape == (len(result.probabilities_a), 3)
+    assert np.all(np.abs(result.points_a[:, 0] - 0.14) <= 0.05 + 1e-12)
+    scene = view.collision_scene(result, box, a, pose)
+    assert len(scene.meshes) == 1 and not scene.points[0].show_quiet
+    np.testing.assert_allclose(
+        scene.meshes[0].vertices, box.vertices + np.array([0.14, 0.0, 0.0]), atol=1e-6
+    )
+    fig = view.to_figure(scene)
+    assert any(t.type == "mesh3d" for t in fig.data)
+
+
+def test_bad_inputs_give_clear_errors(spheres_near, monkeypatch) -> None:
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    with pytest.raises(ValueError, match=r"side A: points of shape \(10, 3\) do not match"):
+        view.collision_scene(result, points_a=a.points[:10])
+    with pytest.raises(ValueError, match="half_size must be finite and > 0"):
+        view.separating_surface(result.regions[0], 0.0)
+    box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
+    with_mesh = cp.collide(box, a, pose_a=translation(0.14))
+    with pytest.raises(ValueError, match=r"a pose must have shape \(4, 4\)"):
+        view.collision_scene(with_mesh, box, a, np.eye(3))
+    monkeypatch.setitem(sys.modules, "plotly", None)
+    monkeypatch.setitem(sys.modules, "plotly.graph_objects", None)
+    with pytest.raises(ImportError, match=r"pip install 'cloudprox\[view\]'"):
+        view.to_figure(view.collision_scene(result))
+
+
+def test_show_writes_and_opens(tmp_path, spheres_near, monkeypatch) -> None:
+    a, b, pose_b = spheres_near
+    opened: list[str] = []
+    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url) or True)
+    result = cp.collide(a, b, pose_b=pose_b)
+    path = result.show(tmp_path / "shown.html", labels=("one", "two"))
+    assert path == tmp_path / "shown.html" and path.stat().st_size > 3_000_000
+    assert opened == [path.resolve().as_uri()]
+    assert "one vs two" in path.read_text()
+    quiet = result.show(open_browser=False)
+    assert quiet.is_file() and len(opened) == 1
+    quiet.unlink()
+
+
+def test_rerun_recording_reads_back(tmp_path, spheres_near) -> None:
+    rr = pytest.importorskip("rerun")
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    scene = view.collision_scene(result, labels=("left", "right"))
+    path = view.write_rerun(scene, tmp_path / "near.rrd")
+    columns: dict[str, dict[str, object]] = {}
+    for chunk in rr.chunk.RrdReader(path).stream():
+        batch = chunk.to_record_batch()
+        columns.setdefault(chunk.entity_path, {}).update(
+            {name: batch.column(name) for name in batch.schema.names}
+        )
+    assert {"/summary", "/points/0_left", "/points/1_right", "/regions"} <= set(columns)
+    for k, name in ((0, "/points/0_left"), (1, "/points/1_right")):
+        positions = np.array(columns[name]["Points3D:positions"][0].as_py(), dtype=np.float32)
+        np.testing.assert_array_equal(positions, scene.points[k].points)
+        prob = np.array(columns[name]["probability"][0].as_py())
+        np.testing.assert_array_equal(prob, scene.points[k].probabilities.astype(np.float64))
+        colors = np.array(columns[name]["Points3D:colors"][0].as_py(), dtype=np.uint64)
+        top = int(np.argmax(prob))
+        # Packed 0xRRGGBBAA: the most probable point is drawn in plasma's yellow end.
+        r, g, bl = (int(colors[top]) >> s & 0xFF for s in (24, 16, 8))
+        assert r > 200 and g > 150 and bl < 120, (r, g, bl)
+    origins = np.array(columns["/regions"]["Arrows3D:origins"][0].as_py())
+    assert len(origins) == len(result.regions)
+    text = columns["/summary"]["TextDocument:text"][0].as_py()
+    assert f"state: {result.state}" in str(text)
+
+
+@pytest.fixture(scope="module")
+def arm_files(tmp_path_factory) -> dict[str, str]:
+    d = tmp_path_factory.mktemp("arm-view")
+    (d / "arm.urdf").write_text(ARM_URDF)
+    np.save(d / "wall.npy", wall(0.36, 0.3, 0.15, 0.002, seed=3))
+    return {"urdf": str(d / "arm.urdf"), "scan": str(d / "wall.npy"), "dir": str(d)}
+
+
+def test_robot_scene(arm_files) -> None:
+    robot = cp.Robot.from_urdf(arm_files["urdf"])
+    cloud = cp.PointCloud(np.load(arm_files["scan"]), sigma=0.002)
+    q = np.array([0.0, 0.0, 0.08, 0.0])  # link3 into the wall
+    result = cp.collide_robot(robot, q, cloud)
+    assert result.state == "collision" and result.links["link3"].state == "collision"
+    scene = view.robot_scene(robot, q, cloud, result, label="wall")
+    names = [m.name for m in scene.meshes]
+    assert names == [n for n in robot.link_names if robot.link_mesh(n) is not None]
+    by_name = {m.name: m for m in scene.meshes}
+    for name, link in result.links.items():
+        expected = link.probability if link.queried else None
+        assert by_name[name].probability == expected
+    worst = np.zeros(len(cloud))
+    for link in result.links.values():
+        if link.result is not None:
+            worst = np.maximum(worst, link.result.probabilities_b)
+    np.testing.assert_array_equal(scene.points[0].probabilities, worst.astype(np.float32))
+    poses = robot.link_poses(q)
+    v = robot.link_mesh("link2").vertices
+    np.testing.assert_allclose(
+        by_name["link2"].vertices, v @ poses["link2"][:3, :3].T + poses["link2"][:3, 3], atol=1e-6
+    )
+    assert result.state in scene.title
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
+    from cloudprox.examples import write_example_files
+
+    ex = write_example_files(tmp_path / "ex")
+    html, rrd = tmp_path / "grasp.html", tmp_path / "grasp.rrd"
+    argv = [
+        "collide",
+        str(ex["gripper"]),
+        str(ex["scan"]),
+        "--pose-a",
+        str(ex["grasp-collision"]),
+        "--sensor",
+        "depth-camera",
+        "--preset",
+        "nguyen-2012",
+    ]
+    code, out, err = run(capsys, *argv, "--html", str(html), "--rerun", str(rrd), "--json")
+    assert code == 0, err
+    assert '"state": "collision"' in out and str(html.resolve()) in err.replace("\n", "")
+    assert 3_000_000 < html.stat().st_size < 10_000_000 and rrd.stat().st_size > 0
+    # The mesh side is drawn as a mesh, with its samples coloured.
+    assert '"type":"mesh3d"' in html.read_text()
+
+    opened: list[str] = []
+    import webbrowser
+
+    orig = webbrowser.open
+    webbrowser.open = lambda url: opened.append(url) or True  # type: ignore[assignment]
+    try:
+        out_html = tmp_path / "v.html"
+        code, out, err = run(capsys, "view", *argv[1:], "--html", str(out_html))
+        assert code == 0, err
+        assert opened == [out_html.resolve().as_uri()] and out_html.is_file()
+        code, out, err = run(
+            capsys, "view", *argv[1:], "--html", str(tmp_path / "w.html"), "--no-open"
+        )
+        assert code == 0 and len(opened) == 1
+    finally:
+        webbrowser.open = orig  # type: ignore[assignment]
+
+    robot_html = tmp_path / "arm.html"
+    code, out, err = run(
+        capsys,
+        "robot",
+        arm_files["urdf"],
+        arm_files["scan"],
+        "--sigma",
+        "0.002",
+        "--q",
+        "0,0,0.08,0",
+        "--html",
+        str(robot_html),
+    )
+    assert code == 0, err
+    assert "link2" in robot_html.read_text()
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--surfaces", "-1"], "--surfaces must be >= 0"),
+        (["--html", "/no/such/folder/x.html"], "no such folder"),
+        (["--html", "noext"], "ending in .html"),
+    ],
+)
+def test_cli_view_errors(capsys, tmp_path, arm_files, extra, message) -> None:
+    a = tmp_path / "a.npy"
+    np.save(a, cp.sample_sphere(200, 0.1))
+    code, _, err = run(capsys, "collide", str(a), str(a), "--sigma", "0.002", *extra)
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_cli_robot_html_needs_one_configuration(capsys, tmp_path, arm_files) -> None:
+    qs = tmp_path / "qs.csv"
+    qs.write_text("0,0,0,0\n0.1,0,0,0\n")
+    code, _, err = run(
+        capsys,
+        "robot",
+        arm_files["urdf"],
+        arm_files["scan"],
+        "--sigma",
+        "0.002",
+        "--q-file",
+        str(qs),
+        "--html",
+        str(tmp_path / "x.html"),
+    )
+    assert code == 2 and "give --q, not --q-file" in err
+
+
+def test_readme_view_line(tmp_path) -> None:
+    from tests.robots import readme_block
+
+    line = readme_block("view-cli").strip()
+    assert "\n" not in line, "the README promises one command line"
+    # The command installed beside this Python (a virtualenv's), else on PATH.
+    beside = Path(sys.executable).parent / "cloudprox"
+    script = str(beside) if beside.is_file() else shutil.which("cloudprox")
+    launcher = [script] if script else [sys.executable, "-m", "cloudprox"]
+    for command in line.split("&&"):
+        argv = command.split()
+        assert argv[0] == "cloudprox"
+        done = subprocess.run(
+            [*launcher, *argv[1:]], cwd=tmp_path, capture_output=True, text=True, check=False
+        )
+        assert done.returncode == 0, done.stderr
+    html = tmp_path / "grasp.html"
+    assert "state: collision" in done.stdout and str(html.resolve()) in done.stdout.replace(
+        "\n", ""
+    )
+    text = html.read_text()
+    assert not re.search(r"<script[^>]*\bsrc=", text) and "state: collision" in text
