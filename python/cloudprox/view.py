@@ -3,11 +3,16 @@
 A view holds both sides of a query (clouds, or a mesh and a cloud, or a robot at
 its configuration and a scene), every point coloured by its collision probability
 on a colour bar, the contact regions with their normals and separations, and the
-separating surface of the most probable regions (hidden until clicked in the
-legend). The HTML file embeds plotly.js: it opens without a server or the
-internet; turn, zoom, and hover a point for its probability.
+separating surface of the most probable regions (hidden at first). The HTML file
+(:func:`write_html`) is drawn by k3d (three.js, its JavaScript inlined: it opens
+without a server or the internet, fast even without a GPU: every point is one
+WebGL point); turn, zoom, and hover a point for its probability. The points
+below ``quiet_below`` are thinned to the density a screen shows of the whole
+scene unless ``all_points``. :func:`to_figure` makes the same scene a plotly
+figure (``write_html(..., renderer="plotly")``).
 
-plotly is the optional extra ``cloudprox[view]``, rerun-sdk ``cloudprox[rerun]``.
+k3d and plotly are the optional extra ``cloudprox[view]``, rerun-sdk
+``cloudprox[rerun]``.
 
 Examples
 --------
@@ -1045,7 +1050,9 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
                     hover_callback=hovered,
                 )
                 info[name] = {"side": layer.name}
-            thinned = "" if len(shown) == total else f" (one a {1e3 * cell:.2g} mm cell)"
+            thinned = ""
+            if cell is not None and len(shown) < total:
+                thinned = f" (one a {1e3 * cell:.2g} mm cell)"
             legend.append(
                 f"<span style='color:{layer.color}'>&#9632;</span> {layer.name}: "
                 f"{len(shown)} of {total} points with p &lt; {scene.quiet_below:g} drawn{thinned}"
