@@ -214,6 +214,41 @@ def test_html_turns_zooms_and_hovers(tmp_path, spheres_near) -> None:
         )
 
 
+def test_separating_surface_shows_from_the_panel(tmp_path, spheres_near) -> None:
+    from matplotlib.image import imread
+
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    html = view.write_html(view.collision_scene(result), tmp_path / "s.html")
+    # The surface's entry in the K3D panel (Objects), its "visible" box.
+    toggle = (
+        "(function(){var t=Array.from(document.querySelectorAll('button.lil-title'))"
+        ".find(function(b){return b.textContent.indexOf('separating surface')===0});"
+        "var c=Array.from(t.parentElement.querySelectorAll('.lil-controller.lil-boolean'))"
+        ".find(function(r){return r.textContent.trim()==='visible'});"
+        "var box=c.querySelector('input');var before=box.checked;box.click();"
+        "return [before, box.checked]})()"
+    )
+    with _browser() as browser:
+        browser.open(html)
+        hidden = (imread(browser.screenshot(tmp_path / "hidden.png"))[:, :, :3] * 255).round()
+        assert browser.eval(toggle) == [False, True]
+        browser.eval(
+            "new Promise(function(r){requestAnimationFrame(function(){setTimeout(r,200)})})"
+        )
+        shown = (imread(browser.screenshot(tmp_path / "surface.png"))[:, :, :3] * 255).round()
+
+    # Half-transparent blue over white and grey: a bluish patch appears.
+    def bluish(px: np.ndarray) -> int:
+        r, g, bl = px[..., 0], px[..., 1], px[..., 2]
+        return int(np.sum((bl > r + 40) & (bl > g + 15) & (r < 200)))
+
+    assert bluish(_plot_area(shown)) > bluish(_plot_area(hidden)) + 2000, (
+        bluish(_plot_area(hidden)),
+        bluish(_plot_area(shown)),
+    )
+
+
 def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
     # A dense wall of 200 000 points with p = 0 and a patch of 400 with p > 0.
     rng = np.random.default_rng(5)
@@ -234,6 +269,13 @@ def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
     assert len(np.unique(cells[shown], axis=0)) == len(shown)
     assert len(np.unique(cells[quiet], axis=0)) == len(shown)
     assert 0.5 * view.QUIET_CELLS**2 < len(shown) < 0.6 * len(wall)
+    # The points of a contact region are drawn even where the cell has another.
+    dropped = np.setdiff1d(quiet, shown)[:50]
+    with_contact = view.PointLayer(
+        "wall", layer.points, prob, layer.color, contact=np.concatenate([dropped, [3]])
+    )
+    kept = view._quiet_shown(with_contact, scene.quiet_below, cell)
+    assert len(kept) == len(shown) + 50 and np.all(np.isin(dropped, kept)) and 3 not in kept
     objects = {o.name: o for o in view.to_k3d(scene).objects}
     assert f"wall: {len(shown)} of {len(wall) - 400} points with p < 0.001" in objects
     assert len(objects["wall: 400 with p ≥ 0.001"].positions) == 400

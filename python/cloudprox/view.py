@@ -101,6 +101,8 @@ class PointLayer:
     show_quiet : bool
         Whether the points below ``quiet_below`` are drawn (a mesh side's samples
         are not: the mesh is).
+    contact : ndarray of int
+        Indices of the points in a contact region: drawn even when thinned.
     """
 
     name: str
@@ -108,6 +110,7 @@ class PointLayer:
     probabilities: np.ndarray
     color: str
     show_quiet: bool = True
+    contact: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 @dataclass(frozen=True)
@@ -276,6 +279,13 @@ def _region_marks(
     return marks
 
 
+def _contact_indices(regions: Sequence[ContactRegion], side: str, n: int) -> np.ndarray:
+    """Collect the indices (sorted, unique, < n) of one side's points in ``regions``."""
+    parts = [np.asarray(getattr(r, f"indices_{side}"), dtype=np.int64) for r in regions]
+    idx = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+    return idx[(idx >= 0) & (idx < n)]
+
+
 def _side_points(
     which: str,
     obj: Any,
@@ -387,6 +397,7 @@ def collision_scene(
                 probabilities=np.nan_to_num(prob[k]).astype(np.float32),
                 color=SIDE_COLORS[k],
                 show_quiet=not is_mesh,
+                contact=_contact_indices(result.regions, "ab"[k], len(prob[k])),
             )
         )
     head = f"{title}<br>" if title else ""
@@ -482,6 +493,7 @@ def robot_scene(
             points=np.asarray(cloud.points, dtype=np.float32),
             probabilities=worst.astype(np.float32),
             color=SIDE_COLORS[1],
+            contact=_contact_indices([r for _, r in result.regions], "b", n),
         )
     ]
     selfc = (
@@ -832,21 +844,24 @@ def _quiet_shown(layer: PointLayer, quiet_below: float, cell: float | None) -> n
     """Pick the quiet points drawn: all, or one a cell of side ``cell`` (indices).
 
     The first point (in the layer's order) of each occupied cell is kept, so the
-    choice is deterministic and the drawn density is at most one a cell.
+    choice is deterministic and the drawn density is at most one a cell; the
+    points of the contact regions (``layer.contact``) are kept besides.
     """
-    quiet = np.flatnonzero(np.asarray(layer.probabilities) < quiet_below)
+    is_quiet = np.asarray(layer.probabilities) < quiet_below
+    quiet = np.flatnonzero(is_quiet)
     if cell is None or not len(quiet):
         return quiet
     pts = np.asarray(layer.points, dtype=np.float64)[quiet]
     ok = np.all(np.isfinite(pts), axis=1)
-    quiet, pts = quiet[ok], pts[ok]
-    if not len(quiet):
-        return quiet
-    key = np.floor((pts - pts.min(axis=0)) / cell).astype(np.int64)
+    if not np.any(ok):
+        return quiet[:0]
+    key = np.floor((pts[ok] - pts[ok].min(axis=0)) / cell).astype(np.int64)
     span = key.max(axis=0) + 1
     flat = (key[:, 0] * span[1] + key[:, 1]) * span[2] + key[:, 2]
     _, first = np.unique(flat, return_index=True)
-    return quiet[np.sort(first)]
+    contact = np.asarray(layer.contact, dtype=np.int64)
+    contact = contact[(contact >= 0) & (contact < len(is_quiet))]
+    return np.union1d(quiet[ok][first], contact[is_quiet[contact]])
 
 
 def _packed(color: str) -> int:
