@@ -484,6 +484,22 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
             capsys, "view", *argv[1:], "--html", str(tmp_path / "w.html"), "--no-open"
         )
         assert code == 0 and len(opened) == 1
+        # --all-points: every quiet point of the scan drawn ("N of N").
+        code, out, err = run(
+            capsys,
+            "view",
+            *argv[1:],
+            "--html",
+            str(tmp_path / "all.html"),
+            "--no-open",
+            "--all-points",
+        )
+        assert code == 0, err
+        counts = [
+            re.match(r".+: (\d+) of (\d+) points", str(o["name"]))
+            for o in _k3d_objects((tmp_path / "all.html").read_text())
+        ]
+        assert [m.group(1) == m.group(2) for m in counts if m] == [True]
     finally:
         webbrowser.open = orig  # type: ignore[assignment]
 

@@ -1000,7 +1000,8 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
     Every point with ``p >= quiet_below`` is drawn, coloured on the plasma scale
     and larger; the others in their side's colour, thinned (unless
     ``all_points``) to one a cell of ``extent / QUIET_CELLS`` (the density a
-    screen shows of the whole scene); the legend says how many are drawn. The
+    screen shows of the whole scene), the points of contact regions kept; the
+    legend says how many are drawn. The
     contact regions are red markers with their normals (hover a marker for P,
     separation, normal), the separating surfaces start hidden (the panel's
     Objects folder shows them), mesh sides and robot links are surfaces.
@@ -1015,7 +1016,7 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
     Returns
     -------
     k3d.plot.Plot
-        Its ``get_snapshot()`` is the HTML that :func:`write_html` writes.
+        :func:`k3d_page` makes it the HTML that :func:`write_html` writes.
     """
     k3d = _need("k3d", "view")
     extent = scene.extent()
