@@ -17,6 +17,7 @@ import os
 import select
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -25,6 +26,21 @@ from typing import Any
 #: Software WebGL (SwiftShader), as on a machine without a GPU; the same flag the
 #: earlier ``--screenshot`` runs used.
 FLAGS = ("--disable-gpu",)
+
+
+_EXEC_WITH_FDS = (
+    "import os, sys; os.dup2(int(sys.argv[1]), 3); os.dup2(int(sys.argv[2]), 4); "
+    "os.close(int(sys.argv[1])); os.close(int(sys.argv[2])); os.execv(sys.argv[3], sys.argv[3:])"
+)
+
+
+def _above_9(fd: int) -> int:
+    """The same pipe end on a descriptor above 9 (``fd`` closed)."""
+    import fcntl
+
+    high = fcntl.fcntl(fd, fcntl.F_DUPFD_CLOEXEC, 10)
+    os.close(fd)
+    return high
 
 
 def find_chromium() -> str | None:
@@ -64,27 +80,27 @@ class Chromium:
         self._profile = tempfile.mkdtemp(prefix="cloudprox-chromium-")
         cmd_r, self._cmd_w = os.pipe()
         self._res_r, res_w = os.pipe()
-
-        def child_fds() -> None:
-            os.dup2(cmd_r, 3)
-            os.dup2(res_w, 4)
-
+        # Chromium's ends go to fds 3 and 4 of the child. A fork-safe way (no
+        # preexec_fn, which may deadlock in a process with threads): a Python
+        # that moves them there and execs Chromium; above 9 first, so that the
+        # moves cannot overwrite each other.
+        cmd_r, res_w = (_above_9(fd) for fd in (cmd_r, res_w))
+        args = [
+            exe,
+            "--headless",
+            "--no-sandbox",
+            "--remote-debugging-pipe",
+            "--hide-scrollbars",
+            "--no-first-run",
+            f"--user-data-dir={self._profile}",
+            f"--window-size={size[0]},{size[1]}",
+            *flags,
+            "about:blank",
+        ]
         start = time.perf_counter()
         self._proc = subprocess.Popen(
-            [
-                exe,
-                "--headless",
-                "--no-sandbox",
-                "--remote-debugging-pipe",
-                "--hide-scrollbars",
-                "--no-first-run",
-                f"--user-data-dir={self._profile}",
-                f"--window-size={size[0]},{size[1]}",
-                *flags,
-                "about:blank",
-            ],
-            pass_fds=(3, 4),
-            preexec_fn=child_fds,  # fds 3 and 4 are set in the child before exec
+            [sys.executable, "-c", _EXEC_WITH_FDS, str(cmd_r), str(res_w), *args],
+            pass_fds=(cmd_r, res_w),
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
@@ -97,7 +113,7 @@ class Chromium:
         self.events: list[dict[str, Any]] = []
         try:
             self.call("Browser.getVersion")
-            #: Seconds from launch to the browser's first answer.
+            #: Seconds from launch (through the small Python launcher) to the first answer.
             self.startup_s = time.perf_counter() - start
             targets = self.call("Target.getTargets")["targetInfos"]
             page = next(t for t in targets if t["type"] == "page")
