@@ -81,16 +81,19 @@ impl<'a> Posed<'a> {
         }
     }
 
-    /// The surface point of `self` straight across from `x` (at `x`'s
-    /// tangential coordinates, clamped to the extent).
-    fn across(&self, x: &Point3) -> Across {
+    /// The surface point of `self` straight across from `x`, a probe of
+    /// `from` (at `x`'s tangential coordinates, clamped to the extent). The
+    /// offset across is measured in `self`'s tangent plane; a single point has
+    /// none, so in the probe's own (the point lies over the probe's surface),
+    /// and in every direction when both are points.
+    fn across(&self, x: &Point3, from: &Posed<'_>) -> Across {
         let (u, v) = self.coordinates(x);
         let (y, var_y) = self.at(u, v);
         let d = y - x;
-        let lateral = if self.e.is_point() {
-            d.norm()
-        } else {
-            (d - self.normal * self.normal.dot(&d)).norm()
+        let lateral = match (self.e.is_point(), from.e.is_point()) {
+            (false, _) => (d - self.normal * self.normal.dot(&d)).norm(),
+            (true, false) => (d - from.normal * from.normal.dot(&d)).norm(),
+            (true, true) => d.norm(),
         };
         Across {
             u,
@@ -109,7 +112,7 @@ impl<'a> Posed<'a> {
         let allowed = HALF_SPACING * self.e.spacing.max(other.e.spacing);
         self.e.probes.iter().any(|&[u, v]| {
             let (x, var_x) = self.probe(u, v);
-            let c = other.across(&x);
+            let c = other.across(&x, self);
             let s = (self.var_bound(var_x) + other.var_bound(c.var_y)).sqrt();
             c.lateral <= allowed
                 && (c.y - x).norm() <= allowed + reach_sds * s
@@ -260,7 +263,7 @@ fn for_each_facing(
                     y,
                     var_y,
                     lateral,
-                } = o.across(&x);
+                } = o.across(&x, p);
                 let d = y - x;
                 let allowed = HALF_SPACING * p.e.spacing.max(o.e.spacing);
                 // An element that `x` lies over (within its extent, so `y`
