@@ -53,7 +53,7 @@ LINK = re.compile(r"\]\(([^)\s]+)\)")
 #: The line of ``docs/reference/cli.md`` replaced by the generated reference.
 CLI_MARKER = "<!-- cli-reference -->"
 #: Width of the generated help text (argparse reads it from ``COLUMNS``).
-HELP_WIDTH = 96
+HELP_WIDTH = 78
 
 
 def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
