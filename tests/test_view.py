@@ -15,43 +15,33 @@ import pytest
 import cloudprox as cp
 from cloudprox import view
 from cloudprox.cli import main
+from tests.chromium import Chromium, find_chromium
 from tests.helpers import translation
 from tests.robots import ARM_URDF, wall
 
 
-def _chromium() -> str:
-    for name in ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable"):
-        path = shutil.which(name)
-        if path:
-            return path
-    if os.environ.get("CI"):
-        pytest.fail("no chromium on CI: scripts/system-deps.sh installs it")
-    pytest.skip("no chromium here (scripts/system-deps.sh installs it)")
+def _browser() -> Chromium:
+    if find_chromium() is None:
+        if os.environ.get("CI"):
+            pytest.fail("no chromium on CI: scripts/system-deps.sh installs it")
+        pytest.skip("no chromium here (scripts/system-deps.sh installs it)")
+    return Chromium(size=SIZE, settle=0.5)
 
 
-def screenshot(html: Path, png: Path, size: tuple[int, int] = (1000, 800)) -> np.ndarray:
-    """Render ``html`` in headless Chromium; return the screenshot's RGB pixels (0-255)."""
+#: The browser's viewport (CSS pixels).
+SIZE = (1000, 800)
+
+
+def screenshot(html: Path, png: Path) -> np.ndarray:
+    """Open ``html`` in headless Chromium, wait until drawn; the screenshot's RGB (0-255)."""
     from matplotlib.image import imread
 
-    done = subprocess.run(
-        [
-            _chromium(),
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--hide-scrollbars",
-            f"--user-data-dir={png.parent / 'chromium-profile'}",
-            f"--screenshot={png}",
-            f"--window-size={size[0]},{size[1]}",
-            "--virtual-time-budget=5000",
-            html.resolve().as_uri(),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
-    assert png.is_file(), done.stderr[-2000:]
+    with _browser() as browser:
+        browser.open(html)
+        # Only the file itself and what it carries inline (data:, a blob: worker).
+        foreign = [u for u in browser.requests() if not u.startswith(("file:", "data:", "blob:"))]
+        assert not foreign, foreign
+        browser.screenshot(png)
     return (imread(png)[:, :, :3] * 255.0).round()
 
 
@@ -66,21 +56,56 @@ def _hex(color: str) -> tuple[int, int, int]:
 
 
 def _plot_area(pixels: np.ndarray) -> np.ndarray:
-    """The 3D scene without the legend (top left) and the colour bar (right)."""
+    """The 3D scene without the legend (top left), panel (top right), colour bar (bottom left)."""
     h, w = pixels.shape[:2]
-    return pixels[int(0.40 * h) : int(0.95 * h), int(0.05 * w) : int(0.86 * w)]
+    return pixels[int(0.20 * h) :, int(0.12 * w) : int(0.88 * w)]
+
+
+def _color_bar(pixels: np.ndarray) -> np.ndarray:
+    h, w = pixels.shape[:2]
+    return pixels[int(0.5 * h) :, : int(0.1 * w)]
+
+
+def hot_mask(pixels: np.ndarray) -> np.ndarray:
+    """Pixels of the plasma scale's top (p >~ 0.75: orange to yellow)."""
+    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    return (r > 220) & (g > 120) & (b < 110)
 
 
 def hot(pixels: np.ndarray) -> int:
-    """Pixels of the plasma scale's top (p >~ 0.75: orange to yellow)."""
-    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
-    return int(np.sum((r > 220) & (g > 120) & (b < 110)))
+    return int(np.sum(hot_mask(pixels)))
 
 
 def cold(pixels: np.ndarray) -> int:
     """Pixels of the plasma scale's bottom (p <~ 0.3: dark blue to purple)."""
     r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
     return int(np.sum((r < 150) & (g < 40) & (b > 110)))
+
+
+def external_scripts(text: str) -> list[str]:
+    """``src`` of the page's real ``<script>`` tags (not of markup inside script text)."""
+    from html.parser import HTMLParser
+
+    found: list[str] = []
+
+    class Scripts(HTMLParser):
+        def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+            found.extend(v or "" for k, v in attrs if tag == "script" and k == "src")
+
+    Scripts().feed(text)
+    return found
+
+
+def _k3d_objects(text: str) -> list[dict[str, object]]:
+    """The objects a k3d page carries (its msgpack snapshot, base64 in the page)."""
+    import base64
+
+    import msgpack
+
+    m = re.search(r'atob\("([A-Za-z0-9+/=]+)"\)', text)
+    assert m, "no k3d snapshot in the page"
+    objects: list[dict[str, object]] = msgpack.unpackb(base64.b64decode(m.group(1)))["objects"]
+    return objects
 
 
 @pytest.fixture(scope="module")
@@ -98,16 +123,28 @@ def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None
     scene = view.collision_scene(result, labels=("left", "right"))
     html = view.write_html(scene, tmp_path / "near.html")
     text = html.read_text()
-    # Self-contained: plotly.js embedded, nothing fetched from elsewhere.
-    assert not re.search(r"<script[^>]*\bsrc=", text)
-    assert "Plotly.newPlot" in text and len(text) > 3_000_000
-    assert html.stat().st_size < 6_000_000
-    pixels = _plot_area(screenshot(html, tmp_path / "near.png"))
+    # Self-contained: k3d (three.js) inlined, nothing fetched from elsewhere (also
+    # checked in the browser by screenshot()).
+    assert text.count("<script") > 3 and not external_scripts(text)
+    assert 'define("k3d"' in text and 2_000_000 < len(text) < 10_000_000
+    assert "<title>left vs right: P = 1, state: collision" in text
+    names = [str(o["name"]) for o in _k3d_objects(text)]
+    assert "left: 1500 of 1500 points with p < 0.001" not in names  # some are hot
+    assert any(n.startswith("left: ") and "with p ≥ 0.001" in n for n in names)
+    assert any(n.startswith("contact regions (") for n in names)
+    pixels = screenshot(html, tmp_path / "near.png")
+    area = _plot_area(pixels)
     # The colliding caps are hot, their rims cold; both spheres keep their colours.
-    assert hot(pixels) > 200, hot(pixels)
-    assert cold(pixels) > 50, cold(pixels)
-    assert _near(pixels, _hex(view.SIDE_COLORS[0])) > 200
-    assert _near(pixels, _hex(view.SIDE_COLORS[1])) > 200
+    assert hot(area) > 200, hot(area)
+    assert cold(area) > 50, cold(area)
+    assert _near(area, _hex(view.SIDE_COLORS[0])) > 200
+    assert _near(area, _hex(view.SIDE_COLORS[1])) > 200
+    # The contact zoom: the camera looks at the contact, the hot pixels are in
+    # the middle of the view (not a speck in a corner).
+    rows, cols = np.nonzero(hot_mask(pixels))
+    h, w = pixels.shape[:2]
+    assert abs(np.median(rows) / h - 0.5) < 0.2 and abs(np.median(cols) / w - 0.5) < 0.2
+    assert np.ptp(cols) > 0.05 * w, np.ptp(cols)
 
     # The same spheres far apart: no hot pixel at all, the colour bar aside.
     far = cp.collide(a, b, pose_b=translation(0.3))
@@ -116,8 +153,154 @@ def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None
     pixels = screenshot(html, tmp_path / "far.png")
     assert hot(_plot_area(pixels)) == 0
     assert _near(_plot_area(pixels), _hex(view.SIDE_COLORS[0])) > 200
-    # ... while the colour bar on the right does show the hot end.
-    assert hot(pixels[:, int(0.86 * pixels.shape[1]) :]) > 50
+    # ... while the colour bar (bottom left) does show the hot end.
+    assert hot(_color_bar(pixels)) > 50
+
+
+def test_html_turns_zooms_and_hovers(tmp_path, spheres_near) -> None:
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    html = view.write_html(
+        view.collision_scene(result, labels=("left", "right")), tmp_path / "v.html"
+    )
+    camera = "cloudproxK3D.getWorld().camera.position.toArray()"
+    with _browser() as browser:
+        browser.open(html)
+        before = browser.screenshot(tmp_path / "before.png")
+        from matplotlib.image import imread
+
+        pixels = (imread(before)[:, :, :3] * 255.0).round()
+        # Hover the hot pixels one by one: a point's tooltip says its probability.
+        rows, cols = np.nonzero(hot_mask(pixels))
+        order = np.argsort(np.hypot(rows - np.median(rows), cols - np.median(cols)))
+        shown = None
+        for k in order[:40]:
+            browser.mouse("mouseMoved", float(cols[k]), float(rows[k]))
+            shown = browser.eval("window.cloudproxHovered || null")
+            if shown and "p = " in shown["html"]:
+                break
+        assert shown and "p = " in shown["html"], shown
+        p = float(re.search(r"p = ([0-9.e+-]+)", shown["html"]).group(1))
+        assert p > 0.5 and shown["name"].split(":")[0] in ("left", "right"), shown
+        assert browser.eval("document.getElementById('cloudprox-hover').style.display") == "block"
+        # A region marker's tooltip: P, separation, normal.
+        region = browser.eval(
+            "(function(){var w=cloudproxK3D.getWorld(),c=w.camera,o=Object.values(w.ObjectsById)"
+            ".find(function(x){return (w.ObjectsListJson[x.K3DIdentifier]||{}).name"
+            "&&w.ObjectsListJson[x.K3DIdentifier].name.indexOf('contact regions')===0});"
+            "var p=o.geometry.attributes.position,v=o.position.clone();"
+            "v.set(p.getX(0),p.getY(0),p.getZ(0)).applyMatrix4(o.matrixWorld).project(c);"
+            "var r=w.targetDOMNode.getBoundingClientRect();"
+            "return [(v.x+1)/2*r.width+r.left,(1-v.y)/2*r.height+r.top]})()"
+        )
+        browser.mouse("mouseMoved", region[0] + 1, region[1])
+        browser.mouse("mouseMoved", region[0], region[1])
+        text = browser.eval("window.cloudproxHovered.html")
+        assert "separation" in text and " mm" in text and "normal (" in text, text
+        # Turn: drag with the left button; the camera moves, the picture changes.
+        start = browser.eval(camera)
+        browser.drag((500.0, 500.0), (700.0, 520.0))
+        turned = browser.eval(camera)
+        assert np.linalg.norm(np.subtract(turned, start)) > 1e-3
+        after = browser.screenshot(tmp_path / "after.png")
+        assert np.mean(np.abs(imread(after)[:, :, :3] - imread(before)[:, :, :3])) > 0.005
+        # Zoom: the wheel brings the camera closer to what it looks at.
+        target = browser.eval("cloudproxK3D.getWorld().controls.target.toArray()")
+        browser.mouse("mouseWheel", 500.0, 400.0, deltaX=0, deltaY=-500)
+        browser.eval("new Promise(function(r){setTimeout(r, 300)})")
+        zoomed = browser.eval(camera)
+        assert np.linalg.norm(np.subtract(zoomed, target)) < np.linalg.norm(
+            np.subtract(turned, target)
+        )
+
+
+def test_separating_surface_shows_from_the_panel(tmp_path, spheres_near) -> None:
+    from matplotlib.image import imread
+
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    html = view.write_html(view.collision_scene(result), tmp_path / "s.html")
+    # The surface's entry in the K3D panel (Objects), its "visible" box.
+    toggle = (
+        "(function(){var t=Array.from(document.querySelectorAll('button.lil-title'))"
+        ".find(function(b){return b.textContent.indexOf('separating surface')===0});"
+        "var c=Array.from(t.parentElement.querySelectorAll('.lil-controller.lil-boolean'))"
+        ".find(function(r){return r.textContent.trim()==='visible'});"
+        "var box=c.querySelector('input');var before=box.checked;box.click();"
+        "return [before, box.checked]})()"
+    )
+    with _browser() as browser:
+        browser.open(html)
+        hidden = (imread(browser.screenshot(tmp_path / "hidden.png"))[:, :, :3] * 255).round()
+        assert browser.eval(toggle) == [False, True]
+        browser.eval(
+            "new Promise(function(r){requestAnimationFrame(function(){setTimeout(r,200)})})"
+        )
+        shown = (imread(browser.screenshot(tmp_path / "surface.png"))[:, :, :3] * 255).round()
+
+    # Half-transparent blue over white and grey: a bluish patch appears.
+    def bluish(px: np.ndarray) -> int:
+        r, g, bl = px[..., 0], px[..., 1], px[..., 2]
+        return int(np.sum((bl > r + 40) & (bl > g + 15) & (r < 200)))
+
+    assert bluish(_plot_area(shown)) > bluish(_plot_area(hidden)) + 2000, (
+        bluish(_plot_area(hidden)),
+        bluish(_plot_area(shown)),
+    )
+
+
+def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
+    # A dense wall of 200 000 points with p = 0 and a patch of 400 with p > 0.
+    rng = np.random.default_rng(5)
+    wall = np.column_stack(
+        [rng.uniform(0, 1, 200_000), rng.uniform(0, 1, 200_000), np.zeros(200_000)]
+    )
+    prob = np.zeros(len(wall), dtype=np.float32)
+    prob[:400] = rng.uniform(0.01, 1.0, 400)
+    layer = view.PointLayer("wall", wall.astype(np.float32), prob, view.SIDE_COLORS[1])
+    scene = view.Scene("wall", points=[layer])
+    cell = scene.extent() / view.QUIET_CELLS
+    shown = view._quiet_shown(layer, scene.quiet_below, cell)
+    # Every shown point is quiet, one in each cell that holds quiet points.
+    quiet = np.flatnonzero(prob < scene.quiet_below)
+    pts = layer.points.astype(np.float64)
+    cells = np.floor((pts - pts[quiet].min(axis=0)) / cell).astype(int)
+    assert np.all(prob[shown] < scene.quiet_below)
+    assert len(np.unique(cells[shown], axis=0)) == len(shown)
+    assert len(np.unique(cells[quiet], axis=0)) == len(shown)
+    assert 0.5 * view.QUIET_CELLS**2 < len(shown) < 0.6 * len(wall)
+    # The points of a contact region are drawn even where the cell has another.
+    dropped = np.setdiff1d(quiet, shown)[:50]
+    with_contact = view.PointLayer(
+        "wall", layer.points, prob, layer.color, contact=np.concatenate([dropped, [3]])
+    )
+    kept = view._quiet_shown(with_contact, scene.quiet_below, cell)
+    assert len(kept) == len(shown) + 50 and np.all(np.isin(dropped, kept)) and 3 not in kept
+    objects = {o.name: o for o in view.to_k3d(scene).objects}
+    assert f"wall: {len(shown)} of {len(wall) - 400} points with p < 0.001" in objects
+    assert len(objects["wall: 400 with p ≥ 0.001"].positions) == 400
+    legend = objects["legend"].text
+    assert f"{len(shown)} of {len(wall) - 400} points with p &lt; 0.001 drawn" in legend
+    everything = {o.name for o in view.to_k3d(scene, all_points=True).objects}
+    assert f"wall: {len(wall) - 400} of {len(wall) - 400} points with p < 0.001" in everything
+    # The plotly figure thins the same way on request.
+    fig = view.to_figure(scene, all_points=False)
+    assert len(fig.data[1].x) == len(shown)
+
+
+def test_plotly_renderer_still_draws(tmp_path, spheres_near) -> None:
+    a, b, pose_b = spheres_near
+    result = cp.collide(a, b, pose_b=pose_b)
+    html = view.write_html(view.collision_scene(result), tmp_path / "p.html", renderer="plotly")
+    text = html.read_text()
+    assert "Plotly.newPlot" in text and len(text) > 3_000_000
+    assert not external_scripts(text)
+    pixels = screenshot(html, tmp_path / "plotly.png")
+    h, w = pixels.shape[:2]
+    area = pixels[int(0.40 * h) : int(0.95 * h), int(0.05 * w) : int(0.86 * w)]
+    assert hot(area) > 100 and cold(area) > 30
+    with pytest.raises(ValueError, match="renderer must be"):
+        view.write_html(view.collision_scene(result), tmp_path / "x.html", renderer="vtk")
 
 
 def test_scene_of_a_result(spheres_near) -> None:
@@ -186,7 +369,7 @@ def test_show_writes_and_opens(tmp_path, spheres_near, monkeypatch) -> None:
     monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url) or True)
     result = cp.collide(a, b, pose_b=pose_b)
     path = result.show(tmp_path / "shown.html", labels=("one", "two"))
-    assert path == tmp_path / "shown.html" and path.stat().st_size > 3_000_000
+    assert path == tmp_path / "shown.html" and path.stat().st_size > 2_000_000
     assert opened == [path.resolve().as_uri()]
     assert "one vs two" in path.read_text()
     quiet = result.show(open_browser=False)
@@ -282,9 +465,10 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
     code, out, err = run(capsys, *argv, "--html", str(html), "--rerun", str(rrd), "--json")
     assert code == 0, err
     assert '"state": "collision"' in out and str(html.resolve()) in err.replace("\n", "")
-    assert 3_000_000 < html.stat().st_size < 10_000_000 and rrd.stat().st_size > 0
+    assert 2_000_000 < html.stat().st_size < 10_000_000 and rrd.stat().st_size > 0
     # The mesh side is drawn as a mesh, with its samples coloured.
-    assert '"type":"mesh3d"' in html.read_text()
+    types = [o["type"] for o in _k3d_objects(html.read_text())]
+    assert "Mesh" in types and "Points" in types
 
     opened: list[str] = []
     import webbrowser
@@ -300,6 +484,22 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
             capsys, "view", *argv[1:], "--html", str(tmp_path / "w.html"), "--no-open"
         )
         assert code == 0 and len(opened) == 1
+        # --all-points: every quiet point of the scan drawn ("N of N").
+        code, out, err = run(
+            capsys,
+            "view",
+            *argv[1:],
+            "--html",
+            str(tmp_path / "all.html"),
+            "--no-open",
+            "--all-points",
+        )
+        assert code == 0, err
+        counts = [
+            re.match(r".+: (\d+) of (\d+) points", str(o["name"]))
+            for o in _k3d_objects((tmp_path / "all.html").read_text())
+        ]
+        assert [m.group(1) == m.group(2) for m in counts if m] == [True]
     finally:
         webbrowser.open = orig  # type: ignore[assignment]
 
@@ -317,7 +517,8 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
         str(robot_html),
     )
     assert code == 0, err
-    assert "link2" in robot_html.read_text()
+    names = [o["name"] for o in _k3d_objects(robot_html.read_text())]
+    assert "link2" in names
 
 
 @pytest.mark.parametrize(
@@ -374,4 +575,4 @@ def test_readme_view_line(tmp_path) -> None:
         "\n", ""
     )
     text = html.read_text()
-    assert not re.search(r"<script[^>]*\bsrc=", text) and "state: collision" in text
+    assert not external_scripts(text) and "state: collision" in text

@@ -301,7 +301,7 @@ def _check_view_arguments(args: argparse.Namespace) -> None:
         parent = Path(path).resolve().parent
         if not parent.is_dir():
             raise CliError(f"{flag} {path}: no such folder {parent}")
-    modules = [("--html", args.html, "plotly", "view"), ("--rerun", args.rerun, "rerun", "rerun")]
+    modules = [("--html", args.html, "k3d", "view"), ("--rerun", args.rerun, "rerun", "rerun")]
     for flag, path, module, extra in modules:
         if path is None:
             continue
@@ -320,7 +320,9 @@ def _write_views(args: argparse.Namespace, make_scene: Any) -> None:
     scene = make_scene()
     console = _console(stderr=bool(getattr(args, "json", False)))
     if args.html is not None:
-        path = view.write_html(scene, args.html)
+        path = view.write_html(
+            scene, args.html, all_points=bool(getattr(args, "all_points", False))
+        )
         size = path.stat().st_size / 1e6
         console.print(f"view written to {path.resolve()} ({size:.1f} MB; open it in a browser)")
     if args.rerun is not None:
@@ -899,7 +901,13 @@ def _add_view_arguments(parser: argparse.ArgumentParser) -> None:
         default=5,
         metavar="N",
         help="separating surfaces of the N most probable regions in the view, hidden until "
-        "clicked in the legend (default: %(default)s)",
+        "shown in the view's panel (default: %(default)s)",
+    )
+    group.add_argument(
+        "--all-points",
+        action="store_true",
+        help="draw every point with p < 1e-3 in the HTML view too (by default they are thinned "
+        "to the density a screen shows of the whole scene; the legend says how many)",
     )
 
 

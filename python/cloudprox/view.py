@@ -3,11 +3,16 @@
 A view holds both sides of a query (clouds, or a mesh and a cloud, or a robot at
 its configuration and a scene), every point coloured by its collision probability
 on a colour bar, the contact regions with their normals and separations, and the
-separating surface of the most probable regions (hidden until clicked in the
-legend). The HTML file embeds plotly.js: it opens without a server or the
-internet; turn, zoom, and hover a point for its probability.
+separating surface of the most probable regions (hidden at first). The HTML file
+(:func:`write_html`) is drawn by k3d (three.js, its JavaScript inlined: it opens
+without a server or the internet, fast even without a GPU: every point is one
+WebGL point); turn, zoom, and hover a point for its probability. The points
+below ``quiet_below`` are thinned to the density a screen shows of the whole
+scene unless ``all_points``. :func:`to_figure` makes the same scene a plotly
+figure (``write_html(..., renderer="plotly")``).
 
-plotly is the optional extra ``cloudprox[view]``, rerun-sdk ``cloudprox[rerun]``.
+k3d and plotly are the optional extra ``cloudprox[view]``, rerun-sdk
+``cloudprox[rerun]``.
 
 Examples
 --------
@@ -22,9 +27,14 @@ Examples
 
 from __future__ import annotations
 
+import base64
+import html
+import json
 import math
+import re
 import tempfile
 import webbrowser
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,10 +54,12 @@ __all__ = [
     "RegionMark",
     "Scene",
     "collision_scene",
+    "k3d_page",
     "robot_scene",
     "separating_surface",
     "show",
     "to_figure",
+    "to_k3d",
     "write_html",
     "write_rerun",
 ]
@@ -89,6 +101,8 @@ class PointLayer:
     show_quiet : bool
         Whether the points below ``quiet_below`` are drawn (a mesh side's samples
         are not: the mesh is).
+    contact : ndarray of int
+        Indices of the points in a contact region: drawn even when thinned.
     """
 
     name: str
@@ -96,6 +110,7 @@ class PointLayer:
     probabilities: np.ndarray
     color: str
     show_quiet: bool = True
+    contact: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 @dataclass(frozen=True)
@@ -264,6 +279,13 @@ def _region_marks(
     return marks
 
 
+def _contact_indices(regions: Sequence[ContactRegion], side: str, n: int) -> np.ndarray:
+    """Collect the indices (sorted, unique, < n) of one side's points in ``regions``."""
+    parts = [np.asarray(getattr(r, f"indices_{side}"), dtype=np.int64) for r in regions]
+    idx = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+    return idx[(idx >= 0) & (idx < n)]
+
+
 def _side_points(
     which: str,
     obj: Any,
@@ -375,6 +397,7 @@ def collision_scene(
                 probabilities=np.nan_to_num(prob[k]).astype(np.float32),
                 color=SIDE_COLORS[k],
                 show_quiet=not is_mesh,
+                contact=_contact_indices(result.regions, "ab"[k], len(prob[k])),
             )
         )
     head = f"{title}<br>" if title else ""
@@ -470,6 +493,7 @@ def robot_scene(
             points=np.asarray(cloud.points, dtype=np.float32),
             probabilities=worst.astype(np.float32),
             color=SIDE_COLORS[1],
+            contact=_contact_indices([r for _, r in result.regions], "b", n),
         )
     ]
     selfc = (
@@ -531,8 +555,16 @@ def _focus(scene: Scene) -> tuple[np.ndarray, float] | None:
     return (lo + hi) / 2.0, max(float((hi - lo).max()), 0.02 * scene.extent())
 
 
-def to_figure(scene: Scene) -> Any:
-    """Build the plotly figure of a scene (needs ``cloudprox[view]``).
+def to_figure(scene: Scene, *, all_points: bool = True) -> Any:
+    """Build the plotly figure of a scene (needs ``plotly``, in ``cloudprox[view]``).
+
+    Parameters
+    ----------
+    scene : Scene
+        From :func:`collision_scene` or :func:`robot_scene`.
+    all_points : bool, default True
+        Draw every point with ``p < quiet_below``; else thin them as
+        :func:`to_k3d` does.
 
     Returns
     -------
@@ -541,6 +573,7 @@ def to_figure(scene: Scene) -> Any:
     go = _need("plotly.graph_objects", "view")
     fig = go.Figure()
     extent = scene.extent()
+    cell = extent / QUIET_CELLS
     focus = _focus(scene)
     colorbar = {
         "title": {"text": "collision<br>probability p", "side": "top"},
@@ -575,17 +608,19 @@ def to_figure(scene: Scene) -> Any:
     for layer in scene.points:
         pts, prob = layer.points, layer.probabilities
         quiet = prob < scene.quiet_below
-        if layer.show_quiet and np.any(quiet):
-            q = pts[quiet]
+        shown = _quiet_shown(layer, scene.quiet_below, None if all_points else cell)
+        if layer.show_quiet and len(shown):
+            q = pts[shown]
+            count = f"{len(pts)}" if len(shown) == np.sum(quiet) else f"{len(shown)} of {len(pts)}"
             fig.add_trace(
                 go.Scatter3d(
                     x=q[:, 0],
                     y=q[:, 1],
                     z=q[:, 2],
                     mode="markers",
-                    name=f"{layer.name}: {len(pts)} points",
+                    name=f"{layer.name}: {count} points",
                     marker={"size": 1.5, "color": layer.color},
-                    customdata=prob[quiet],
+                    customdata=prob[shown],
                     hovertemplate=_hover(layer.name),
                 )
             )
@@ -732,12 +767,23 @@ def to_figure(scene: Scene) -> Any:
     return fig
 
 
-def write_html(scene: Scene, path: str | Path) -> Path:
-    """Write the scene as one self-contained HTML file (plotly.js embedded).
+def write_html(
+    scene: Scene,
+    path: str | Path,
+    *,
+    renderer: str = "k3d",
+    all_points: bool = False,
+) -> Path:
+    """Write the scene as one self-contained HTML file (its renderer embedded).
 
     The file opens in a browser without a server or the internet: turn with the
-    left button, zoom with the wheel, hover a point for its probability; click a
-    legend entry to show or hide it (the separating surfaces start hidden).
+    left button, zoom with the wheel, hover a point for its probability.
+
+    ``renderer="k3d"`` (the default) draws with three.js (k3d): every point is
+    one WebGL point, so it opens fast even without a GPU; the K3D panel's Objects
+    folder shows and hides each part (the separating surfaces start hidden).
+    ``renderer="plotly"`` writes :func:`to_figure` (plotly.js embedded, axes with
+    ticks, a clickable legend), several times slower to open with many points.
 
     Parameters
     ----------
@@ -745,21 +791,512 @@ def write_html(scene: Scene, path: str | Path) -> Path:
         From :func:`collision_scene` or :func:`robot_scene`.
     path : str or Path
         The file to write.
+    renderer : {"k3d", "plotly"}, default "k3d"
+        Which library draws the scene.
+    all_points : bool, default False
+        Draw every point with ``p < quiet_below`` too, instead of one a cell of
+        the density the screen shows of the whole scene (the legend says how
+        many are drawn); points with ``p >= quiet_below`` are always all drawn.
 
     Returns
     -------
     Path
         ``path``.
     """
-    fig = to_figure(scene)
     path = Path(path)
-    fig.write_html(
-        str(path),
-        include_plotlyjs=True,
-        full_html=True,
-        config={"displaylogo": False, "responsive": True},
-    )
+    if renderer == "k3d":
+        path.write_text(
+            k3d_page(to_k3d(scene, all_points=all_points), scene.title), encoding="utf-8"
+        )
+    elif renderer == "plotly":
+        fig = to_figure(scene, all_points=all_points)
+        fig.write_html(
+            str(path),
+            include_plotlyjs=True,
+            full_html=True,
+            config={"displaylogo": False, "responsive": True},
+            post_script=_PLOTLY_DRAWN,
+        )
+    else:
+        raise ValueError(f"renderer must be 'k3d' or 'plotly', got {renderer!r}")
     return path
+
+
+_PLOTLY_DRAWN = (
+    "requestAnimationFrame(function(){requestAnimationFrame(function(){"
+    "window.cloudproxDrawn=performance.now()})})"
+)
+
+
+# --------------------------------------------------------------------------- k3d
+
+#: Quiet points are thinned to one a cubic cell of ``extent / QUIET_CELLS``: the
+#: size of one drawn quiet point (2 pixels) when the whole scene fills a view
+#: about 800 pixels across.
+QUIET_CELLS = 400
+#: Pixel sizes of the drawn points (below and above ``quiet_below``, regions).
+POINT_PIXELS = (2.0, 5.0, 11.0)
+#: How many contact regions (the most probable) carry a text label in the view.
+REGION_LABELS = 3
+
+
+def _quiet_shown(layer: PointLayer, quiet_below: float, cell: float | None) -> np.ndarray:
+    """Pick the quiet points drawn: all, or one a cell of side ``cell`` (indices).
+
+    The first point (in the layer's order) of each occupied cell is kept, so the
+    choice is deterministic and the drawn density is at most one a cell; the
+    points of the contact regions (``layer.contact``) are kept besides.
+    """
+    is_quiet = np.asarray(layer.probabilities) < quiet_below
+    quiet = np.flatnonzero(is_quiet)
+    if cell is None or not len(quiet):
+        return quiet
+    pts = np.asarray(layer.points, dtype=np.float64)[quiet]
+    ok = np.all(np.isfinite(pts), axis=1)
+    if not np.any(ok):
+        return quiet[:0]
+    key = np.floor((pts[ok] - pts[ok].min(axis=0)) / cell).astype(np.int64)
+    span = key.max(axis=0) + 1
+    flat = (key[:, 0] * span[1] + key[:, 1]) * span[2] + key[:, 2]
+    _, first = np.unique(flat, return_index=True)
+    contact = np.asarray(layer.contact, dtype=np.int64)
+    contact = contact[(contact >= 0) & (contact < len(is_quiet))]
+    return np.union1d(quiet[ok][first], contact[is_quiet[contact]])
+
+
+def _packed(color: str) -> int:
+    return int(color.lstrip("#"), 16)
+
+
+def _plasma_packed(p: float) -> int:
+    r, g, b = (int(x) for x in _rgb(np.array([p]))[0])
+    return (r << 16) | (g << 8) | b
+
+
+def _flat_map(color: str) -> list[float]:
+    """Make a k3d colour map of one colour (the probabilities ride along as the attribute)."""
+    r, g, b = (float(x) / 255.0 for x in _hex_rgb(color))
+    return [0.0, r, g, b, 1.0, r, g, b]
+
+
+def _k3d_camera(scene: Scene, lo: np.ndarray, hi: np.ndarray, fov: float) -> list[float]:
+    """Look at the contact from the (1, 1, 1) direction, as :func:`to_figure` does."""
+    size = float((hi - lo).max())
+    focus = _focus(scene)
+    if focus is None:
+        centre, distance = (lo + hi) / 2.0, 2.165 * size
+    else:
+        centre = focus[0]
+        distance = 2.165 * size * min(1.0, max(2.0 * focus[1] / size, 0.12))
+    # plotly's camera sees 45 degrees vertically, k3d's ``fov``.
+    distance *= math.tan(math.radians(22.5)) / math.tan(math.radians(fov / 2.0))
+    eye = centre + distance * np.full(3, 1.0 / math.sqrt(3.0))
+    return [*eye.tolist(), *centre.tolist(), 0.0, 0.0, 1.0]
+
+
+_K3D_JS = r"""
+(function () {
+  var info = __INFO__;
+  var k3d = K3DInstance, world = k3d.getWorld(), target = world.targetDOMNode;
+  window.cloudproxK3D = k3d;
+  function fmt(v) { return Number(v.toPrecision(4)).toString(); }
+  var tip = document.createElement('div');
+  tip.id = 'cloudprox-hover';
+  tip.style.cssText = 'position:absolute;display:none;pointer-events:none;z-index:30;' +
+    'background:rgba(255,255,255,0.93);border:1px solid #777;border-radius:3px;' +
+    'padding:3px 6px;font:12px sans-serif;color:#222;white-space:nowrap';
+  target.appendChild(tip);
+  var bar = document.createElement('div');
+  bar.id = 'cloudprox-colorbar-title';
+  bar.innerHTML = 'collision<br>probability p';
+  bar.style.cssText = 'position:absolute;left:12px;bottom:230px;z-index:20;' +
+    'pointer-events:none;font:13px sans-serif;color:#333';
+  target.appendChild(bar);
+  // Above k3d's colour bar (an SVG bottom left, its height a share of the view's).
+  function placeBarTitle() {
+    var rects = target.querySelectorAll('svg rect'), t = target.getBoundingClientRect();
+    for (var k = 0; k < rects.length; k++) {
+      var r = rects[k].getBoundingClientRect();
+      if (r.left - t.left < 100 && r.height > 50) {
+        bar.style.bottom = (t.bottom - r.top + 16) + 'px';
+        return;
+      }
+    }
+  }
+  k3d.on(k3d.events.RESIZED, placeBarTitle);
+  var mouse = {x: 0, y: 0}, hit = false, onRegion = false;
+  function show(html, name, index) {
+    tip.innerHTML = html;
+    tip.style.left = (mouse.x + 14) + 'px';
+    tip.style.top = (mouse.y + 14) + 'px';
+    tip.style.display = 'block';
+    hit = true;
+    window.cloudproxHovered = {name: name, index: index, html: html};
+  }
+  // The region markers win over the points around them: the nearest one within
+  // 9 pixels of the pointer, found on the screen.
+  function region() {
+    var r = info.__regions__;
+    if (!r) return false;
+    var V = world.camera.position.constructor, best = -1, bestD = 81;
+    var w = target.clientWidth, h = target.clientHeight;
+    for (var k = 0; k < r.points.length; k++) {
+      var v = new V(r.points[k][0], r.points[k][1], r.points[k][2]).project(world.camera);
+      if (v.z < -1 || v.z > 1) continue;
+      var dx = (v.x + 1) / 2 * w - mouse.x, dy = (1 - v.y) / 2 * h - mouse.y;
+      if (dx * dx + dy * dy < bestD) { bestD = dx * dx + dy * dy; best = k; }
+    }
+    if (best < 0) return false;
+    show(r.texts[best], r.name, best);
+    return true;
+  }
+  // Capture: runs before k3d's own pointermove (which casts the ray, then fires
+  // OBJECT_HOVERED and MOUSE_MOVE).
+  target.addEventListener('pointermove', function (e) {
+    var r = target.getBoundingClientRect();
+    mouse.x = e.clientX - r.left; mouse.y = e.clientY - r.top; hit = false;
+    onRegion = region();
+  }, true);
+  k3d.on(k3d.events.OBJECT_HOVERED, function (e) {
+    var json = world.ObjectsListJson[e.K3DIdentifier];
+    var entry = json && info[json.name];
+    if (!entry || onRegion) return;
+    var html = entry.text;
+    if (entry.texts) {
+      html = entry.texts[e.index];
+    } else if (entry.side) {
+      var i = e.index, xyz = json.positions.data;
+      html = '<b>' + entry.side + '</b><br>p = ' + fmt(json.attribute.data[i]) + '<br>(' +
+        [xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]].map(function (v) {
+          return v.toFixed(4);
+        }).join(', ') + ')';
+    }
+    if (html !== undefined) show(html, json.name, e.index);
+  });
+  k3d.on(k3d.events.MOUSE_MOVE, function () { if (!hit) tip.style.display = 'none'; });
+  k3d.on(k3d.events.MOUSE_LEAVE, function () { tip.style.display = 'none'; });
+  // Drawn: two frames after the scene was loaded and rendered (the frame is on
+  // screen); the benches and tests wait for this.
+  requestAnimationFrame(function () {
+    placeBarTitle();
+    requestAnimationFrame(function () { window.cloudproxDrawn = performance.now(); });
+  });
+})();
+"""
+
+
+def _hover_texts(scene: Scene) -> list[str]:
+    return [
+        f"<b>{r.label}</b><br>P = {r.probability:.4g}<br>separation "
+        f"{1e3 * r.separation:+.2f} mm<br>normal ({r.normal[0]:+.3f}, "
+        f"{r.normal[1]:+.3f}, {r.normal[2]:+.3f})<br>points {r.points[0]} + {r.points[1]}"
+        for r in scene.regions
+    ]
+
+
+def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
+    """Build the k3d plot of a scene (needs ``cloudprox[view]``).
+
+    Every point with ``p >= quiet_below`` is drawn, coloured on the plasma scale
+    and larger; the others in their side's colour, thinned (unless
+    ``all_points``) to one a cell of ``extent / QUIET_CELLS`` (the density a
+    screen shows of the whole scene), the points of contact regions kept; the
+    legend says how many are drawn. The
+    contact regions are red markers with their normals (hover a marker for P,
+    separation, normal), the separating surfaces start hidden (the panel's
+    Objects folder shows them), mesh sides and robot links are surfaces.
+
+    Parameters
+    ----------
+    scene : Scene
+        From :func:`collision_scene` or :func:`robot_scene`.
+    all_points : bool, default False
+        Draw every quiet point too.
+
+    Returns
+    -------
+    k3d.plot.Plot
+        :func:`k3d_page` makes it the HTML that :func:`write_html` writes.
+    """
+    k3d = _need("k3d", "view")
+    extent = scene.extent()
+    lo, hi = _bounds(scene)
+    pad = 0.02 * float((hi - lo).max()) + 1e-9
+    lo, hi = lo - pad, hi + pad
+    fov = 45.0
+    plot = k3d.plot(
+        antialias=0,  # multisampling doubles the time software WebGL takes to draw
+        camera_auto_fit=False,
+        grid_auto_fit=False,
+        grid=(*lo.tolist(), *hi.tolist()),
+        grid_color=0xD0D0D0,
+        background_color=0xFFFFFF,
+        camera_fov=fov,
+        menu_visibility=True,
+        mode="callback",  # hovering an object fires OBJECT_HOVERED (the tooltips)
+        axes=["x (m)", "y (m)", "z (m)"],
+    )
+    plot.camera = _k3d_camera(scene, lo, hi, fov)
+
+    def hovered(*_: Any) -> None:  # marks an object as hoverable in the browser
+        return None
+
+    info: dict[str, dict[str, Any]] = {}
+    bar_id = -1
+    legend = [f"<b>{scene.title}</b>"]
+    cell = None if all_points else extent / QUIET_CELLS
+    for layer in scene.points:
+        pts = np.asarray(layer.points, dtype=np.float32)
+        prob = np.asarray(layer.probabilities, dtype=np.float32)
+        if layer.show_quiet:
+            shown = _quiet_shown(layer, scene.quiet_below, cell)
+            total = int(np.sum(prob < scene.quiet_below))
+            if len(shown):
+                name = (
+                    f"{layer.name}: {len(shown)} of {total} points with p < {scene.quiet_below:g}"
+                )
+                plot += k3d.points(
+                    pts[shown],
+                    attribute=prob[shown],
+                    color_map=_flat_map(layer.color),
+                    color_range=[0.0, 1.0],
+                    shader="dot",
+                    point_size=POINT_PIXELS[0],
+                    name=name,
+                    hover_callback=hovered,
+                )
+                info[name] = {"side": layer.name}
+            thinned = ""
+            if cell is not None and len(shown) < total:
+                thinned = f" (one a {1e3 * cell:.2g} mm cell)"
+            legend.append(
+                f"<span style='color:{layer.color}'>&#9632;</span> {layer.name}: "
+                f"{len(shown)} of {total} points with p &lt; {scene.quiet_below:g} drawn{thinned}"
+            )
+        loud = np.flatnonzero(prob >= scene.quiet_below)
+        loud = loud[np.argsort(prob[loud], kind="stable")]
+        if len(loud):
+            name = f"{layer.name}: {len(loud)} with p ≥ {scene.quiet_below:g}"
+            obj = k3d.points(
+                pts[loud],
+                attribute=prob[loud],
+                color_map=k3d.colormaps.matplotlib_color_maps.plasma,
+                color_range=[0.0, 1.0],
+                shader="dot",
+                point_size=POINT_PIXELS[1],
+                name=name,
+                hover_callback=hovered,
+            )
+            plot += obj
+            bar_id = obj.id if bar_id < 0 else bar_id
+            info[name] = {"side": layer.name}
+        legend.append(f"{layer.name}: {len(loud)} points with p ≥ {scene.quiet_below:g}, all drawn")
+    for m in scene.meshes:
+        color = m.color if m.probability is None else f"#{_plasma_packed(m.probability):06x}"
+        plot += k3d.mesh(
+            np.asarray(m.vertices, dtype=np.float32),
+            np.asarray(m.faces, dtype=np.uint32),
+            color=_packed(color),
+            opacity=m.opacity,
+            flat_shading=True,
+            side="double",
+            name=m.name,
+            hover_callback=hovered,
+        )
+        info[m.name] = {"text": m.hover or m.name}
+    marks = [
+        r for r in scene.regions if np.all(np.isfinite(r.point)) and np.all(np.isfinite(r.normal))
+    ]
+    if marks:
+        focus = _focus(scene)
+        length = 0.08 * extent if focus is None else max(0.4 * focus[1], 0.005 * extent)
+        name = f"contact regions ({len(marks)})"
+        plot += k3d.points(
+            np.array([r.point for r in marks], dtype=np.float32),
+            color=_packed(REGION_COLOR),
+            shader="dot",
+            point_size=POINT_PIXELS[2],
+            name=name,
+            hover_callback=hovered,
+        )
+        info[name] = {"texts": _hover_texts(Scene(scene.title, regions=marks))}
+        info["__regions__"] = {
+            "name": name,
+            "points": [r.point.tolist() for r in marks],
+            "texts": info[name]["texts"],
+        }
+        plot += k3d.vectors(
+            np.array([r.point for r in marks], dtype=np.float32),
+            np.array([length * r.normal for r in marks], dtype=np.float32),
+            color=_packed(REGION_COLOR),
+            head_size=length,  # k3d's arrow head: a cone 0.2 head_size long
+            line_width=0.06 * length,
+            name="region normals (A → B)",
+        )
+        # The most probable regions carry a label (all of them a hover text).
+        for r in sorted(marks, key=lambda r: -r.probability)[:REGION_LABELS]:
+            plot += k3d.label(
+                f"{r.label}: P = {r.probability:.3g}, {1e3 * r.separation:+.2f} mm",
+                position=(r.point + length * r.normal).astype(np.float32),
+                color=_packed(REGION_COLOR),
+                is_html=True,
+                size=0.8,
+                mode="local",
+                name=f"label of {r.label}",
+            )
+        legend.append(
+            f"<span style='color:{REGION_COLOR}'>&#9670;</span> {len(marks)} contact regions "
+            "with normals (A → B) and separations: hover a marker"
+        )
+    for r in scene.regions:
+        if r.surface is None:
+            continue
+        v, f = r.surface
+        name = f"separating surface, {r.label} (P = {r.probability:.3g})"
+        plot += k3d.mesh(
+            np.asarray(v, dtype=np.float32),
+            np.asarray(f, dtype=np.uint32),
+            color=0x1F77B4,
+            opacity=0.5,
+            side="double",
+            visible=False,
+            name=name,
+            hover_callback=hovered,
+        )
+        info[name] = {"text": f"separating surface of {r.label}"}
+    if any(r.surface is not None for r in scene.regions):
+        legend.append("separating surfaces: K3D panel, Objects (hidden at first)")
+    if bar_id < 0:
+        # The colour bar shows one object's map: with no loud point, a carrier
+        # of two points drawn fully transparent.
+        obj = k3d.points(
+            np.repeat(lo[None].astype(np.float32), 2, axis=0),
+            attribute=np.array([0.0, 1.0], dtype=np.float32),
+            color_map=k3d.colormaps.matplotlib_color_maps.plasma,
+            color_range=[0.0, 1.0],
+            shader="dot",
+            point_size=1.0,
+            opacity=0.0,
+            name="colour bar",
+        )
+        plot += obj
+        bar_id = obj.id
+    plot.colorbar_object_id = bar_id
+    plot += k3d.text2d(
+        "<br>".join(legend),
+        position=(0.005, 0.005),
+        reference_point="lt",
+        is_html=True,
+        size=0.8,
+        color=0x333333,
+        label_box=True,
+        name="legend",
+    )
+    plot.additional_js_code = _K3D_JS.replace("__INFO__", json.dumps(info).replace("</", "<\\/"))
+    return plot
+
+
+_K3D_PAGE = """<!DOCTYPE html>
+<html>
+<head>
+<meta charset="utf-8">
+<title>__TITLE__</title>
+<style>
+html, body { margin: 0; padding: 0; overflow: hidden; background: #ffffff; }
+#canvasTarget { width: 100%; height: 100%; position: absolute; }
+</style>
+</head>
+<body>
+<div id="canvasTarget"></div>
+<script>
+// k3d's bundle registers itself with an AMD define("k3d", [], factory).
+var cloudproxK3DLib = null;
+function define(name, deps, factory) { cloudproxK3DLib = factory(); }
+</script>
+<script>__K3D_JS__</script>
+<script>
+var K3DInstance = (function () {
+  var lib = cloudproxK3DLib;
+  var text = atob("__DATA__"), bytes = new Uint8Array(text.length);
+  for (var i = 0; i < text.length; i++) bytes[i] = text.charCodeAt(i);
+  var snapshot = lib.msgpackDecode(bytes);
+  var k3d = new lib.K3D(lib.ThreeJsProvider, document.getElementById('canvasTarget'),
+                        Object.assign({}, snapshot.plot, {standaloneGUI: true}));
+  // One draw an animation frame: k3d asks for a draw on every object loaded and
+  // every setting applied, and with many points each costs a lot in software WebGL.
+  var world = k3d.getWorld(), draw = world.render, queued = null, forced = false;
+  world.render = function (force) {
+    forced = forced || !!force;
+    if (queued === null) {
+      queued = new Promise(function (resolve) {
+        requestAnimationFrame(function () {
+          var f = forced;
+          queued = null;
+          forced = false;
+          resolve(draw.call(world, f));
+        });
+      });
+    }
+    return queued;
+  };
+  return k3d.setSnapshot(snapshot).then(function () {
+    if (snapshot.plot.camera.length > 0) k3d.setCamera(snapshot.plot.camera);
+    k3d.render();
+    return k3d;
+  });
+})();
+K3DInstance.then(function (K3DInstance) {
+__ADDITIONAL__
+});
+</script>
+</body>
+</html>
+"""
+
+
+def k3d_page(plot: Any, title: str = "cloudprox view") -> str:
+    """Write a k3d plot as one self-contained HTML page (k3d's JavaScript inlined).
+
+    k3d's own ``plot.get_snapshot()`` ships its 2.6 MB bundle zlib-compressed in
+    base64 and runs it through ``eval`` and require.js; here it is a plain script
+    (parsed as the page loads), the plot's data plain msgpack in base64, and k3d
+    draws at most once an animation frame while the scene loads (it asks for a
+    draw on every object and setting, each one costly in software WebGL). The
+    plot's ``additional_js_code`` runs once it is loaded, with ``K3DInstance``.
+
+    Parameters
+    ----------
+    plot : k3d.plot.Plot
+        The plot (from :func:`to_k3d`, or any).
+    title : str
+        The page's title (``<br>`` becomes " | ").
+
+    Returns
+    -------
+    str
+        The HTML text.
+    """
+    k3d = _need("k3d", "view")
+    source = Path(k3d.__file__).parent / "static" / "standalone.js"
+    code = source.read_text(encoding="utf-8") if source.is_file() else ""
+    if not code.lstrip().split("*/", 1)[-1].lstrip().startswith('define("k3d"') or re.search(
+        r"</script|<!--", code, re.IGNORECASE
+    ):
+        # Another k3d layout: its own page, which embeds the same.
+        page: str = plot.get_snapshot()
+        return re.sub(
+            r"<title>.*?</title>",
+            lambda _: f"<title>{html.escape(title.replace('<br>', ' | '))}</title>",
+            page,
+            count=1,
+        )
+    data = zlib.decompress(plot.get_binary_snapshot(compression_level=0))
+    return (
+        _K3D_PAGE.replace("__TITLE__", html.escape(title.replace("<br>", " | ")))
+        .replace("__ADDITIONAL__", plot.additional_js_code)
+        .replace("__DATA__", base64.b64encode(data).decode("ascii"))
+        .replace("__K3D_JS__", code)
+    )
 
 
 # ------------------------------------------------------------------------- rerun

@@ -253,29 +253,31 @@ fn moved_points_give_the_elements_of_a_fresh_cloud() {
 }
 
 #[test]
-fn patches_whose_surfaces_cannot_reach_are_pruned_without_a_classifier() {
+fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
     // 1 mm of noise on 3000-point spheres: an element of tens of points locates
     // its surface to a fraction of a millimetre, so a few sigma apart the
-    // points are near (their noise reaches across) but no element faces the
-    // other sphere within the noise's reach of the fitted surfaces.
+    // points are near (their noise reaches across: the points model
+    // classifies them) but no element faces the other sphere within the
+    // noise's reach of the fitted surfaces: the element hulls (or, failing
+    // them, each patch's facing pairs) decide the pair free.
     let (a, b) = spheres(3000);
+    let points = CollisionRequest::builder()
+        .model(QueryModel::Points)
+        .build()
+        .unwrap();
     let mut pruned = 0;
     for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
-        let r = collide(
-            &Pose::identity(),
-            &a,
-            &sphere_pose(gap * SIGMA),
-            &b,
-            &elements(),
-        )
-        .unwrap();
-        if r.stats.patches_beyond_reach == 0 {
+        let pose = sphere_pose(gap * SIGMA);
+        let r = collide(&Pose::identity(), &a, &pose, &b, &elements()).unwrap();
+        if r.stats.points_classified > 0 {
+            continue;
+        }
+        let p = collide(&Pose::identity(), &a, &pose, &b, &points).unwrap();
+        if p.stats.points_classified == 0 {
             continue;
         }
         pruned += 1;
-        assert!(r.stats.near_regions >= 1, "{:?}", r.stats);
         assert!(r.regions.is_empty(), "gap {gap}");
-        assert_eq!(r.stats.points_classified, 0);
         assert_eq!(r.probability, 0.0);
         assert_eq!(r.state, CollisionState::Free);
         assert!(r
@@ -288,4 +290,86 @@ fn patches_whose_surfaces_cannot_reach_are_pruned_without_a_classifier() {
     let near = collide(&Pose::identity(), &a, &sphere_pose(SIGMA), &b, &elements()).unwrap();
     assert_eq!(near.stats.patches_beyond_reach, 0, "{:?}", near.stats);
     assert!(!near.regions.is_empty());
+}
+
+/// Two noisy spheres of `na`, `nb` points (radii `ra`, `rb`, noise `sigma`,
+/// `outliers` points off each surface: single-point elements) whose exact
+/// surfaces are `gap` sigma apart along `dir`, B turned by `rot`.
+#[allow(clippy::too_many_arguments)]
+fn sphere_scene(
+    (na, nb): (usize, usize),
+    (ra, rb): (f64, f64),
+    sigma: f64,
+    outliers: usize,
+    gap: f64,
+    dir: Vector3,
+    rot: Vector3,
+    seed: u64,
+) -> (PointCloud, PointCloud, Pose) {
+    let cloud = |n: usize, r: f64, seed: u64| {
+        let mut pts = add_noise(
+            &cloudprox::sample::sphere(&Point3::origin(), r, n),
+            sigma,
+            seed,
+        );
+        let mut rng = NormalRng::new(seed + 100);
+        for _ in 0..outliers {
+            let d = Vector3::new(rng.normal(), rng.normal(), rng.normal()).normalize();
+            pts.push(Point3::from(d * (r + sigma * 8.0 * (rng.uniform() - 0.5))));
+        }
+        PointCloud::from_sigma(pts, sigma).unwrap()
+    };
+    let (a, b) = (cloud(na, ra, seed), cloud(nb, rb, seed + 1));
+    let pose = Pose::new(dir.normalize() * (ra + rb + gap * sigma), rot);
+    (a, b, pose)
+}
+
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20261124),
+        .. ProptestConfig::default()
+    })]
+
+    /// The hierarchy path (which first bounds the element hulls, then finds
+    /// the near set with the trees) against the brute-force path (every
+    /// sample pair, no hulls): where the hulls say the clouds are free, the
+    /// brute-force query finds no probability either, and the states agree
+    /// wherever either is decisive.
+    #[test]
+    fn element_hierarchy_agrees_with_brute_force(
+        na in 300usize..1500,
+        nb in 300usize..1500,
+        ra in 0.03f64..0.08,
+        rb in 0.03f64..0.08,
+        sigma in 0.0005f64..0.004,
+        outliers in 0usize..6,
+        gap in -3.0f64..14.0,
+        dir in prop::array::uniform3(-1.0f64..1.0).prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01),
+        rot in prop::array::uniform3(-3.0f64..3.0),
+        seed in 0u64..1000,
+    ) {
+        let (a, b, pose_b) = sphere_scene(
+            (na, nb), (ra, rb), sigma, outliers, gap, Vector3::from(dir), Vector3::from(rot), seed,
+        );
+        let brute = CollisionRequest::builder()
+            .model(QueryModel::Elements)
+            .use_hierarchy(false)
+            .build()
+            .unwrap();
+        let h = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
+        let bf = collide(&Pose::identity(), &a, &pose_b, &b, &brute).unwrap();
+        let (ph, pb) = (h.probability, bf.probability);
+        if h.stats.near_regions == 0 {
+            prop_assert_eq!(ph, 0.0);
+            prop_assert!(pb < 1e-9, "hulls apart at gap {} sigma, brute force P = {}", gap, pb);
+        }
+        for (x, y, what) in [(ph, pb, "hierarchy decisive"), (pb, ph, "brute force decisive")] {
+            prop_assert!(!(x <= 0.01 && y > 0.1), "{}: {} vs {} at gap {} sigma", what, x, y, gap);
+            prop_assert!(!(x >= 0.99 && y < 0.9), "{}: {} vs {} at gap {} sigma", what, x, y, gap);
+        }
+    }
 }

@@ -78,27 +78,66 @@ impl Bvh {
     ) -> PairTraversal {
         let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
         let mut out = PairTraversal::default();
-        let stack = &mut workspace.pair_stack;
+        let mut pruned_bound = 0.0;
+        let mut leaf_pairs = Vec::new();
+        out.node_pairs_visited = self.descend_pairs(
+            other,
+            &mut workspace.pair_stack,
+            |ia, ib| {
+                let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
+                let gap = (na.aabb.transformed(pose).distance(&nb.aabb)
+                    - margin(margin_self, ia).max(margin(margin_other, ib)))
+                .max(0.0);
+                let bound = prune_bound(
+                    gap,
+                    na.sigma_max,
+                    nb.sigma_max,
+                    (na.count + nb.count) as usize,
+                );
+                if bound < epsilon {
+                    pruned_bound += bound;
+                    return false;
+                }
+                true
+            },
+            |ia, ib| {
+                leaf_pairs.push((ia, ib));
+                true
+            },
+        );
+        out.leaf_pairs = leaf_pairs;
+        out.pruned_bound = pruned_bound.min(1.0);
+        out
+    }
+
+    /// The bounding volume test tree of `self` and `other`: from the root pair,
+    /// every node pair for which `keep` holds is descended (the node with more
+    /// points first split; both nodes leaves: `leaf` is called), until `leaf`
+    /// returns `false`. Returns the number of node pairs tested. The traversals
+    /// differ only in `keep` (what bounds a node pair) and in what a leaf pair
+    /// does.
+    pub(crate) fn descend_pairs(
+        &self,
+        other: &Bvh,
+        stack: &mut Vec<(u32, u32)>,
+        mut keep: impl FnMut(u32, u32) -> bool,
+        mut leaf: impl FnMut(u32, u32) -> bool,
+    ) -> usize {
+        let mut visited = 0;
         stack.clear();
         stack.push((0, 0));
         while let Some((ia, ib)) = stack.pop() {
-            out.node_pairs_visited += 1;
-            let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
-            let gap = (na.aabb.transformed(pose).distance(&nb.aabb)
-                - margin(margin_self, ia).max(margin(margin_other, ib)))
-            .max(0.0);
-            let bound = prune_bound(
-                gap,
-                na.sigma_max,
-                nb.sigma_max,
-                (na.count + nb.count) as usize,
-            );
-            if bound < epsilon {
-                out.pruned_bound += bound;
+            visited += 1;
+            if !keep(ia, ib) {
                 continue;
             }
+            let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
             match (na.children, nb.children) {
-                (None, None) => out.leaf_pairs.push((ia, ib)),
+                (None, None) => {
+                    if !leaf(ia, ib) {
+                        break;
+                    }
+                }
                 (Some([l, r]), None) => {
                     stack.push((l, ib));
                     stack.push((r, ib));
@@ -118,7 +157,6 @@ impl Bvh {
                 }
             }
         }
-        out.pruned_bound = out.pruned_bound.min(1.0);
-        out
+        visited
     }
 }

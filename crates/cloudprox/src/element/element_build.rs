@@ -105,6 +105,7 @@ impl SurfaceElements {
             indices,
             samples,
             sample_owner,
+            hulls: std::sync::OnceLock::new(),
         })
     }
 }

@@ -1,6 +1,9 @@
 //! The types of the surface-element stage.
 
+use std::sync::OnceLock;
+
 use crate::cloud::PointCloud;
+use crate::element::element_reach::ElementHulls;
 use crate::error::{Error, Result};
 use nalgebra::{SMatrix, SVector};
 
@@ -203,6 +206,8 @@ pub struct SurfaceElements {
     pub(crate) indices: Vec<u32>,
     pub(crate) samples: PointCloud,
     pub(crate) sample_owner: Vec<u32>,
+    /// The elements' hulls and a hierarchy over them, built on first use.
+    pub(crate) hulls: OnceLock<ElementHulls>,
 }
 
 impl SurfaceElements {
@@ -233,6 +238,22 @@ impl SurfaceElements {
     /// The element each sample stands for.
     pub fn sample_owner(&self) -> &[u32] {
         &self.sample_owner
+    }
+
+    /// The elements' hulls and the hierarchy over them ([`ElementHulls`]),
+    /// built on first use.
+    pub(crate) fn hulls(&self) -> &ElementHulls {
+        self.hulls.get_or_init(|| {
+            let n = self.elements.len();
+            let (mut sigma, mut spacing) = (vec![0.0; n], vec![0.0; n]);
+            let s = &self.samples;
+            for (k, &e) in self.sample_owner.iter().enumerate() {
+                let e = e as usize;
+                sigma[e] = Real::max(sigma[e], s.sigma_max()[k].max(s.sensor_sigma_max()[k]));
+                spacing[e] = Real::max(spacing[e], s.spacing()[k]);
+            }
+            ElementHulls::new(&self.elements, &sigma, &spacing)
+        })
     }
 
     /// Number of elements of more than one point.

@@ -46,12 +46,22 @@
 //! ([`SurfaceElement::surface_point`]). In a query it is represented by five
 //! samples of that surface ([`SurfaceElements::samples`]): over its mean and at
 //! the ends of its points' range along each tangent.
+//!
+//! Each element also has a *hull*: its fitted surface at the four corners of
+//! the extent (the surface is a plane over the extent, so it lies in their
+//! convex hull), the largest variance of its height and half its sampling
+//! spacing; a hierarchy over the hulls, built once per cloud, tells a query at
+//! once when no element of one cloud can come within the noise's reach of the
+//! other's, without building near regions (two 10 000-point spheres at 1 mm
+//! of noise, 6 sigma apart: 0.03 ms instead of 0.3-0.4 ms).
 
 mod element_build;
 mod element_fit;
 mod element_merge;
+mod element_reach;
 mod element_samples;
 mod element_types;
 
 pub use element_fit::chi_square_quantile;
+pub(crate) use element_reach::{across_normal, hull_gap, surfaces_may_reach, Hull, HALF_SPACING};
 pub use element_types::{ElementSettings, FootprintPoint, SurfaceElement, SurfaceElements};

@@ -2,22 +2,18 @@
 
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::classify::Separator;
-use crate::element::SurfaceElement;
+use crate::element::{across_normal, hull_gap, Hull, SurfaceElement, HALF_SPACING};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::gaussian::wrong_side;
 use crate::Real;
 
 /// Elements of the other side tried as the facing one (the nearest by mean).
 const FACING_CANDIDATES: usize = 6;
-/// A surface point faces another when their offset across the surface is at
-/// most this many sampling spacings (half a spacing: samples of two touching
-/// surfaces can be that far apart, as in the near rule).
-const FACING_SPACINGS: Real = 0.5;
 
 /// One side's elements of a patch, posed in the separator's frame.
-pub struct ElementSide<'a> {
-    /// The elements.
-    pub elements: Vec<&'a SurfaceElement>,
+pub(crate) struct ElementSide<'a> {
+    /// The elements and their hulls.
+    pub elements: Vec<(&'a SurfaceElement, &'a Hull)>,
     /// Pose of their cloud's frame in the separator's frame.
     pub pose: Pose,
     /// +1 for cloud A, -1 for cloud B.
@@ -27,95 +23,98 @@ pub struct ElementSide<'a> {
 /// An element moved into the separator's frame.
 struct Posed<'a> {
     e: &'a SurfaceElement,
+    hull: &'a Hull,
     mean: Point3,
     tangents: [Vector3; 2],
     normal: Vector3,
     /// The covariance across the normal (the whole covariance for a point).
     across: Matrix3,
-    /// The corners of the fitted surface over the extent (all four the mean
-    /// for a point): every surface point [`Posed::at`] returns lies in their
-    /// convex hull.
+    /// The hull's corners, moved: every surface point [`Posed::at`] returns
+    /// lies in their convex hull.
     corners: [Point3; 4],
-    /// The largest height variance of [`Posed::at`] (reached at a corner: the
-    /// variance is a convex quadratic of the tangential coordinates).
-    var_max: Real,
-    /// The largest distance of a corner from the mean.
-    radius: Real,
 }
 
 impl<'a> Posed<'a> {
-    fn new(e: &'a SurfaceElement, pose: &Pose) -> Self {
+    fn new((e, hull): (&'a SurfaceElement, &'a Hull), pose: &Pose) -> Self {
         let r = pose.rotation.to_rotation_matrix();
         let r = r.matrix();
-        let across = if e.is_point() {
-            e.cov_mean
-        } else {
-            let p = Matrix3::identity() - e.normal * e.normal.transpose();
-            p * e.cov_mean * p
-        };
-        let mut posed = Self {
+        Self {
             e,
+            hull,
             mean: pose * e.mean,
             tangents: [r * e.tangents[0], r * e.tangents[1]],
             normal: r * e.normal,
-            across: r * across * r.transpose(),
-            corners: [Point3::origin(); 4],
-            var_max: 0.0,
-            radius: 0.0,
-        };
-        let [[u0, u1], [v0, v1]] = e.extent;
-        for (k, (u, v)) in [(u0, v0), (u1, v0), (u0, v1), (u1, v1)]
-            .into_iter()
-            .enumerate()
-        {
-            let (x, var) = posed.at(u, v);
-            posed.corners[k] = x;
-            posed.var_max = posed.var_max.max(var);
-            posed.radius = posed.radius.max((x - posed.mean).norm());
+            across: r * across_normal(e) * r.transpose(),
+            corners: hull.corners.map(|c| pose * c),
         }
-        posed
     }
 
     /// A lower bound on the distance between any surface point of `self` and
-    /// any of `other`: the gap between their corners' projections on a few
-    /// axes (the two normals and the line between the means).
+    /// any of `other` ([`hull_gap`]).
     fn distance_bound(&self, other: &Posed<'_>) -> Real {
-        let offset = other.mean - self.mean;
-        let apart = offset.norm();
-        let between = if apart > 0.0 {
-            offset / apart
-        } else {
-            self.normal
-        };
-        let span = |corners: &[Point3; 4], d: &Vector3| {
-            corners
-                .iter()
-                .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), c| {
-                    let t = c.coords.dot(d);
-                    (lo.min(t), hi.max(t))
-                })
-        };
-        [self.normal, other.normal, between]
-            .iter()
-            .map(|d| {
-                let (lo_s, hi_s) = span(&self.corners, d);
-                let (lo_o, hi_o) = span(&other.corners, d);
-                (lo_o - hi_s).max(lo_s - hi_o)
-            })
-            .fold(0.0, Real::max)
+        hull_gap(
+            (&self.mean, &self.normal, &self.corners),
+            (&other.mean, &other.normal, &other.corners),
+        )
     }
 
     /// Whether some facing pair of `self` and `other` could lie within the
     /// noise's reach (`reach_sds` standard deviations, bounded over every
     /// direction, beyond half a spacing); `false` proves that none does.
     fn may_reach(&self, other: &Posed<'_>, reach_sds: Real) -> bool {
-        let allowed = FACING_SPACINGS * self.e.spacing.max(other.e.spacing);
-        let s = (self.var_bound(self.var_max) + other.var_bound(other.var_max)).sqrt();
+        let allowed = HALF_SPACING * self.e.spacing.max(other.e.spacing);
+        let s = (self.var_bound(self.hull.var_max) + other.var_bound(other.hull.var_max)).sqrt();
         let limit = allowed + reach_sds * s;
         // The bounding spheres first (most pairs of a patch are far apart),
         // then the tighter bound.
-        (other.mean - self.mean).norm() - self.radius - other.radius <= limit
+        (other.mean - self.mean).norm() - self.hull.radius - other.hull.radius <= limit
             && self.distance_bound(other) <= limit
+    }
+
+    /// The probe of `self` at tangential coordinates `(u, v)` and the variance
+    /// of its height (the mean, without one, for a single point).
+    fn probe(&self, u: Real, v: Real) -> (Point3, Real) {
+        if self.e.is_point() {
+            (self.mean, 0.0)
+        } else {
+            self.at(u, v)
+        }
+    }
+
+    /// The surface point of `self` straight across from `x` (at `x`'s
+    /// tangential coordinates, clamped to the extent).
+    fn across(&self, x: &Point3) -> Across {
+        let (u, v) = self.coordinates(x);
+        let (y, var_y) = self.at(u, v);
+        let d = y - x;
+        let lateral = if self.e.is_point() {
+            d.norm()
+        } else {
+            (d - self.normal * self.normal.dot(&d)).norm()
+        };
+        Across {
+            u,
+            v,
+            y,
+            var_y,
+            lateral,
+        }
+    }
+
+    /// Whether some probe of `self` faces `other` (within half a spacing
+    /// across its surface, where it was sampled) within the noise's reach:
+    /// every facing pair, not only each probe's best, so `false` proves that
+    /// no facing pair of the two elements is within reach.
+    fn probes_reach(&self, other: &Posed<'_>, reach_sds: Real) -> bool {
+        let allowed = HALF_SPACING * self.e.spacing.max(other.e.spacing);
+        self.e.probes.iter().any(|&[u, v]| {
+            let (x, var_x) = self.probe(u, v);
+            let c = other.across(&x);
+            let s = (self.var_bound(var_x) + other.var_bound(c.var_y)).sqrt();
+            c.lateral <= allowed
+                && (c.y - x).norm() <= allowed + reach_sds * s
+                && other.e.covers(c.u, c.v)
+        })
     }
 
     /// Tangential coordinates of `x`.
@@ -178,6 +177,17 @@ struct Facing {
     key: (bool, Real),
 }
 
+/// A point `x` seen from an element: its tangential coordinates, the surface
+/// point `y` straight across (clamped to the extent) with the variance of its
+/// height, and the offset of `y - x` across the element's normal.
+struct Across {
+    u: Real,
+    v: Real,
+    y: Point3,
+    var_y: Real,
+    lateral: Real,
+}
+
 /// The other side's elements nearest to a probe by mean: a hierarchy over the
 /// means when there are many (a patch holds hundreds of elements, each with 25
 /// probes), every mean otherwise.
@@ -238,25 +248,21 @@ fn for_each_facing(
             continue;
         }
         for &[u, v] in &p.e.probes {
-            let (x, var_x) = if p.e.is_point() {
-                (p.mean, 0.0)
-            } else {
-                p.at(u, v)
-            };
+            let (x, var_x) = p.probe(u, v);
             candidates.nearest(&x, &mut ws, &mut nearest);
             let mut best: Option<Facing> = None;
             for &(_, j) in &nearest {
                 let j = j as usize;
                 let o = &other[j];
-                let (ou, ov) = o.coordinates(&x);
-                let (y, var_y) = o.at(ou, ov);
+                let Across {
+                    u: ou,
+                    v: ov,
+                    y,
+                    var_y,
+                    lateral,
+                } = o.across(&x);
                 let d = y - x;
-                let lateral = if o.e.is_point() {
-                    d.norm()
-                } else {
-                    (d - o.normal * o.normal.dot(&d)).norm()
-                };
-                let allowed = FACING_SPACINGS * p.e.spacing.max(o.e.spacing);
+                let allowed = HALF_SPACING * p.e.spacing.max(o.e.spacing);
                 // An element that `x` lies over (within its extent, so `y`
                 // is straight across) beats one it lies beside (`y` clamped
                 // to the extent's edge, offset sideways): the gap of a pair
@@ -301,13 +307,32 @@ fn within_reach_of(own: &[Posed<'_>], other: &[Posed<'_>], reach_sds: Real) -> V
         .collect()
 }
 
+/// Whether element `a` (with its hull, its cloud at `pose_a` in `b`'s frame)
+/// and element `b` have a facing pair within `reach_sds` standard deviations
+/// (as [`elements_within_reach`] tests it, over every facing pair of the two).
+/// `false` proves that no patch holding both finds the pair within reach.
+pub(crate) fn element_pair_within_reach(
+    a: (&SurfaceElement, &Hull),
+    pose_a: &Pose,
+    b: (&SurfaceElement, &Hull),
+    reach_sds: Real,
+) -> bool {
+    let (pa, pb) = (Posed::new(a, pose_a), Posed::new(b, &Pose::identity()));
+    pa.may_reach(&pb, reach_sds)
+        && (pa.probes_reach(&pb, reach_sds) || pb.probes_reach(&pa, reach_sds))
+}
+
 /// Whether some probe of either side faces the other side within the noise's
 /// reach (`|y - x| <= h/2 + reach_sds s` with `s` bounded over all directions):
 /// when none does, the surfaces cannot cross and no separating surface is
 /// needed to say so.
-pub fn elements_within_reach(a: &ElementSide<'_>, b: &ElementSide<'_>, reach_sds: Real) -> bool {
-    let pa: Vec<Posed<'_>> = a.elements.iter().map(|e| Posed::new(e, &a.pose)).collect();
-    let pb: Vec<Posed<'_>> = b.elements.iter().map(|e| Posed::new(e, &b.pose)).collect();
+pub(crate) fn elements_within_reach(
+    a: &ElementSide<'_>,
+    b: &ElementSide<'_>,
+    reach_sds: Real,
+) -> bool {
+    let pa: Vec<Posed<'_>> = a.elements.iter().map(|&e| Posed::new(e, &a.pose)).collect();
+    let pb: Vec<Posed<'_>> = b.elements.iter().map(|&e| Posed::new(e, &b.pose)).collect();
     // Stops at the first pair within reach.
     let reaches = |own: &[Posed<'_>], other: &[Posed<'_>]| {
         let active = within_reach_of(own, other, reach_sds);
@@ -336,7 +361,7 @@ pub fn elements_within_reach(a: &ElementSide<'_>, b: &ElementSide<'_>, reach_sds
 /// reach (`|y - x| > h/2 + reach_sds s`, `h` the spacing) cannot cross there
 /// and counts 0: a deep crossing shows where the surfaces cross, not far from
 /// it. The element's value is the largest over its probes.
-pub fn element_crossing_probabilities(
+pub(crate) fn element_crossing_probabilities(
     own: &ElementSide<'_>,
     other: &ElementSide<'_>,
     sep: &Separator,
@@ -345,12 +370,12 @@ pub fn element_crossing_probabilities(
     let po: Vec<Posed<'_>> = own
         .elements
         .iter()
-        .map(|e| Posed::new(e, &own.pose))
+        .map(|&e| Posed::new(e, &own.pose))
         .collect();
     let pt: Vec<Posed<'_>> = other
         .elements
         .iter()
-        .map(|e| Posed::new(e, &other.pose))
+        .map(|&e| Posed::new(e, &other.pose))
         .collect();
     let mut out = vec![0.0; po.len()];
     let active = within_reach_of(&po, &pt, reach_sds);
@@ -452,16 +477,23 @@ mod tests {
         for (k, offset) in [0.1, 0.102, 0.11, 0.13].into_iter().enumerate() {
             let turn = UnitQuaternion::from_euler_angles(0.3 * k as Real, 0.7, -0.2);
             let pose = Pose::from_parts(Translation3::new(offset, 0.0, 0.0), turn);
-            let pa: Vec<Posed<'_>> = ea.iter().step_by(7).map(|e| Posed::new(e, &pose)).collect();
+            let (ha, hb) = (ca.elements().hulls(), cb.elements().hulls());
+            let pa: Vec<Posed<'_>> = ea
+                .iter()
+                .enumerate()
+                .step_by(7)
+                .map(|(k, e)| Posed::new((e, ha.hull(k as u32)), &pose))
+                .collect();
             let pb: Vec<Posed<'_>> = eb
                 .iter()
+                .enumerate()
                 .step_by(5)
-                .map(|e| Posed::new(e, &Pose::identity()))
+                .map(|(k, e)| Posed::new((e, hb.hull(k as u32)), &Pose::identity()))
                 .collect();
             for a in &pa {
                 let ga = grid(a);
                 for &(_, var) in &ga {
-                    assert!(var <= a.var_max * (1.0 + 1e-12) + 1e-18);
+                    assert!(var <= a.hull.var_max * (1.0 + 1e-12) + 1e-18);
                 }
                 for b in &pb {
                     let gb = grid(b);

@@ -4,9 +4,9 @@
 //! - [`Aggregation`]: how per-point probabilities become the pair's `P`;
 //! - [`surface_probability`]: the same for the surface around a point;
 //! - [`crossing_probabilities`]: where two sampled surfaces cross;
-//! - [`element_crossing_probabilities`]: the probability that the fitted
-//!   surfaces of two clouds' surface elements cross (the elements model's `P`);
-//!   [`elements_within_reach`]: whether they can at all;
+//! - `element_crossing_probabilities` (crate-internal): the probability that
+//!   the fitted surfaces of two clouds' surface elements cross (the elements
+//!   model's `P`), and `elements_within_reach`: whether they can at all;
 //! - [`Thresholds`] and [`CollisionState`]: the decision `free` / `contact` / `collision`.
 
 mod aggregation;
@@ -18,7 +18,9 @@ mod state;
 
 pub use aggregation::{surface_probability, Aggregation};
 pub use crossing::crossing_probabilities;
-pub use element::{element_crossing_probabilities, elements_within_reach, ElementSide};
+pub(crate) use element::{
+    element_crossing_probabilities, element_pair_within_reach, elements_within_reach, ElementSide,
+};
 pub use gaussian::{normal_cdf, normal_quantile};
 pub use point::point_probability;
 pub use state::{CollisionState, Thresholds};

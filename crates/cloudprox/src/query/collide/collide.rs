@@ -10,9 +10,10 @@ use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{crossing_probabilities, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
-    element_crossings, element_points, element_sides_within_reach, has_surface_element,
+    element_crossings, element_points, element_sides_within_reach, element_surfaces_may_reach,
+    has_surface_element,
 };
-use crate::query::collide::near::near_set;
+use crate::query::collide::near::{near_set, NearSet};
 use crate::query::collide::probabilities::{
     core_values, indexed, point_probabilities, surface_probabilities,
 };
@@ -87,7 +88,21 @@ pub(crate) fn collide_with_workspace(
         None => (a, b),
         Some((ea, eb)) => (ea.samples(), eb.samples()),
     };
-    let near = near_set(&rel, sa, sb, request, workspace, &mut stats);
+    // The noise's reach in standard deviations: beyond it no surface crosses.
+    let reach = -normal_quantile(0.5 * request.prune_epsilon);
+    // The elements model first bounds the element surfaces themselves: when no
+    // two can reach each other, the clouds are free.
+    let beyond_reach = match elements {
+        Some((ea, eb)) if request.use_hierarchy => {
+            !element_surfaces_may_reach(ea, &rel, eb, reach, workspace, &mut stats)
+        }
+        _ => false,
+    };
+    let near = if beyond_reach {
+        NearSet::empty(sa.len(), sb.len())
+    } else {
+        near_set(&rel, sa, sb, request, workspace, &mut stats)
+    };
     let core = &near.core;
     stats.near_regions = near.regions.len();
 
@@ -134,7 +149,6 @@ pub(crate) fn collide_with_workspace(
             let surfaces = elements
                 .filter(|&(ea, eb)| has_surface_element(ea, &ia) || has_surface_element(eb, &ib));
             if let Some((ea, eb)) = surfaces {
-                let reach = -normal_quantile(0.5 * request.prune_epsilon);
                 if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
                     stats.patches_beyond_reach += 1;
                     continue;
@@ -176,7 +190,6 @@ pub(crate) fn collide_with_workspace(
             let (qa, qb) = match (surfaces, request.aggregation) {
                 (Some((ea, eb)), _) => {
                     let id = Pose::identity();
-                    let reach = -normal_quantile(0.5 * request.prune_epsilon);
                     element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
                 }
                 (None, Aggregation::Surface) if elements.is_none() => {

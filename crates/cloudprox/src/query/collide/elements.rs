@@ -2,10 +2,14 @@
 //! stand for, whether their fitted surfaces can reach each other at all, and
 //! the probability that they cross ([`crate::probability::element`]).
 
+use crate::bvh::BvhWorkspace;
 use crate::classify::Separator;
-use crate::element::SurfaceElements;
+use crate::element::{surfaces_may_reach, SurfaceElements};
 use crate::math::Pose;
-use crate::probability::{element_crossing_probabilities, elements_within_reach, ElementSide};
+use crate::probability::{
+    element_crossing_probabilities, element_pair_within_reach, elements_within_reach, ElementSide,
+};
+use crate::query::collide::QueryStats;
 use crate::Real;
 
 /// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
@@ -43,6 +47,35 @@ pub(crate) fn element_crossings(
     (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
 }
 
+/// Whether some element surface (or single point) of `ea`, at `rel` in `eb`'s
+/// frame, may come within `reach_sds` noise standard deviations, beyond half a
+/// sampling spacing, of one of `eb` (the hierarchies over both clouds'
+/// element hulls, see [`crate::element`]). When none may, every patch the
+/// query would build is pruned: the clouds are free, and neither the near set
+/// nor a classifier is needed to say so. The node pairs it tests are counted
+/// in `stats`.
+pub(crate) fn element_surfaces_may_reach(
+    ea: &SurfaceElements,
+    rel: &Pose,
+    eb: &SurfaceElements,
+    reach_sds: Real,
+    workspace: &mut BvhWorkspace,
+    stats: &mut QueryStats,
+) -> bool {
+    if !reach_sds.is_finite() {
+        return true;
+    }
+    let (ha, hb) = (ea.hulls(), eb.hulls());
+    let faces = |i: u32, j: u32| {
+        let a = (&ea.elements()[i as usize], ha.hull(i));
+        let b = (&eb.elements()[j as usize], hb.hull(j));
+        element_pair_within_reach(a, rel, b, reach_sds)
+    };
+    let (may, visited) = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, faces);
+    stats.node_pairs_visited += visited;
+    may
+}
+
 /// Whether some sample of `samples` stands for an element of more than one point.
 pub(crate) fn has_surface_element(elements: &SurfaceElements, samples: &[u32]) -> bool {
     let owner = elements.sample_owner();
@@ -77,7 +110,7 @@ fn element_side<'a>(
     ElementSide {
         elements: unique
             .iter()
-            .map(|&e| &els.elements()[e as usize])
+            .map(|&e| (&els.elements()[e as usize], els.hulls().hull(e)))
             .collect(),
         pose: *pose,
         label,

@@ -19,6 +19,16 @@ pub(crate) struct NearSet {
     pub core: (Vec<bool>, Vec<bool>),
 }
 
+impl NearSet {
+    /// No near region: the clouds are free.
+    pub(crate) fn empty(na: usize, nb: usize) -> Self {
+        Self {
+            regions: Vec::new(),
+            core: (vec![false; na], vec![false; nb]),
+        }
+    }
+}
+
 /// Finds the near set of `a` (at `rel` in `b`'s frame) and `b`, in two stages.
 ///
 /// First the noise and the sampling alone: two surfaces sampled at spacing `h`
@@ -53,7 +63,7 @@ pub(crate) fn near_set(
                 .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
             keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx);
         }
-        stats.node_pairs_visited = t.node_pairs_visited;
+        stats.node_pairs_visited += t.node_pairs_visited;
         stats.leaf_pairs = t.leaf_pairs.len();
         stats.pruned_bound = t.pruned_bound;
         if !any_near {
