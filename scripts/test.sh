@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every check and test of cloudprox: Rust (format, lints, unit, integration
-# and doc tests) and Python (the package built and installed, ruff, pytest).
+# Runs every check and test of cloudprox: Rust (format, lints, documentation, unit,
+# integration and doc tests) and Python (the package built and installed, ruff,
+# the documentation site, pytest).
 # Usage: bash scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,9 @@ cargo fmt --all -- --check
 step "cargo clippy (all targets, -D warnings)"
 cargo clippy --workspace --all-targets -- -D warnings
 
+step "cargo doc (core crate, warnings as errors: missing docs, broken links)"
+RUSTDOCFLAGS="-D warnings" cargo doc -p cloudprox --no-deps --quiet
+
 step "cargo test (core crate: unit, integration, doc tests)"
 cargo test -p cloudprox
 
@@ -23,11 +27,18 @@ step "build and install the Python package"
 python3 -m pip install --quiet --disable-pip-version-check -e '.[test]'
 
 step "ruff"
-python3 -m ruff check python tests benches
-python3 -m ruff format --check python tests benches
+python3 -m ruff check python tests benches scripts
+python3 -m ruff format --check python tests benches scripts
 
 step "stubs match the compiled module (mypy.stubtest)"
 python3 -m mypy.stubtest cloudprox._native
+
+step "documentation site (mkdocs build --strict, API reference from the installed package)"
+if python3 -c 'import sys; sys.exit(sys.version_info < (3, 11))'; then
+    NO_MKDOCS_2_WARNING=1 python3 -m mkdocs build --strict --site-dir "${TMPDIR:-/tmp}/cloudprox-site"
+else
+    echo "skipped: the documentation tools (the docs extra) need Python >= 3.11"
+fi
 
 step "pytest"
 python3 -m pytest -q

@@ -46,7 +46,7 @@ from cloudprox._native import (
 )
 from cloudprox.exceptions import CloudproxError
 
-__all__ = ["main", "result_to_dict"]
+__all__ = ["build_parser", "main", "result_to_dict"]
 
 #: Gaps of the demo, in units of sigma.
 DEMO_GAPS_SIGMA = (-3.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 15.0)
@@ -911,7 +911,16 @@ def _add_view_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
+    """Build the ``cloudprox`` command's argument parser, with every subcommand.
+
+    The documentation's command-line reference is generated from it.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser :func:`main` uses.
+    """
     defaults = default_options()
     names = option_names()
     parser = argparse.ArgumentParser(
@@ -1102,7 +1111,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     int
         Exit status: 0 on success, 2 on a user error.
     """
-    parser = _parser()
+    parser = build_parser()
     try:
         args = parser.parse_args(argv)
     except SystemExit as e:  # --help, --version, or a usage error already printed

@@ -6,7 +6,8 @@
 //!
 //! Two clouds A and B are collision-free iff a surface separates them. Every point
 //! carries a 3x3 covariance (sensor noise plus discretization error). A robust
-//! classifier (a second-order cone program solved by Clarabel) finds the separating
+//! classifier (a second-order cone program, solved by a specialized barrier method
+//! with Clarabel as reference and fallback) finds the separating
 //! surface that tolerates that noise; every point then gets the probability of lying
 //! on the wrong side of it (a Gaussian cdf), and the pair gets an aggregated
 //! probability `P` and a state (free / contact / collision).
@@ -46,7 +47,7 @@
 //! assert_eq!(result.state, CollisionState::Free);
 //! assert!(result.probability < 0.01);
 //! ```
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 #![deny(unused_qualifications)]
 
 pub mod bvh;

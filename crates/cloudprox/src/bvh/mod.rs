@@ -16,7 +16,7 @@
 //! (`grid_knn.rs`) answers exact k-nearest-neighbour queries for every point of
 //! a large cloud at once, much cheaper to build on millions of points than a
 //! tree; the filters and the sampling spacing of large clouds use it
-//! ([`knn_map`]).
+//! (`knn_map`).
 
 mod aabb;
 mod bvh_build;

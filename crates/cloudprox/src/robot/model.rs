@@ -209,7 +209,7 @@ impl Robot {
     }
 
     /// Checks that `q` has one finite value per configuration entry, within the
-    /// joint limits (up to [`LIMIT_TOLERANCE`]).
+    /// joint limits (up to `LIMIT_TOLERANCE`, 1e-9).
     ///
     /// # Errors
     /// [`Error::Shape`] for a wrong length; [`Error::InvalidInput`] naming the

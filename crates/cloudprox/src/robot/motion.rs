@@ -76,7 +76,7 @@ fn default_resolution(cloud: &PointCloud) -> Real {
 ///
 /// # Errors
 /// As [`Robot::check_configuration`] for `q0` and `q1`; an invalid request or
-/// resolution; a motion needing more than [`MAX_MOTION_STATES`] states.
+/// resolution; a motion needing more than `MAX_MOTION_STATES` (one million) states.
 pub fn check_motion(
     robot: &Robot,
     q0: &[Real],

@@ -14,7 +14,7 @@ pub enum QueryModel {
     /// trains on the elements' samples (their means and extents, with the
     /// covariance of the fitted plane), so a near region holds tens of samples
     /// at any noise level, and `P` is the probability that the sampled surfaces
-    /// cross ([`crate::probability::pair_crossing_probabilities`]). Per-point
+    /// cross (the crate-internal `element_crossing_probabilities`). Per-point
     /// probabilities (Eq. 3 with each point's own covariance against the trained
     /// surface) are still reported.
     Elements,
@@ -43,7 +43,7 @@ impl QueryModel {
     }
 }
 
-/// Options of [`crate::query::collide`]. Build with [`CollisionRequestBuilder`] or
+/// Options of [`crate::query::collide()`]. Build with [`CollisionRequestBuilder`] or
 /// take [`CollisionRequest::default`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CollisionRequest {

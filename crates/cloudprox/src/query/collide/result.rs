@@ -73,7 +73,7 @@ pub struct QueryStats {
     pub time_seconds: Real,
 }
 
-/// The answer of [`crate::query::collide`].
+/// The answer of [`crate::query::collide()`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct CollisionResult {
     /// The pair's collision probability `P`, aggregated as requested.
