@@ -40,5 +40,5 @@ else
     echo "skipped: the documentation tools (the docs extra) need Python >= 3.11"
 fi
 
-step "pytest"
-python3 -m pytest -q
+step "pytest (two workers, one file each)"
+python3 -m pytest -q -n 2 --dist loadfile
