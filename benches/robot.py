@@ -5,8 +5,9 @@ mushroom) seen by the simulated Kinect at 1.63 times its image size (522 x 391:
 about 100 000 points, Nguyen et al. 2012 noise). In one run:
 
 * **Cost per configuration**, one thread (``RAYON_NUM_THREADS=1``): cloudprox's
-  ``collide_robot`` (its own ``stats["time_seconds"]``: forward kinematics, broad
-  phase and queries, self-collision off) against python-fcl's ``collide()`` of
+  ``collide_robot`` with each model (surface elements, the default, and points;
+  its own ``stats["time_seconds"]``: forward kinematics, broad phase and
+  queries, self-collision off) against python-fcl's ``collide()`` of
   the robot's exact link meshes (a ``DynamicAABBTreeCollisionManager``) against
   the exact scene meshes (the anchor) and against the collision map's occupied
   voxels as boxes (sensor resolution and 2 cm), the links posed beforehand (not
@@ -22,7 +23,8 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   sigma (the meshes are not convex: the depth is that travel, as in
   ``benches/realmesh.py``). Decided accuracy (free or collision, against the
   exact label), undecided share, false collisions beyond 3 sigma, missed
-  collisions deeper than 3 sigma; the collision maps' booleans alike.
+  collisions deeper than 3 sigma, for both models; the collision maps' booleans
+  alike.
 
 Usage: ``python3 benches/robot.py [--configurations 2000] [--near 1000] [--seed 0]``
 """
@@ -53,6 +55,8 @@ import cloudprox as cp
 #: Image scale of the simulated camera: 1.63^2 x the 37 539 points of the planning scan.
 SCALE = 1.63
 ARM = slice(0, 7)
+#: cloudprox's query models, the default (surface elements) first.
+MODELS = ("elements", "points")
 
 
 def setup(seed: int) -> tuple[cp.Robot, dict[str, cp.Mesh], cp.PointCloud, float, float]:
@@ -227,15 +231,21 @@ def main() -> None:
     log(f"{len(near_q)} configurations near the scene")
     free_near = near_q[(near_d > 0) & (near_d <= 5 * sigma)]
 
-    cp.collide_robot(robot, qs[0], cloud)  # link samples, scan hierarchy
+    for model in MODELS:  # link samples, scan hierarchy and elements: built once
+        cp.collide_robot(robot, qs[0], cloud, model=model)
     rows = []
     for name, sel in (("far (> 5 sigma)", far), ("near contact (free, <= 5 sigma)", free_near)):
-        t_cp = np.array(
-            [
-                cp.collide_robot(robot, q, cloud, self_collision=False).stats["time_seconds"]
-                for q in sel
-            ]
-        )
+        t_cp = {
+            model: np.array(
+                [
+                    cp.collide_robot(robot, q, cloud, self_collision=False, model=model).stats[
+                        "time_seconds"
+                    ]
+                    for q in sel
+                ]
+            )
+            for model in MODELS
+        }
         t_ex = fcl_call_times(exact, sel)
         t_maps = {k: fcl_call_times(c, sel) for k, c in maps.items()}
         rows.append((name, len(sel), t_cp, t_ex, t_maps))
@@ -245,16 +255,20 @@ def main() -> None:
     )
     map_names = list(maps)
     print(
-        "| configurations | n | cloudprox `collide_robot` | python-fcl exact meshes | "
+        "| configurations | n | "
+        + " | ".join(f"cloudprox `collide_robot`, {m}" for m in MODELS)
+        + " | python-fcl exact meshes | "
         + " | ".join(f"python-fcl {k} boxes" for k in map_names)
-        + " | cloudprox / fcl exact |"
+        + " | cloudprox (elements) / fcl exact |"
     )
-    print("|---|---|---|---|" + "---|" * len(map_names) + "---|")
+    print("|---|---|" + "---|" * (len(MODELS) + 1 + len(map_names)) + "---|")
     for name, n, t_cp, t_ex, t_maps in rows:
         print(
-            f"| {name} | {n} | {us(t_cp)} | {us(t_ex)} | "
+            f"| {name} | {n} | "
+            + " | ".join(us(t_cp[m]) for m in MODELS)
+            + f" | {us(t_ex)} | "
             + " | ".join(us(t_maps[k]) for k in map_names)
-            + f" | {np.median(t_cp) / np.median(t_ex):.1f}x |"
+            + f" | {np.median(t_cp[MODELS[0]]) / np.median(t_ex):.1f}x |"
         )
 
     seconds = {k: many_seconds(k, args.many, args.seed) for k in (1, 2)}
@@ -264,10 +278,14 @@ def main() -> None:
         f"(speed-up {seconds[1] / seconds[2]:.2f}x on 2 cores)"
     )
 
-    batch = cp.collide_robot_many(robot, near_q, cloud, self_collision=False)
-    states = np.asarray(batch.states)
+    answers = {
+        f"cloudprox ({model})": np.asarray(
+            cp.collide_robot_many(robot, near_q, cloud, self_collision=False, model=model).states
+        )
+        for model in MODELS
+    }
+    states = answers[f"cloudprox ({MODELS[0]})"]
     label = near_d <= 0.0
-    answers = {"cloudprox": states}
     for k, c in maps.items():
         answers[k] = np.where(map_booleans(c, near_q), "collision", "free")
     print(

@@ -78,3 +78,21 @@ def test_scene_gaps_are_exact() -> None:
     assert lo[0] < -3.0 and hi[0] > 3.0 and lo[2] < 0.0
     with pytest.raises(ValueError, match="points must be >= 10"):
         build_scene(points=1)
+
+
+def test_elements_do_not_read_a_collision_off_a_surface_that_does_not_describe_it() -> None:
+    # The demo's scene: a patch's quadric, wrapped around a contact 0.4 m away,
+    # ran across the piano's bottom and the table top 20 mm (4 sigma) apart with
+    # its normal nearly horizontal, and read P = 1 there. Such a patch is now cut.
+    s = 0.005
+    scene = build_scene(sigma=s, points=10_000, seed=0)
+    pa = cloudprox.PointCloud(scene.piano_points, sigma=s)
+    room_cloud = cloudprox.PointCloud(scene.room_points, sigma=s)
+
+    def p(gap_sigmas: float) -> float:
+        pose = scene.piano_pose(gap_sigmas * s)
+        return cloudprox.collide(pa, room_cloud, pose_a=pose, model="elements").probability
+
+    assert p(4.0) <= 0.1
+    assert p(15.0) == 0.0
+    assert p(-1.0) >= 0.9 and p(-3.0) >= 0.9

@@ -1178,8 +1178,11 @@ def collide_robot(
 
     Each link with geometry is sampled once per spacing (``mesh_spacing``, default
     half the cloud's median spacing) into a cloud without sensor noise. A broad
-    phase (``broad_phase=True``) skips links whose bounding box is beyond the noise's
-    reach of every node of the cloud's hierarchy: their query would read 0. Every
+    phase (``broad_phase=True``) skips links that cannot reach the cloud: with the
+    points model, the link's bounding box is beyond the noise's reach of every node
+    of the cloud's hierarchy; with the elements model, no element surface of the
+    link comes within the noise's reach of one of the cloud (the hierarchies over
+    both clouds' element hulls). Their query would read 0. Every
     other link is queried as :func:`collide` does; with ``decide_only=True`` the
     links after the first whose probability reaches ``threshold_collision`` are
     left (probability NaN, ``stats["links_after_decision"]``): the state is

@@ -12,8 +12,9 @@ use proptest::prelude::*;
 
 const SIGMA: f64 = 0.003;
 
-fn req(hierarchy: bool, surface: Surface) -> CollisionRequest {
+fn req(hierarchy: bool, surface: Surface, model: QueryModel) -> CollisionRequest {
     CollisionRequest::builder()
+        .model(model)
         .classify(
             ClassifySettings::builder()
                 .surface(surface)
@@ -75,11 +76,13 @@ proptest! {
         rot in prop::array::uniform3(-3.0f64..3.0),
         seed in 0u64..1000,
         linear in any::<bool>(),
+        points in any::<bool>(),
     ) {
         let (a, b, pose_b) = scene(na, nb, ra, rb, gap_sigmas, Vector3::from(dir), Vector3::from(rot), seed);
         let surface = if linear { Surface::Linear } else { Surface::Quadric };
-        let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface)).unwrap();
-        let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface)).unwrap();
+        let model = if points { QueryModel::Points } else { QueryModel::Elements };
+        let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface, model)).unwrap();
+        let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface, model)).unwrap();
         let (ph, pb) = (h.probability, bf.probability);
         let classified = |r: &CollisionResult| r.stats.points_classified;
         prop_assert_eq!(classified(&h), classified(&bf), "the same near points");
@@ -96,6 +99,12 @@ proptest! {
 
 #[test]
 fn hierarchy_and_brute_force_agree_on_most_scenes() {
+    for model in [QueryModel::Elements, QueryModel::Points] {
+        agree_on_most_scenes(model);
+    }
+}
+
+fn agree_on_most_scenes(model: QueryModel) {
     let mut rng = NormalRng::new(5);
     for surface in [Surface::Linear, Surface::Quadric] {
         let (mut equal, mut total) = (0, 0);
@@ -107,14 +116,28 @@ fn hierarchy_and_brute_force_agree_on_most_scenes() {
             let dir = Vector3::new(rng.normal(), rng.normal(), rng.normal());
             let rot = Vector3::new(rng.normal(), rng.normal(), rng.normal());
             let (a, b, pose_b) = scene(na, nb, ra, rb, gap, dir, rot, k);
-            let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface)).unwrap();
-            let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface)).unwrap();
+            let h = collide(
+                &Pose::identity(),
+                &a,
+                &pose_b,
+                &b,
+                &req(true, surface, model),
+            )
+            .unwrap();
+            let bf = collide(
+                &Pose::identity(),
+                &a,
+                &pose_b,
+                &b,
+                &req(false, surface, model),
+            )
+            .unwrap();
             total += 1;
             equal += usize::from((h.probability - bf.probability).abs() < 1e-6);
         }
         assert!(
             equal * 10 >= total * 9,
-            "{surface:?}: equal on {equal} of {total}"
+            "{model:?} {surface:?}: equal on {equal} of {total}"
         );
     }
 }

@@ -81,30 +81,44 @@ fn a_robot_far_from_the_cloud_costs_no_link_query() {
 fn broad_phase_changes_the_cost_not_the_answer() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 3);
-    let with = RobotRequest::default();
-    let without = RobotRequest {
-        broad_phase: false,
-        ..RobotRequest::default()
-    };
-    for q in [
-        [0.0, 0.0, 0.0, 0.0],
-        [0.0, 0.0, 0.06, 0.0],
-        [0.0, 0.0, 0.075, 0.0],
-        [0.2, -0.1, 0.1, 0.0],
-        [1.5, 0.0, 0.1, 0.0],
-    ] {
-        let a = collide_robot(&robot, &q, &Pose::identity(), &cloud, &with).unwrap();
-        let b = collide_robot(&robot, &q, &Pose::identity(), &cloud, &without).unwrap();
-        assert_eq!(b.stats.links_queried, 6);
-        assert_eq!(a.probability, b.probability, "{q:?}");
-        for (x, y) in a.links.iter().zip(&b.links) {
-            assert_eq!(x.probability, y.probability, "{q:?} link {}", x.link);
+    for model in [QueryModel::Elements, QueryModel::Points] {
+        let with = RobotRequest {
+            collide: CollisionRequest::builder().model(model).build().unwrap(),
+            ..RobotRequest::default()
+        };
+        let without = RobotRequest {
+            broad_phase: false,
+            ..with
+        };
+        let mut skipped = 0;
+        for q in [
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.06, 0.0],
+            [0.0, 0.0, 0.075, 0.0],
+            [0.2, -0.1, 0.1, 0.0],
+            [1.5, 0.0, 0.1, 0.0],
+        ] {
+            let a = collide_robot(&robot, &q, &Pose::identity(), &cloud, &with).unwrap();
+            let b = collide_robot(&robot, &q, &Pose::identity(), &cloud, &without).unwrap();
+            assert_eq!(b.stats.links_queried, 6);
+            skipped += 6 - a.stats.links_queried;
+            assert_eq!(a.probability, b.probability, "{model:?} {q:?}");
+            for (x, y) in a.links.iter().zip(&b.links) {
+                assert_eq!(
+                    x.probability, y.probability,
+                    "{model:?} {q:?} link {}",
+                    x.link
+                );
+                assert_eq!(x.state, y.state);
+            }
         }
+        // The broad phase did skip links (the comparison is not vacuous).
+        assert!(skipped > 0, "{model:?}");
     }
 }
 
 #[test]
-fn the_elements_model_queries_every_near_link() {
+fn the_elements_model_reads_contact_and_freedom_at_a_wall() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 9);
     let req = RobotRequest {
@@ -122,8 +136,9 @@ fn the_elements_model_queries_every_near_link() {
         &req,
     )
     .unwrap();
-    assert_eq!(hit.stats.links_queried, 6);
     assert_eq!(hit.state, CollisionState::Collision);
+    // Links 0 and 1 (the base, far from the wall) are skipped by the broad phase.
+    assert!(hit.links.iter().filter(|l| l.link <= 1).all(|l| !l.queried));
     let free = collide_robot(
         &robot,
         &[0.0, 0.0, 0.0, 0.0],
@@ -439,15 +454,11 @@ fn a_decide_only_query_leaves_the_links_after_one_that_collides() {
     // to 0.33) and the tool are within its noise's reach.
     let cloud = wall(0.25, 0.3, 0.1, SIGMA, 5);
     let q = [0.0, 0.0, 0.0, 0.0];
-    let full = collide_robot(
-        &robot,
-        &q,
-        &Pose::identity(),
-        &cloud,
-        &RobotRequest::default(),
-    )
-    .unwrap();
+    // The points model: its broad phase leaves links within the points'
+    // noise reach that the decision then skips.
     let mut req = RobotRequest::default();
+    req.collide.model = QueryModel::Points;
+    let full = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
     req.collide.decide_only = true;
     let fast = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
     assert_eq!(full.state, CollisionState::Collision);

@@ -70,7 +70,7 @@ FloatArray = npt.NDArray[np.float64]
 THRESHOLD_COLLISION, THRESHOLD_FREE = 0.9, 0.1
 #: Queries of the reconstruction baseline timed one by one.
 TIMED_QUERIES = 30
-#: cloudprox's aggregations: the surface one (default) and the paper's three.
+#: The points model's aggregations: the surface one and the paper's three.
 AGGREGATIONS = ("surface", "max", "union", "independent")
 
 

@@ -100,6 +100,7 @@ impl Bvh {
                 }
                 true
             },
+            |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
             |ia, ib| {
                 leaf_pairs.push((ia, ib));
                 true
@@ -111,16 +112,18 @@ impl Bvh {
     }
 
     /// The bounding volume test tree of `self` and `other`: from the root pair,
-    /// every node pair for which `keep` holds is descended (the node with more
-    /// points first split; both nodes leaves: `leaf` is called), until `leaf`
-    /// returns `false`. Returns the number of node pairs tested. The traversals
-    /// differ only in `keep` (what bounds a node pair) and in what a leaf pair
-    /// does.
+    /// every node pair for which `keep` holds is descended (where both nodes
+    /// have children, `self`'s node is split when `split_self` says so; both
+    /// nodes leaves: `leaf` is called), until `leaf` returns `false`. Returns
+    /// the number of node pairs tested. The traversals differ in `keep` (what
+    /// bounds a node pair), in which node they split first and in what a leaf
+    /// pair does.
     pub(crate) fn descend_pairs(
         &self,
         other: &Bvh,
         stack: &mut Vec<(u32, u32)>,
         mut keep: impl FnMut(u32, u32) -> bool,
+        split_self: impl Fn(u32, u32) -> bool,
         mut leaf: impl FnMut(u32, u32) -> bool,
     ) -> usize {
         let mut visited = 0;
@@ -147,7 +150,7 @@ impl Bvh {
                     stack.push((ia, r));
                 }
                 (Some([al, ar]), Some([bl, br])) => {
-                    if na.count >= nb.count {
+                    if split_self(ia, ib) {
                         stack.push((al, ib));
                         stack.push((ar, ib));
                     } else {

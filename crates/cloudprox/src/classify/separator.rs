@@ -30,6 +30,11 @@ impl Separator {
         (f, self.frame.rotation * g)
     }
 
+    /// `f` at a point given in the training frame.
+    pub fn value_local(&self, x: &Point3) -> Real {
+        self.value_and_gradient_local(x).0
+    }
+
     /// `f` and its gradient at a point given in the training frame.
     pub fn value_and_gradient_local(&self, x: &Point3) -> (Real, Vector3) {
         let u = (x - self.center) / self.scale;

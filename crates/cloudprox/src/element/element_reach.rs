@@ -23,6 +23,12 @@ use crate::Real;
 /// rule of the crossing probabilities use).
 pub(crate) const HALF_SPACING: Real = 0.5;
 
+/// The hierarchy over element hulls keeps few hulls per leaf: hulls differ
+/// far more than points do (a table top's plane half a metre across beside
+/// single points seen at grazing angles with centimetres of noise), and a
+/// node's box, sigma and margin are its widest hull's.
+const HULL_TREE: BvhSettings = BvhSettings { leaf_max_points: 1 };
+
 /// An element's fitted surface as the reach tests read it, in its cloud's own
 /// frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -157,7 +163,7 @@ impl ElementHulls {
             .collect();
         let means: Vec<Point3> = hulls.iter().map(|h| h.mean).collect();
         let sigmas: Vec<Real> = hulls.iter().map(|h| h.sigma).collect();
-        let tree = Bvh::build(&means, &sigmas, &BvhSettings::default())
+        let tree = Bvh::build(&means, &sigmas, &HULL_TREE)
             .expect("element means are finite and the default settings valid");
         let n = tree.nodes().len();
         let mut node_box = vec![Aabb::empty(); n];
@@ -226,6 +232,15 @@ pub(crate) fn surfaces_may_reach(
     workspace: &mut BvhWorkspace,
     mut faces: impl FnMut(u32, u32) -> bool,
 ) -> (bool, usize) {
+    // All of A as one box first: a node pair of the traversal below can only
+    // pass where A's root passes with B's node (the root's box, sigma and
+    // margin bound its descendants'), and this one-sided descent prunes
+    // moderately distant pairs in a few nodes where the pair traversal would
+    // split A's nodes first.
+    let (near, visited_root) = root_may_reach(a, rel, b, reach_sds, &mut workspace.pair_stack);
+    if !near {
+        return (false, visited_root);
+    }
     let mut found = false;
     let mut posed: Vec<PosedHull> = Vec::new();
     let visited = a.tree.descend_pairs(
@@ -236,6 +251,15 @@ pub(crate) fn surfaces_may_reach(
             let gap = a.node_box[ia].transformed(rel).distance(&b.node_box[ib]);
             gap <= a.node_margin[ia].max(b.node_margin[ib])
                 + reach_sds * (a.node_sigma[ia] + b.node_sigma[ib])
+        },
+        // The node whose box, grown by its reach, is the larger first: hulls
+        // differ in size and noise far more than points do.
+        |ia, ib| {
+            let size = |h: &ElementHulls, i: u32| {
+                let i = i as usize;
+                h.node_box[i].half_extents().norm() + h.node_margin[i] + reach_sds * h.node_sigma[i]
+            };
+            size(a, ia) >= size(b, ib)
         },
         |la, lb| {
             let own = a.tree.node_points(la);
@@ -261,7 +285,42 @@ pub(crate) fn surfaces_may_reach(
             true
         },
     );
-    (found, visited)
+    (found, visited_root + visited)
+}
+
+/// Whether the box of all of `a`'s element corners (at `rel` in `b`'s frame),
+/// with `a`'s largest sigma and margin, comes within reach of some leaf of
+/// `b`'s hierarchy (by the node rule of [`surfaces_may_reach`]). `false`
+/// proves that no node pair of that traversal passes. Returns the answer and
+/// the number of nodes of `b` tested.
+fn root_may_reach(
+    a: &ElementHulls,
+    rel: &Pose,
+    b: &ElementHulls,
+    reach_sds: Real,
+    stack: &mut Vec<(u32, u32)>,
+) -> (bool, usize) {
+    let whole = a.node_box[0].transformed(rel);
+    let (sigma, margin) = (a.node_sigma[0], a.node_margin[0]);
+    let mut visited = 0;
+    stack.clear();
+    stack.push((0, 0));
+    while let Some((_, id)) = stack.pop() {
+        visited += 1;
+        let id = id as usize;
+        let limit = margin.max(b.node_margin[id]) + reach_sds * (sigma + b.node_sigma[id]);
+        if whole.distance(&b.node_box[id]) > limit {
+            continue;
+        }
+        match b.tree.nodes()[id].children {
+            None => return (true, visited),
+            Some([l, r]) => {
+                stack.push((0, r));
+                stack.push((0, l));
+            }
+        }
+    }
+    (false, visited)
 }
 
 #[cfg(test)]

@@ -364,12 +364,21 @@ pub(crate) fn elements_within_reach(
 /// reach (`|y - x| > h/2 + reach_sds s`, `h` the spacing) cannot cross there
 /// and counts 0: a deep crossing shows where the surfaces cross, not far from
 /// it. The element's value is the largest over its probes.
+///
+/// The second value says whether some pair that would cross (`Phi(-g/s) >=
+/// 1/2`) lies where the separating surface does not describe it: `x` and `y`
+/// on the same side of it, both farther from it than the pair spans (the
+/// pair's length plus `h/2 + reach_sds s`; the distance to the surface read as
+/// `|f| / |grad f|` at the nearer end). There the surface's normal says nothing about which
+/// side either surface is on (a patch's quadric wrapped around a contact
+/// elsewhere, running across two flat faces 4 sigma apart), and the patch is
+/// cut like a misfit.
 pub(crate) fn element_crossing_probabilities(
     own: &ElementSide<'_>,
     other: &ElementSide<'_>,
     sep: &Separator,
     reach_sds: Real,
-) -> Vec<Real> {
+) -> (Vec<Real>, bool) {
     let po: Vec<Posed<'_>> = own
         .elements
         .iter()
@@ -381,6 +390,7 @@ pub(crate) fn element_crossing_probabilities(
         .map(|&e| Posed::new(e, &other.pose))
         .collect();
     let mut out = vec![0.0; po.len()];
+    let mut undescribed = false;
     let active = within_reach_of(&po, &pt, reach_sds);
     for_each_facing(&po, &pt, &active, |f| {
         let (_, g) = sep.value_and_gradient_local(&nalgebra::center(&f.x, &f.y));
@@ -397,12 +407,19 @@ pub(crate) fn element_crossing_probabilities(
         let sd = (po[f.own].var_along(f.var_x, &u) + pt[f.other].var_along(f.var_y, &u))
             .max(0.0)
             .sqrt();
-        if (f.y - f.x).norm() <= f.allowed + reach_sds * sd {
-            out[f.own] = Real::max(out[f.own], wrong_side(gap, sd));
+        let span = (f.y - f.x).norm();
+        if span <= f.allowed + reach_sds * sd {
+            let p = wrong_side(gap, sd);
+            if p >= 0.5 && !undescribed {
+                let (fx, fy) = (sep.value_local(&f.x), sep.value_local(&f.y));
+                let near_end = fx.abs().min(fy.abs()) / gn;
+                undescribed = fx * fy > 0.0 && near_end > span + f.allowed + reach_sds * sd;
+            }
+            out[f.own] = Real::max(out[f.own], p);
         }
         true
     });
-    out
+    (out, undescribed)
 }
 
 #[cfg(test)]

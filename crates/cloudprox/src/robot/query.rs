@@ -12,7 +12,8 @@ use crate::error::{Error, Result};
 use crate::math::Pose;
 use crate::probability::{normal_quantile, Aggregation, CollisionState};
 use crate::query::collide::{
-    collide_with_workspace, mesh_sampling_spacing, CollisionRequest, CollisionResult, QueryModel,
+    collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, CollisionRequest,
+    CollisionResult, QueryModel,
 };
 use crate::query::exact::exact_intersects;
 use crate::Real;
@@ -25,12 +26,13 @@ pub struct RobotRequest {
     /// Sampling spacing of the link meshes (metres); `None`: half the cloud's
     /// median spacing, as [`crate::query::collide_mesh_cloud`] does.
     pub mesh_spacing: Option<Real>,
-    /// Skip links whose bounding box is beyond the noise's reach of every node
-    /// of the cloud's hierarchy (default `true`). Such a link has no pair of
-    /// points near by the query's near rule, so its query would read `P = 0`:
-    /// the broad phase changes the cost, not the answer. Applied with the
-    /// points model only (the elements model's near rule runs on the
-    /// elements' samples, which the links' boxes do not bound).
+    /// Skip links that cannot reach the cloud (default `true`), reading
+    /// `P = 0` without a query. Points model: the link's bounding box is beyond
+    /// the noise's reach of every node of the cloud's hierarchy, so no pair of
+    /// points is near by the query's near rule. Elements model: no element
+    /// surface of the link may reach one of the cloud through the hierarchies
+    /// over both clouds' element hulls (the elements query's own first test).
+    /// Either way the broad phase changes the cost, not the answer.
     pub broad_phase: bool,
     /// Check self-collision between non-adjacent links (default `true`).
     pub self_collision: bool,
@@ -245,9 +247,7 @@ pub(crate) fn collide_robot_prepared(
     let k = -normal_quantile(0.5 * request.collide.prune_epsilon);
     let mut stats = RobotStats::default();
     let mut links = Vec::new();
-    // The broad phase reproduces the near rule on the points; the elements
-    // model applies it to the elements' samples, which it does not bound.
-    let broad_phase = request.broad_phase && request.collide.model == QueryModel::Points;
+    let broad_phase = request.broad_phase;
     // Every aggregation is at least the largest link probability: once a link
     // reaches the collision threshold, a decide_only query is decided.
     let mut decided = false;
@@ -261,21 +261,37 @@ pub(crate) fn collide_robot_prepared(
             links.push(after_decision(l));
             continue;
         }
-        let near = !broad_phase || {
-            let local = robot.links[l]
-                .geometry
-                .as_ref()
-                .map_or_else(Aabb::empty, |g| g.aabb);
-            let world = local.transformed(&poses[l]);
-            near_cloud(
-                &world,
-                samples.spacing_max[l],
-                cloud,
-                k,
-                &mut stats.broad_phase_nodes,
-                &mut ws.stack,
-            )
-        };
+        let near = !broad_phase
+            || match request.collide.model {
+                // The elements model's own first test: the hierarchies over both
+                // clouds' element hulls (the query reads P = 0 when it fails).
+                QueryModel::Elements => {
+                    let (may, visited) = element_surfaces_may_reach(
+                        link_cloud.elements(),
+                        &poses[l],
+                        cloud.elements(),
+                        k,
+                        &mut ws.bvh,
+                    );
+                    stats.broad_phase_nodes += visited;
+                    may
+                }
+                QueryModel::Points => {
+                    let local = robot.links[l]
+                        .geometry
+                        .as_ref()
+                        .map_or_else(Aabb::empty, |g| g.aabb);
+                    let world = local.transformed(&poses[l]);
+                    near_cloud(
+                        &world,
+                        samples.spacing_max[l],
+                        cloud,
+                        k,
+                        &mut stats.broad_phase_nodes,
+                        &mut ws.stack,
+                    )
+                }
+            };
         if !near {
             links.push(LinkCollision {
                 link: l,

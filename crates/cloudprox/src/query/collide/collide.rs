@@ -94,7 +94,9 @@ pub(crate) fn collide_with_workspace(
     // two can reach each other, the clouds are free.
     let beyond_reach = match elements {
         Some((ea, eb)) if request.use_hierarchy => {
-            !element_surfaces_may_reach(ea, &rel, eb, reach, workspace, &mut stats)
+            let (may, visited) = element_surfaces_may_reach(ea, &rel, eb, reach, workspace);
+            stats.node_pairs_visited += visited;
+            !may
         }
         _ => false,
     };
@@ -166,15 +168,25 @@ pub(crate) fn collide_with_workspace(
                 request,
                 !request.decide_only,
             )?;
+            // The element surfaces' crossings, and whether some crossing pair
+            // lies where the separating surface does not describe it.
+            let crossings = surfaces.map(|(ea, eb)| {
+                let id = Pose::identity();
+                let sep = &fit.classification.separator;
+                element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
+            });
             // A context sample (beyond the noise's reach of the other cloud) that
             // the surface puts on the wrong side shows a surface too rigid for the
-            // patch (a wrapped or saddle-shaped contact): cut it and fit the halves.
+            // patch (a wrapped or saddle-shaped contact): cut it and fit the
+            // halves. So does a crossing element pair the surface does not
+            // describe.
             let misfit = ia
                 .iter()
                 .map(|&i| !core.0[i as usize])
                 .chain(ib.iter().map(|&i| !core.1[i as usize]))
                 .zip(&fit.probabilities)
-                .any(|(context, &p)| context && p >= 0.5);
+                .any(|(context, &p)| context && p >= 0.5)
+                || crossings.as_ref().is_some_and(|c| c.2);
             let big_enough = na >= MIN_CUT_POINTS && pts.len() - na >= MIN_CUT_POINTS;
             if misfit && big_enough {
                 if let Some((l, r)) = cut(&patch, &pa, &pb) {
@@ -187,11 +199,8 @@ pub(crate) fn collide_with_workspace(
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
             let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
-            let (qa, qb) = match (surfaces, request.aggregation) {
-                (Some((ea, eb)), _) => {
-                    let id = Pose::identity();
-                    element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
-                }
+            let (qa, qb) = match (crossings, request.aggregation) {
+                (Some((qa, qb, _)), _) => (qa, qb),
                 (None, Aggregation::Surface) if elements.is_none() => {
                     let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
                         q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()

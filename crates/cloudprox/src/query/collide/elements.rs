@@ -9,13 +9,14 @@ use crate::math::Pose;
 use crate::probability::{
     element_crossing_probabilities, element_pair_within_reach, elements_within_reach, ElementSide,
 };
-use crate::query::collide::QueryStats;
 use crate::Real;
 
 /// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
 /// in the separator's frame; `ib` of B's), that the fitted surface of the
 /// element it stands for crosses the other side's
-/// ([`element_crossing_probabilities`]).
+/// ([`element_crossing_probabilities`]), and whether some pair that would
+/// cross lies where the separating surface does not describe it (the patch is
+/// then cut like a misfit).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn element_crossings(
     ea: &SurfaceElements,
@@ -26,14 +27,14 @@ pub(crate) fn element_crossings(
     pose_b: &Pose,
     sep: &Separator,
     reach_sds: Real,
-) -> (Vec<Real>, Vec<Real>) {
+) -> (Vec<Real>, Vec<Real>, bool) {
     let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
     let (sa, sb) = (
         element_side(ea, &ua, pose_a, 1.0),
         element_side(eb, &ub, pose_b, -1.0),
     );
-    let qa = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
-    let qb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
+    let (qa, undescribed_a) = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
+    let (qb, undescribed_b) = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
     let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
         let owner = els.sample_owner();
         idx.iter()
@@ -44,7 +45,11 @@ pub(crate) fn element_crossings(
             })
             .collect::<Vec<Real>>()
     };
-    (per_sample(ea, ia, &ua, &qa), per_sample(eb, ib, &ub, &qb))
+    (
+        per_sample(ea, ia, &ua, &qa),
+        per_sample(eb, ib, &ub, &qb),
+        undescribed_a || undescribed_b,
+    )
 }
 
 /// Whether some element surface (or single point) of `ea`, at `rel` in `eb`'s
@@ -52,18 +57,17 @@ pub(crate) fn element_crossings(
 /// sampling spacing, of one of `eb` (the hierarchies over both clouds'
 /// element hulls, see [`crate::element`]). When none may, every patch the
 /// query would build is pruned: the clouds are free, and neither the near set
-/// nor a classifier is needed to say so. The node pairs it tests are counted
-/// in `stats`.
+/// nor a classifier is needed to say so. Returns the answer and the number of
+/// node pairs tested.
 pub(crate) fn element_surfaces_may_reach(
     ea: &SurfaceElements,
     rel: &Pose,
     eb: &SurfaceElements,
     reach_sds: Real,
     workspace: &mut BvhWorkspace,
-    stats: &mut QueryStats,
-) -> bool {
+) -> (bool, usize) {
     if !reach_sds.is_finite() {
-        return true;
+        return (true, 0);
     }
     let (ha, hb) = (ea.hulls(), eb.hulls());
     let faces = |i: u32, j: u32| {
@@ -71,9 +75,7 @@ pub(crate) fn element_surfaces_may_reach(
         let b = (&eb.elements()[j as usize], hb.hull(j));
         element_pair_within_reach(a, rel, b, reach_sds)
     };
-    let (may, visited) = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, faces);
-    stats.node_pairs_visited += visited;
-    may
+    surfaces_may_reach(ha, rel, hb, reach_sds, workspace, faces)
 }
 
 /// Whether some sample of `samples` stands for an element of more than one point.

@@ -1,7 +1,10 @@
 //! The probabilistic collision query between two noisy point clouds.
 //!
 //! 0. the samples: each cloud's points (the paper's model, the default) or its
-//!    surface elements ([`crate::element`]), see [`QueryModel`];
+//!    surface elements ([`crate::element`]), see [`QueryModel`]; with
+//!    elements, the hierarchies over both clouds' element hulls first decide
+//!    whether any two surfaces can come within the noise's reach
+//!    (`elements.rs`): if none can, the pair is free without a near set;
 //! 1. the near set: traverse the two hierarchies under the relative pose,
 //!    pruning node pairs whose crossing bound is below `prune_epsilon`
 //!    ([`crate::bvh`]), and keep the samples within the noise's reach of the
@@ -36,5 +39,6 @@ pub use collide_many::collide_many;
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
 };
+pub(crate) use elements::element_surfaces_may_reach;
 pub use request::{CollisionRequest, CollisionRequestBuilder, QueryModel};
 pub use result::{CollisionResult, ContactRegion, QueryStats};
