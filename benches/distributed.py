@@ -42,7 +42,7 @@ def same(r: list[cp.CollisionResult], s: list[cp.CollisionResult]) -> bool:
         and x.state == y.state
         and np.array_equal(x.probabilities_a, y.probabilities_a)
         and np.array_equal(x.probabilities_b, y.probabilities_b)
-        for x, y in zip(r, s)
+        for x, y in zip(r, s, strict=False)
     )
 
 

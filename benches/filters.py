@@ -42,8 +42,9 @@ import platform
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -130,8 +131,14 @@ def make_scene(n_points: int, seed: int = 0) -> Scene:
         (_pose(0.0, (0.5, 0.54, 1.2)), np.array([0.12, 0.06, 0.1])),
     ]
     link_poses = [_pose(0.4, (0.1, 0.1, 1.5)), _pose(0.4, (0.33, 0.26, 1.4))]
-    links = [(cp.Mesh.cuboid(*half), pose) for half, pose in zip(LINKS_HALF, link_poses)]
-    solids = [table, *boxes, *((p, np.array(hx)) for hx, p in zip(LINKS_HALF, link_poses))]
+    links = [
+        (cp.Mesh.cuboid(*half), pose) for half, pose in zip(LINKS_HALF, link_poses, strict=False)
+    ]
+    solids = [
+        table,
+        *boxes,
+        *((p, np.array(hx)) for hx, p in zip(LINKS_HALF, link_poses, strict=False)),
+    ]
     for pose, half in solids:
         depth = np.minimum(depth, _ray_box(dirs, pose, half))
     rng = np.random.default_rng(seed)

@@ -41,14 +41,16 @@ import argparse
 import math
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import itertools
 
 from tabletop import (
     FclChecker,
@@ -100,12 +102,12 @@ def problems(
             starts.append(q)
         elif 0.005 <= d <= 0.03 and link in hand and len(goals) < n:
             goals.append((q, d))
-    return [(s, g, d) for s, (g, d) in zip(starts, goals)]
+    return [(s, g, d) for s, (g, d) in zip(starts, goals, strict=False)]
 
 
 def dense_collides(exact: FclChecker, path: np.ndarray) -> bool:
     """Whether the exact robot meets the exact scene anywhere along the path (1 mm travel)."""
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         if exact.collides(a) or any(exact.collides(q) for q in motion_states(a, b, 0.001)):
             return True
     return exact.collides(path[-1])
@@ -376,7 +378,7 @@ def figure(rows: dict[str, Row], path: Path) -> None:
     }
     colours = ["#4c9a5b", "#c8423b", "#9a9a9a", "#d9c27a"]
     left = np.zeros(len(names))
-    for (label, share), colour in zip(parts.items(), colours):
+    for (label, share), colour in zip(parts.items(), colours, strict=False):
         ax.barh(names, share, left=left, color=colour, label=label)
         left += np.asarray(share)
     ax.invert_yaxis()

@@ -3,7 +3,7 @@
 #   1. `maturin sdist`, unpacked in a temporary folder;
 #   2. a release wheel built from the unpacked sdist alone (so the sdist holds
 #      everything it needs), checked to be an abi3 wheel for the Python floor
-#      that the PyO3 crate is built for (`abi3-py39`: cp39-abi3);
+#      that the PyO3 crate is built for (`abi3-py311`: cp311-abi3);
 #   3. that wheel installed into a fresh virtual environment (`python3 -m venv`),
 #      and `cloudprox demo` run from there, which must write its PNG.
 # One wheel build in all. CARGO_TARGET_DIR defaults to this repository's target/,

@@ -42,7 +42,9 @@ def rigid(rotvec: np.ndarray, t: np.ndarray) -> np.ndarray:
 def assert_non_increasing(sweep, gaps, slack: float = 1e-12) -> None:
     p = [sweep[g].probability for g in gaps]
     assert all(0.0 <= x <= 1.0 for x in p)
-    for (g0, p0), (g1, p1) in zip(zip(gaps, p), zip(gaps[1:], p[1:])):
+    for (g0, p0), (g1, p1) in zip(
+        zip(gaps, p, strict=False), zip(gaps[1:], p[1:], strict=False), strict=False
+    ):
         assert p1 <= p0 + slack, f"P rose from {p0} at {g0} sigma to {p1} at {g1} sigma"
     assert p[0] > p[-1]
 
@@ -237,7 +239,7 @@ def test_collide_many_equals_a_loop(spheres) -> None:
     poses = pose_b @ poses  # A placed relative to B at each gap
     many = cp.collide_many(a, b, poses, pose_b, aggregation="union")
     assert isinstance(many, list) and len(many) == len(poses)
-    for pose, r in zip(poses, many):
+    for pose, r in zip(poses, many, strict=False):
         one = cp.collide(a, b, pose, pose_b, aggregation="union")
         assert r.probability == one.probability
         assert r.state == one.state

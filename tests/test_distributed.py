@@ -47,11 +47,13 @@ def test_collide_many_equals_local(clouds) -> None:
     assert len(remote) == len(local)
     states = {r.state for r in local}
     assert states >= {"free", "collision"}
-    for r, s in zip(local, remote):
+    for r, s in zip(local, remote, strict=False):
         assert_same_result(r, s)
     # Options travel too.
     linear = distributed.collide_many(a, b, poses[:20], pose_b, surface="linear", progress=False)
-    for r, s in zip(cp.collide_many(a, b, poses[:20], pose_b, surface="linear"), linear):
+    for r, s in zip(
+        cp.collide_many(a, b, poses[:20], pose_b, surface="linear"), linear, strict=False
+    ):
         assert_same_result(r, s)
 
 
@@ -61,7 +63,7 @@ def test_mesh_side_and_default_batches(clouds) -> None:
     poses = _poses(40)
     poses[:, 0, 3] -= 0.04
     remote = distributed.collide_many(box, a, poses)
-    for r, s in zip(cp.collide_many(box, a, poses), remote):
+    for r, s in zip(cp.collide_many(box, a, poses), remote, strict=False):
         assert_same_result(r, s)
 
 

@@ -18,7 +18,8 @@ Open3D facts these tests rely on (checked here; measured with open3d 0.20):
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest

@@ -273,7 +273,9 @@ def test_cloudfile_with_normals_and_organized_grid_round_trips(tmp_path: Path) -
     rng = np.random.default_rng(3)
     pts = f32(points(6, seed=3))
     nrm = f32(rng.normal(size=(6, 3)))
-    rows = "\n".join(" ".join(repr(float(v)) for v in (*p, *n)) for p, n in zip(pts, nrm))
+    rows = "\n".join(
+        " ".join(repr(float(v)) for v in (*p, *n)) for p, n in zip(pts, nrm, strict=False)
+    )
     src = tmp_path / "src.pcd"
     src.write_text(
         "VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n"

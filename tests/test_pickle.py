@@ -21,7 +21,7 @@ def assert_same_result(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
     np.testing.assert_array_equal(r.probabilities_a, s.probabilities_a)
     np.testing.assert_array_equal(r.probabilities_b, s.probabilities_b)
     assert len(r.regions) == len(s.regions)
-    for x, y in zip(r.regions, s.regions):
+    for x, y in zip(r.regions, s.regions, strict=False):
         assert (x.component, x.separation, x.probability, x.surface, x.status, x.iterations) == (
             y.component,
             y.separation,
@@ -99,7 +99,7 @@ def test_result_and_region_roundtrip() -> None:
     assert back.stats == result.stats
     assert back.points_a is None and result.points_a is not None
     x = np.random.default_rng(0).normal(0.1, 0.05, (50, 3))
-    for r, s in zip(result.regions, back.regions):
+    for r, s in zip(result.regions, back.regions, strict=False):
         f, g = r.evaluate(x)
         f2, g2 = s.evaluate(x)
         np.testing.assert_array_equal(f, f2)

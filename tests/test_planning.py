@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import itertools
 import os
 import shutil
 from pathlib import Path
@@ -62,7 +63,7 @@ def exact_hits(arm: cp.Robot, path: np.ndarray, steps: int = 101) -> list[tuple[
     box_pose[:3, 3] = BOX_CENTRE
     shapes = {n: cp.ExactShape([m]) for n in arm.link_names if (m := arm.link_mesh(n))}
     hits = []
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         ts = np.linspace(0.0, 1.0, steps)
         qs = a + ts[:, None] * (b - a)
         for name, shape in shapes.items():
@@ -89,7 +90,7 @@ def test_the_planner_goes_around_an_obstacle_the_straight_motion_hits(
     assert np.isfinite(result.length) and result.length > np.linalg.norm(Q1 - Q0)
     lim = arm.joint_limits
     assert np.all(path >= lim[:, 0] - 1e-9) and np.all(path <= lim[:, 1] + 1e-9)
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         m = cp.check_motion(arm, a, b, cloud, max_probability=0.1)
         assert m.safe and m.probability <= 0.1
     for q in path:
@@ -211,7 +212,7 @@ def test_plan_joint_space_with_plain_checks_is_reproducible(ompl: None, planner:
     ]
     for r in runs:
         assert r.solved and r.path is not None
-        assert all(motion_valid(a, b) for a, b in zip(r.path[:-1], r.path[1:]))
+        assert all(motion_valid(a, b) for a, b in zip(r.path[:-1], r.path[1:], strict=False))
         assert r.length > 1.8
     np.testing.assert_array_equal(runs[0].path, runs[1].path)
 
@@ -239,5 +240,5 @@ def test_readme_robot_planning(ompl: None, tmp_path: Path, monkeypatch: pytest.M
     # The straight motion leaves the constraint (the hand sweeps through the box);
     # every segment of the plan keeps it.
     assert not cp.check_motion(robot, q0, q1, scan, base, max_probability=0.01).safe
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         assert cp.check_motion(robot, a, b, scan, base, max_probability=0.01).safe

@@ -28,7 +28,7 @@ def test_kinect_noise_follows_nguyen_et_al() -> None:
     )
     pts = np.array([[0.0, 0.0, 2.0], [1.0, -0.5, 1.5]])
     cov = kinect_covariances(pts, 575.0)
-    for p, c in zip(pts, cov):
+    for p, c in zip(pts, cov, strict=False):
         ray = p / np.linalg.norm(p)
         assert np.allclose(c, c.T)
         stretch = np.linalg.norm(p) / p[2]

@@ -61,7 +61,7 @@ def test_anisotropic_noise_has_its_axial_and_lateral_spread() -> None:
     pts = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.5]])
     model = NoiseModel(0.03, origin=(0.0, 0.0, 2.0), lateral_ratio=0.25)
     cov = model.covariances(pts)
-    for p, c in zip(pts, cov):
+    for p, c in zip(pts, cov, strict=False):
         ray = (p - np.array([0.0, 0.0, 2.0])) / np.linalg.norm(p - np.array([0.0, 0.0, 2.0]))
         assert ray @ c @ ray == pytest.approx(0.03**2)
         side = np.cross(ray, [1.0, 0.0, 0.0])

@@ -509,7 +509,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         f"{len(qs)} configurations: {counts['free']} free, {counts['contact']} contact, "
         f"{counts['collision']} collision, {int(selfc.sum())} self-colliding"
     )
-    for i, (p, s) in enumerate(zip(probabilities, states)):
+    for i, (p, s) in enumerate(zip(probabilities, states, strict=False)):
         console.print(f"  {i}: P = {p:.6g}  {s}{'  self-collision' if selfc[i] else ''}")
     return 0
 

@@ -251,7 +251,7 @@ def plot_collisions(
     fig = Figure(figsize=(1.0 + 6.0 * len(panels), 5.5))
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(1, len(panels), k + 1, projection="3d") for k in range(len(panels))]
-    for ax, panel in zip(axes, panels):
+    for ax, panel in zip(axes, panels, strict=False):
         _draw(ax, panel, bounds, labels, quiet_below)
         ax.view_init(elev=elev, azim=azim)
     fig.colorbar(

@@ -746,14 +746,14 @@ def to_figure(scene: Scene, *, all_points: bool = True) -> Any:
         distance = 2.165 * min(1.0, max(2.0 * focus[1] / size, 0.12))
         eye = centre + distance * np.full(3, 1.0 / math.sqrt(3.0))
         camera = {
-            "center": dict(zip("xyz", centre.tolist())),
-            "eye": dict(zip("xyz", eye.tolist())),
+            "center": dict(zip("xyz", centre.tolist(), strict=False)),
+            "eye": dict(zip("xyz", eye.tolist(), strict=False)),
         }
     fig.update_layout(
         title={"text": scene.title, "x": 0.01, "font": {"size": 15}},
         scene={
             "aspectmode": "manual",
-            "aspectratio": dict(zip("xyz", ((hi - lo) / size).tolist())),
+            "aspectratio": dict(zip("xyz", ((hi - lo) / size).tolist(), strict=False)),
             "camera": camera,
             "xaxis": {"title": {"text": "x (m)"}, "range": [lo[0], hi[0]], **axis},
             "yaxis": {"title": {"text": "y (m)"}, "range": [lo[1], hi[1]], **axis},

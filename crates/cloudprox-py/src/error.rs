@@ -8,7 +8,7 @@
 //!     └── SolverError        (also a RuntimeError)
 //! ```
 //!
-//! `CloudproxError` is made with `create_exception!`. The two others need two bases
+//! `CloudproxError` is made with `create_exception!`. The three others need two bases
 //! each, which `create_exception!` cannot express, so they are made once per
 //! interpreter by calling `type(name, (CloudproxError, builtin), namespace)` and kept
 //! in a [`PyOnceLock`].

@@ -216,8 +216,9 @@ impl PyContactRegion {
         vector3_to_py(py, &self.inner.normal)
     }
 
-    /// Estimated signed separation along the normal (metres), negative when the
-    /// clouds interpenetrate.
+    /// Estimated signed separation of the two surfaces at this patch (metres),
+    /// negative when they interpenetrate: measured along the near region's
+    /// direction of least spread (oriented from A to B), not along ``normal``.
     #[getter]
     fn separation(&self) -> f64 {
         self.inner.separation

@@ -41,8 +41,8 @@ def plot_probability_vs_distance(
     fig = _figure(5.0 * len(panels), 4.2)
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
     colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
-    for ax, (title, sigma, dist, scores) in zip(axes, panels):
-        for (name, s), c in zip(scores.items(), colors):
+    for ax, (title, sigma, dist, scores) in zip(axes, panels, strict=False):
+        for (name, s), c in zip(scores.items(), colors, strict=False):
             x = np.broadcast_to(dist / sigma, s.shape).ravel()
             ax.scatter(x, s.ravel(), s=7, alpha=0.5, color=c, label=name, linewidths=0)
         ax.axvline(0.0, color="k", lw=0.8)
@@ -83,8 +83,8 @@ def plot_reliability(
     fig = _figure(4.2 * len(panels), 4.0)
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
     colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
-    for ax, (title, _sigma, dist, scores) in zip(axes, panels):
-        for (name, s), c in zip(scores.items(), colors):
+    for ax, (title, _sigma, dist, scores) in zip(axes, panels, strict=False):
+        for (name, s), c in zip(scores.items(), colors, strict=False):
             label = np.broadcast_to(dist <= 0.0, s.shape).ravel()
             mean_p, observed, count = reliability(np.clip(s.ravel(), 0.0, 1.0), label)
             ok = count > 0
@@ -128,7 +128,7 @@ def plot_roc(
     """
     fig = _figure(5.0 * len(panels), 4.5)
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
-    for ax, (level, label, scores) in zip(axes, panels):
+    for ax, (level, label, scores) in zip(axes, panels, strict=False):
         for name, s in scores.items():
             y = np.broadcast_to(label, s.shape).ravel()
             fpr, tpr = roc_curve(s.ravel(), y)
@@ -172,7 +172,7 @@ def plot_scan_scene(
     )
     side.scatter(z, -scan[:, 1], s=1.0, color="0.55", linewidths=0)
     cmap = colormaps["coolwarm"]
-    for pose, p in zip(poses[:shown], probability[:shown]):
+    for pose, p in zip(poses[:shown], probability[:shown], strict=False):
         g = gripper @ pose[:3, :3].T + pose[:3, 3]
         front.scatter(g[:, 0], -g[:, 1], s=0.4, color=cmap(float(p)), linewidths=0)
         side.scatter(g[:, 2], -g[:, 1], s=0.4, color=cmap(float(p)), linewidths=0)

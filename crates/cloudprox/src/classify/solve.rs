@@ -1,4 +1,5 @@
-//! Solving the robust SOCP with Clarabel, and the outcome as data.
+//! Solving the robust SOCP (the barrier method, or Clarabel as reference and
+//! fallback), and the outcome as data.
 
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
 
@@ -12,11 +13,11 @@ use crate::Real;
 /// How a classification ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SolveStatus {
-    /// Clarabel converged to the requested tolerance.
+    /// The solver (barrier or Clarabel) converged to the requested tolerance.
     Solved,
     /// Clarabel converged to its reduced tolerance.
     AlmostSolved,
-    /// Clarabel did not converge (iteration limit, numerical trouble); the separator
+    /// Neither solver converged (iteration limit, numerical trouble); the separator
     /// is the fallback plane: normal along the difference of the two class means
     /// (in normalized coordinates), through their midpoint.
     Fallback,

@@ -210,7 +210,7 @@ pub fn near_regions(
     keep_a: &[bool],
     keep_b: &[bool],
 ) -> Vec<Patch> {
-    // Union-find over the leaves that occur: A leaves as 2k, B leaves as 2k + 1.
+    // Union-find over the leaves that occur, keyed by (leaf, whether it is B's).
     let mut id_of: HashMap<(u32, bool), usize> = HashMap::new();
     let mut parent: Vec<usize> = Vec::new();
     let mut node = |key: (u32, bool), parent: &mut Vec<usize>| -> usize {

@@ -23,7 +23,7 @@ pub struct ContactRegion {
     /// direction of least spread (oriented from A to B), as the smallest over lines
     /// through up to 64 of the patch's points of: the median
     /// offset of B's points nearest that line minus that of A's (those within two
-    /// sampling spacings of it, at most 30, at least 3 of each). Medians keep it unbiased by the noise on a
+    /// sampling spacings of it, at most 12, at least 3 of each). Medians keep it unbiased by the noise on a
     /// flat contact; curvature within the sampled neighbourhood biases it upwards.
     pub separation: Real,
     /// The patch's aggregated collision probability.
