@@ -15,9 +15,20 @@
 //! from. Points are then read in batches, so a hostile count never allocates
 //! more than the file can hold. Every error of the crate becomes an
 //! [`Error::Format`] naming the file, with the format `LAS` or `LAZ` (compressed).
+//!
+//! The LAZ decoder can still panic on corrupt compressed points (its arithmetic
+//! decoder has no way to tell them from valid ones). That panic is caught and
+//! becomes an [`Error::Format`] too, and it prints nothing: the first call of
+//! [`read_las`] installs, once per process, a panic hook that stays silent for
+//! panics raised on a thread while it is inside the decoder and hands every
+//! other panic to the hook that was there before. (A hook installed later by
+//! the program replaces it; a decoder panic then prints through that hook, and
+//! is still returned as an error.)
 
+use std::cell::Cell;
 use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Once;
 
 use crate::error::{Error, Result};
 use crate::io::{ByteCursor, CloudData, CloudDataBuilder};
@@ -312,6 +323,44 @@ fn field_names(format: las::point::Format) -> Vec<String> {
     names
 }
 
+thread_local! {
+    /// Whether this thread is inside the `las`/`laz` decoder (see [`quietly`]).
+    static IN_DECODER: Cell<bool> = const { Cell::new(false) };
+}
+
+static QUIET_HOOK: Once = Once::new();
+
+/// Clears [`IN_DECODER`] when the decoder call ends, by return or by unwind.
+struct DecoderScope(bool);
+
+impl Drop for DecoderScope {
+    fn drop(&mut self) {
+        IN_DECODER.with(|f| f.set(self.0));
+    }
+}
+
+/// Runs `f` (a call into the `las` crate) with its panics caught and silent:
+/// a panic is returned as its message, and the panic hook prints nothing for
+/// it. Panics elsewhere, on this thread or others, reach the previous hook.
+fn quietly<T>(f: impl FnOnce() -> T) -> std::result::Result<T, String> {
+    QUIET_HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !IN_DECODER.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let _scope = DecoderScope(IN_DECODER.with(|flag| flag.replace(true)));
+    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default()
+    })
+}
+
 /// Reads a LAS or LAZ file from its bytes; `name` is used in errors.
 ///
 /// # Errors
@@ -321,24 +370,15 @@ fn field_names(format: las::point::Format) -> Vec<String> {
 pub fn read_las(bytes: &[u8], name: &str) -> Result<CloudData> {
     let format = format_name(bytes, name);
     let facts = check_header(bytes, name, format)?;
-    // The crate is not ours: a panic inside it on a corrupt file still becomes
-    // a format error rather than unwinding into the caller.
-    match catch_unwind(AssertUnwindSafe(|| {
-        read_points(bytes, name, format, &facts)
-    })) {
+    // The crate is not ours: a panic inside it on a corrupt file becomes a
+    // format error rather than unwinding into the caller, and prints nothing.
+    match quietly(|| read_points(bytes, name, format, &facts)) {
         Ok(result) => result,
-        Err(payload) => {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(Error::format(
-                name,
-                format,
-                format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
-            ))
-        }
+        Err(what) => Err(Error::format(
+            name,
+            format,
+            format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
+        )),
     }
 }
 
