@@ -174,3 +174,81 @@ fn describe_input() {
         bodies::describe(&target, &data).unwrap_or_else(|| format!("{data:?}"))
     );
 }
+
+/// The error says the data is shorter than the header promises.
+fn short<T: std::fmt::Debug>(r: cloudprox::Result<T>) {
+    match r {
+        Err(cloudprox::Error::Format { problem, .. }) => assert!(
+            problem.contains("truncated") || problem.contains("ends after"),
+            "{problem}"
+        ),
+        other => panic!("expected a format error, got {other:?}"),
+    }
+}
+
+/// Headers that claim 10^12 points (or the largest count the field holds)
+/// over a few bytes of data are errors, and allocate nothing for them: this
+/// test binary runs under the fuzz targets' allocator, which aborts on any
+/// single allocation above 512 MiB.
+#[test]
+fn huge_header_counts_allocate_nothing() {
+    use cloudprox::io::{las, npy, off, pcd, ply, pointcloud2, stl};
+    let t = 1_000_000_000_000u64;
+    let ply_text = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {t}\nproperty float x\n\
+         property float y\nproperty float z\nend_header\n\0\0\0\0\0\0\0\0\0\0\0\0"
+    );
+    short(ply::read_ply(ply_text.as_bytes(), "huge.ply"));
+    for data in ["ascii", "binary", "binary_compressed"] {
+        let pcd_text = format!(
+            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {t}\n\
+             HEIGHT 1\nPOINTS {t}\nDATA {data}\n0 0 0\n"
+        );
+        short(pcd::read_pcd(pcd_text.as_bytes(), "huge.pcd"));
+    }
+    let dict = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({t}, 3), }}");
+    let mut npy_bytes = b"\x93NUMPY\x01\x00".to_vec();
+    let header = format!("{dict:<117}\n");
+    npy_bytes.extend((header.len() as u16).to_le_bytes());
+    npy_bytes.extend(header.as_bytes());
+    npy_bytes.extend([0u8; 48]);
+    short(npy::read_npy(&npy_bytes, "huge.npy"));
+    let off_text = "OFF\n4000000000 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    short(off::read_off_mesh(off_text.as_bytes(), "huge.off"));
+    let mut stl_bytes = vec![0u8; 80];
+    stl_bytes.extend(u32::MAX.to_le_bytes());
+    stl_bytes.extend([0u8; 50]);
+    short(stl::read_stl_mesh(&stl_bytes, "huge.stl"));
+    // LAS 1.4: legacy count 0, 64-bit count 10^12, records of 20 bytes.
+    let mut las_bytes = vec![0u8; 375];
+    las_bytes[..4].copy_from_slice(b"LASF");
+    las_bytes[24] = 1;
+    las_bytes[25] = 4;
+    las_bytes[94..96].copy_from_slice(&375u16.to_le_bytes());
+    las_bytes[96..100].copy_from_slice(&375u32.to_le_bytes());
+    las_bytes[105..107].copy_from_slice(&20u16.to_le_bytes());
+    for k in 0..3 {
+        las_bytes[131 + 8 * k..139 + 8 * k].copy_from_slice(&0.01f64.to_le_bytes());
+    }
+    las_bytes[247..255].copy_from_slice(&t.to_le_bytes());
+    las_bytes.extend([0u8; 40]);
+    short(las::read_las(&las_bytes, "huge.las"));
+    let layout = pointcloud2::PointCloud2Layout {
+        height: u32::MAX,
+        width: u32::MAX / 12,
+        fields: ["x", "y", "z"]
+            .iter()
+            .zip(0u32..)
+            .map(|(n, k)| pointcloud2::PointField {
+                name: (*n).to_string(),
+                offset: 4 * k,
+                datatype: pointcloud2::FLOAT32,
+                count: 1,
+            })
+            .collect(),
+        is_bigendian: false,
+        point_step: 12,
+        row_step: u32::MAX,
+    };
+    short(pointcloud2::read_pointcloud2(&layout, &[0u8; 64]));
+}
