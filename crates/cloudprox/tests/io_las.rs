@@ -267,3 +267,28 @@ fn extended_records_are_checked() {
     let p = problem(read_las(&far, "t.las"), "LAS");
     assert!(p.contains("1 extended records from offset"), "{p}");
 }
+
+/// fuzz target `las` (laspy's `1_4_w_evlr.laz`, mutated): a layered LAZ chunk
+/// (LAS 1.4 point formats) whose layer size reads 4 GiB made the decoder
+/// allocate and zero 4 GiB before it found the data missing. The first
+/// chunk's layer sizes must now fit in the file.
+#[test]
+fn layered_chunk_sizes_must_fit_in_the_file() {
+    for format in [6, 7] {
+        let bytes = write_file((1, 4), format, true);
+        check(&read_las(&bytes, "t.las").unwrap());
+        let start = u32::from_le_bytes(bytes[96..100].try_into().unwrap()) as usize;
+        let record_len = usize::from(u16::from_le_bytes(bytes[105..107].try_into().unwrap()));
+        // Chunk table offset, first point, point count, then the layer sizes.
+        let sizes = start + 8 + record_len + 4;
+        for layer in [0, 1, 8] {
+            let mut big = bytes.clone();
+            let at = sizes + 4 * layer;
+            big[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+            let p = problem(read_las(&big, "t.las"), "LAZ");
+            assert!(p.contains("first chunk's layers add up to"), "{p}");
+        }
+        let p = problem(read_las(&bytes[..sizes + 8], "t.las"), "LAZ");
+        assert!(p.contains("truncated"), "{p}");
+    }
+}

@@ -175,8 +175,11 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
         }
     }
     if compressed {
-        check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
+        let layers = check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
         check_chunk_table(bytes, &mut cur, offset_to_points)?;
+        if let Some(layers) = layers {
+            check_first_layered_chunk(bytes, &mut cur, offset_to_points, record_len, layers)?;
+        }
     }
     Ok(HeaderFacts {
         compressed,
@@ -187,13 +190,15 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
 }
 
 /// The LAZ items (in the `laszip encoded` record) must add up to the point
-/// record length, or the decoder writes past its buffer.
+/// record length, or the decoder writes past its buffer. Returns the number
+/// of layers of each chunk when the points are compressed in layers (LAS 1.4
+/// point formats), `None` otherwise.
 fn check_laszip_items(
     cur: &mut ByteCursor,
     header_size: u16,
     vlrs: u32,
     record_len: u64,
-) -> Result<()> {
+) -> Result<Option<u64>> {
     cur.seek(usize::from(header_size))?;
     // Variable length records: a 54-byte header, then `length` bytes.
     for _ in 0..vlrs {
@@ -209,6 +214,9 @@ fn check_laszip_items(
         if user_id.starts_with(b"laszip encoded") && record_id == 22204 {
             let data = cur.take(length)?;
             let mut items = ByteCursor::new(data, "", "LAZ");
+            let compressor = items
+                .u16_le()
+                .map_err(|_| cur.error("the laszip record is too short"))?;
             items
                 .seek(32)
                 .map_err(|_| cur.error("the laszip record is too short"))?;
@@ -216,8 +224,9 @@ fn check_laszip_items(
                 .u16_le()
                 .map_err(|_| cur.error("the laszip record is too short"))?;
             let mut total = 0u64;
+            let mut layers = 0u64;
             for _ in 0..n {
-                let _kind = items.u16_le();
+                let kind = items.u16_le().unwrap_or(0);
                 let size = items.u16_le().map_err(|_| {
                     cur.error(format!(
                         "the laszip record at offset {start} lists {n} items but is only {length} bytes"
@@ -225,6 +234,15 @@ fn check_laszip_items(
                 })?;
                 let _version = items.u16_le();
                 total += u64::from(size);
+                // Layers per item in laz 0.13: point 14 has 9, RGB 1, RGB+NIR 2,
+                // wave packet 1, extra bytes one per byte.
+                layers += match kind {
+                    10 => 9,
+                    11 | 13 => 1,
+                    12 => 2,
+                    14 => u64::from(size),
+                    _ => 0,
+                };
             }
             if total != record_len {
                 return Err(cur.error(format!(
@@ -232,13 +250,49 @@ fn check_laszip_items(
                      records are {record_len} bytes"
                 )));
             }
-            return Ok(());
+            // Compressor 3: layered and chunked.
+            return Ok((compressor == 3).then_some(layers));
         }
         if cur.take(length).is_err() {
             break;
         }
     }
     // No laszip record: the las crate reports it.
+    Ok(None)
+}
+
+/// A layered chunk starts with its first point (uncompressed), the number of
+/// points and the byte size of every layer; the decoder allocates each layer
+/// at the size it reads (up to 4 GiB each) before it reads the layer. The
+/// sizes of the first chunk must fit in the file.
+fn check_first_layered_chunk(
+    bytes: &[u8],
+    cur: &mut ByteCursor,
+    data_start: u64,
+    record_len: u64,
+    layers: u64,
+) -> Result<()> {
+    let len = bytes.len() as u64;
+    let sizes_at = data_start
+        .checked_add(8 + record_len + 4)
+        .filter(|&p| p.checked_add(4 * layers).is_some_and(|e| e <= len))
+        .ok_or_else(|| {
+            cur.error(format!(
+                "truncated: the first chunk's {layers} layer sizes do not fit in the file \
+                 ({len} bytes)"
+            ))
+        })?;
+    cur.seek(sizes_at as usize)?;
+    let mut total = 0u64;
+    for _ in 0..layers {
+        total += u64::from(cur.u32_le()?);
+    }
+    let left = (cur.remaining()) as u64;
+    if total > left {
+        return Err(cur.error(format!(
+            "truncated: the first chunk's layers add up to {total} bytes, only {left} are left"
+        )));
+    }
     Ok(())
 }
 
