@@ -291,4 +291,12 @@ fn layered_chunk_sizes_must_fit_in_the_file() {
         let p = problem(read_las(&bytes[..sizes + 8], "t.las"), "LAZ");
         assert!(p.contains("truncated"), "{p}");
     }
+    // A layered file without points has no chunk to check.
+    let mut builder = Builder::from((1, 4));
+    let mut point_format = Format::new(6).unwrap();
+    point_format.is_compressed = true;
+    builder.point_format = point_format;
+    let writer = Writer::new(Cursor::new(Vec::new()), builder.into_header().unwrap()).unwrap();
+    let empty = writer.into_inner().unwrap().into_inner();
+    assert_eq!(read_las(&empty, "t.las").unwrap().points.len(), 0);
 }

@@ -177,7 +177,7 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
     if compressed {
         let layers = check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
         check_chunk_table(bytes, &mut cur, offset_to_points)?;
-        if let Some(layers) = layers {
+        if let Some(layers) = layers.filter(|_| count > 0) {
             check_first_layered_chunk(bytes, &mut cur, offset_to_points, record_len, layers)?;
         }
     }
@@ -287,7 +287,7 @@ fn check_first_layered_chunk(
     for _ in 0..layers {
         total += u64::from(cur.u32_le()?);
     }
-    let left = (cur.remaining()) as u64;
+    let left = cur.remaining() as u64;
     if total > left {
         return Err(cur.error(format!(
             "truncated: the first chunk's layers add up to {total} bytes, only {left} are left"
