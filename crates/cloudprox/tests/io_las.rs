@@ -270,7 +270,7 @@ fn extended_records_are_checked() {
 
 /// fuzz target `las` (laspy's `1_4_w_evlr.laz`, mutated): a layered LAZ chunk
 /// (LAS 1.4 point formats) whose layer size reads 4 GiB made the decoder
-/// allocate and zero 4 GiB before it found the data missing. The first
+/// allocate and zero 4 GiB before it found the data missing. Every layered
 /// chunk's layer sizes must now fit in the file.
 #[test]
 fn layered_chunk_sizes_must_fit_in_the_file() {
@@ -286,11 +286,28 @@ fn layered_chunk_sizes_must_fit_in_the_file() {
             let at = sizes + 4 * layer;
             big[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
             let p = problem(read_las(&big, "t.las"), "LAZ");
-            assert!(p.contains("first chunk's layers add up to"), "{p}");
+            assert!(
+                p.contains("the layers of chunk 0") && p.contains("add up to"),
+                "{p}"
+            );
         }
         let p = problem(read_las(&bytes[..sizes + 8], "t.las"), "LAZ");
         assert!(p.contains("truncated"), "{p}");
     }
+    // The second input the fuzzer found: the laszip record's compressor set to
+    // 1 (point-wise). The decoder still decodes the LAS 1.4 items in layers,
+    // without the chunk table offset, so it read its layer sizes 8 bytes
+    // early: from the chunk's layer sizes and data.
+    let bytes = write_file((1, 4), 6, true);
+    let vlr = bytes
+        .windows(14)
+        .position(|w| w == b"laszip encoded")
+        .unwrap()
+        - 2;
+    let mut pointwise = bytes.clone();
+    pointwise[vlr + 54..vlr + 56].copy_from_slice(&1u16.to_le_bytes());
+    let p = problem(read_las(&pointwise, "t.las"), "LAZ");
+    assert!(p.contains("chunk 0"), "{p}");
     // A layered file without points has no chunk to check.
     let mut builder = Builder::from((1, 4));
     let mut point_format = Format::new(6).unwrap();

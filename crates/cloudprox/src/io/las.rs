@@ -11,8 +11,8 @@
 //! signature, finite and non-zero scales, finite offsets, a point count that the
 //! data can hold (an uncompressed file must contain every point record its
 //! header promises; a compressed one must not end early), and the extended
-//! records and LAZ chunk table that the crate would otherwise size its buffers
-//! from. Points are then read in batches, so a hostile count never allocates
+//! records, the LAZ chunk table and the layer sizes of LAS 1.4 LAZ chunks that
+//! the crate would otherwise size its buffers from. Points are then read in batches, so a hostile count never allocates
 //! more than the file can hold. Every error of the crate becomes an
 //! [`Error::Format`] naming the file, with the format `LAS` or `LAZ` (compressed).
 //!
@@ -177,8 +177,15 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
     if compressed {
         let layers = check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
         check_chunk_table(bytes, &mut cur, offset_to_points)?;
-        if let Some(layers) = layers.filter(|_| count > 0) {
-            check_first_layered_chunk(bytes, &mut cur, offset_to_points, record_len, layers)?;
+        if let Some(chunks) = layers {
+            check_layered_chunks(
+                bytes,
+                &mut cur,
+                offset_to_points,
+                record_len,
+                count,
+                &chunks,
+            )?;
         }
     }
     Ok(HeaderFacts {
@@ -190,15 +197,15 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
 }
 
 /// The LAZ items (in the `laszip encoded` record) must add up to the point
-/// record length, or the decoder writes past its buffer. Returns the number
-/// of layers of each chunk when the points are compressed in layers (LAS 1.4
+/// record length, or the decoder writes past its buffer. Returns how the
+/// chunks are laid out when the points are compressed in layers (LAS 1.4
 /// point formats), `None` otherwise.
 fn check_laszip_items(
     cur: &mut ByteCursor,
     header_size: u16,
     vlrs: u32,
     record_len: u64,
-) -> Result<Option<u64>> {
+) -> Result<Option<LayeredChunks>> {
     cur.seek(usize::from(header_size))?;
     // Variable length records: a 54-byte header, then `length` bytes.
     for _ in 0..vlrs {
@@ -250,8 +257,19 @@ fn check_laszip_items(
                      records are {record_len} bytes"
                 )));
             }
-            // Compressor 3: layered and chunked.
-            return Ok((compressor == 3).then_some(layers));
+            // The decoder compresses in layers whenever the items are the
+            // LAS 1.4 ones, whatever the compressor field says.
+            return Ok((layers > 0).then_some(LayeredChunks {
+                layers,
+                // Compressor 1 (point-wise, one chunk) has no chunk table offset.
+                table_offset: compressor != 1,
+                // Offset 12: the number of points in a chunk (u32::MAX: variable).
+                chunk_size: u32::from_le_bytes(
+                    data.get(12..16)
+                        .and_then(|b| b.try_into().ok())
+                        .unwrap_or([0; 4]),
+                ),
+            }));
         }
         if cur.take(length).is_err() {
             break;
@@ -261,37 +279,69 @@ fn check_laszip_items(
     Ok(None)
 }
 
-/// A layered chunk starts with its first point (uncompressed), the number of
-/// points and the byte size of every layer; the decoder allocates each layer
-/// at the size it reads (up to 4 GiB each) before it reads the layer. The
-/// sizes of the first chunk must fit in the file.
-fn check_first_layered_chunk(
+/// How a file compressed in layers lays out its chunks (from its `laszip`
+/// record).
+struct LayeredChunks {
+    /// Layers per chunk.
+    layers: u64,
+    /// Whether the point data starts with the 8-byte chunk table offset.
+    table_offset: bool,
+    /// Points per chunk (`u32::MAX`: each chunk says how many it holds).
+    chunk_size: u32,
+}
+
+/// A layered chunk is its first point (uncompressed), its number of points,
+/// the byte size of each of its layers, then the layers. The decoder
+/// allocates (and zeroes) each layer at the size it reads, up to 4 GiB, before
+/// it reads the layer, so every chunk's sizes must fit in the file. The
+/// chunks are walked in order until they hold the header's point count.
+fn check_layered_chunks(
     bytes: &[u8],
     cur: &mut ByteCursor,
     data_start: u64,
     record_len: u64,
-    layers: u64,
+    count: u64,
+    chunks: &LayeredChunks,
 ) -> Result<()> {
     let len = bytes.len() as u64;
-    let sizes_at = data_start
-        .checked_add(8 + record_len + 4)
-        .filter(|&p| p.checked_add(4 * layers).is_some_and(|e| e <= len))
-        .ok_or_else(|| {
-            cur.error(format!(
-                "truncated: the first chunk's {layers} layer sizes do not fit in the file \
-                 ({len} bytes)"
-            ))
-        })?;
-    cur.seek(sizes_at as usize)?;
-    let mut total = 0u64;
-    for _ in 0..layers {
-        total += u64::from(cur.u32_le()?);
-    }
-    let left = cur.remaining() as u64;
-    if total > left {
-        return Err(cur.error(format!(
-            "truncated: the first chunk's layers add up to {total} bytes, only {left} are left"
-        )));
+    let mut pos = data_start + if chunks.table_offset { 8 } else { 0 };
+    let mut points = 0u64;
+    let mut chunk = 0u64;
+    while points < count {
+        let sizes_at = pos
+            .checked_add(record_len + 4)
+            .filter(|&p| p.checked_add(4 * chunks.layers).is_some_and(|e| e <= len))
+            .ok_or_else(|| {
+                cur.error(format!(
+                    "truncated: chunk {chunk} (from offset {pos}) and its {} layer sizes do \
+                     not fit in the file ({len} bytes)",
+                    chunks.layers
+                ))
+            })?;
+        cur.seek(sizes_at as usize - 4)?;
+        let in_chunk = u64::from(cur.u32_le()?);
+        let mut total = 0u64;
+        for _ in 0..chunks.layers {
+            total += u64::from(cur.u32_le()?);
+        }
+        let left = cur.remaining() as u64;
+        if total > left {
+            return Err(cur.error(format!(
+                "truncated: the layers of chunk {chunk} (from offset {pos}) add up to {total} \
+                 bytes, only {left} are left"
+            )));
+        }
+        let held = if chunks.chunk_size == u32::MAX {
+            in_chunk
+        } else {
+            u64::from(chunks.chunk_size)
+        };
+        if held == 0 {
+            return Err(cur.error(format!("chunk {chunk} (from offset {pos}) holds no point")));
+        }
+        points = points.saturating_add(held);
+        pos = (cur.position() as u64) + total;
+        chunk += 1;
     }
     Ok(())
 }
