@@ -317,3 +317,23 @@ fn layered_chunk_sizes_must_fit_in_the_file() {
     let empty = writer.into_inner().unwrap().into_inner();
     assert_eq!(read_las(&empty, "t.las").unwrap().points.len(), 0);
 }
+
+/// An item whose size is not its type's (here point 10 at 21 bytes and GPS
+/// time at 7: the same total) would have the decoder read past its slices
+/// with unchecked reads in release builds: a format error.
+#[test]
+fn laszip_items_have_their_fixed_sizes() {
+    let bytes = write_file((1, 2), 3, true);
+    let vlr = bytes
+        .windows(14)
+        .position(|w| w == b"laszip encoded")
+        .unwrap()
+        - 2;
+    let items = vlr + 54 + 34;
+    assert_eq!(u16::from_le_bytes([bytes[items], bytes[items + 1]]), 6);
+    let mut odd = bytes.clone();
+    odd[items + 2..items + 4].copy_from_slice(&21u16.to_le_bytes());
+    odd[items + 8..items + 10].copy_from_slice(&7u16.to_le_bytes());
+    let p = problem(read_las(&odd, "t.las"), "LAZ");
+    assert!(p.contains("item of type 6 is 21 bytes, not 20"), "{p}");
+}

@@ -240,6 +240,22 @@ fn check_laszip_items(
                     ))
                 })?;
                 let _version = items.u16_le();
+                // The decoder reads each item's fixed size from the record's
+                // bytes without checking it (unchecked reads in release builds).
+                let fixed = match kind {
+                    6 => Some(20),
+                    7 | 12 => Some(8),
+                    8 | 11 => Some(6),
+                    9 | 13 => Some(29),
+                    10 => Some(30),
+                    _ => None,
+                };
+                if fixed.is_some_and(|f| f != size) {
+                    return Err(cur.error(format!(
+                        "the laszip record's item of type {kind} is {size} bytes, not {}",
+                        fixed.unwrap_or(0)
+                    )));
+                }
                 total += u64::from(size);
                 // Layers per item in laz 0.13: point 14 has 9, RGB 1, RGB+NIR 2,
                 // wave packet 1, extra bytes one per byte.
