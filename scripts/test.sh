@@ -17,7 +17,7 @@ cargo clippy --workspace --all-targets -- -D warnings
 step "cargo doc (core crate, warnings as errors: missing docs, broken links)"
 RUSTDOCFLAGS="-D warnings" cargo doc -p cloudprox --no-deps --quiet
 
-step "cargo test (core crate: unit, integration, doc tests)"
+step "cargo test (core crate: unit, integration, doc tests; the fuzz smoke run, tests/fuzz_smoke.rs)"
 cargo test -p cloudprox
 
 step "system packages (Open3D's libraries, apt lists for the Kinect frame)"

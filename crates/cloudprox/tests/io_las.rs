@@ -267,3 +267,73 @@ fn extended_records_are_checked() {
     let p = problem(read_las(&far, "t.las"), "LAS");
     assert!(p.contains("1 extended records from offset"), "{p}");
 }
+
+/// fuzz target `las` (laspy's `1_4_w_evlr.laz`, mutated): a layered LAZ chunk
+/// (LAS 1.4 point formats) whose layer size reads 4 GiB made the decoder
+/// allocate and zero 4 GiB before it found the data missing. Every layered
+/// chunk's layer sizes must now fit in the file.
+#[test]
+fn layered_chunk_sizes_must_fit_in_the_file() {
+    for format in [6, 7] {
+        let bytes = write_file((1, 4), format, true);
+        check(&read_las(&bytes, "t.las").unwrap());
+        let start = u32::from_le_bytes(bytes[96..100].try_into().unwrap()) as usize;
+        let record_len = usize::from(u16::from_le_bytes(bytes[105..107].try_into().unwrap()));
+        // Chunk table offset, first point, point count, then the layer sizes.
+        let sizes = start + 8 + record_len + 4;
+        for layer in [0, 1, 8] {
+            let mut big = bytes.clone();
+            let at = sizes + 4 * layer;
+            big[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+            let p = problem(read_las(&big, "t.las"), "LAZ");
+            assert!(
+                p.contains("the layers of chunk 0") && p.contains("add up to"),
+                "{p}"
+            );
+        }
+        let p = problem(read_las(&bytes[..sizes + 8], "t.las"), "LAZ");
+        assert!(p.contains("truncated"), "{p}");
+    }
+    // The second input the fuzzer found: the laszip record's compressor set to
+    // 1 (point-wise). The decoder still decodes the LAS 1.4 items in layers,
+    // without the chunk table offset, so it read its layer sizes 8 bytes
+    // early: from the chunk's layer sizes and data.
+    let bytes = write_file((1, 4), 6, true);
+    let vlr = bytes
+        .windows(14)
+        .position(|w| w == b"laszip encoded")
+        .unwrap()
+        - 2;
+    let mut pointwise = bytes.clone();
+    pointwise[vlr + 54..vlr + 56].copy_from_slice(&1u16.to_le_bytes());
+    let p = problem(read_las(&pointwise, "t.las"), "LAZ");
+    assert!(p.contains("chunk 0"), "{p}");
+    // A layered file without points has no chunk to check.
+    let mut builder = Builder::from((1, 4));
+    let mut point_format = Format::new(6).unwrap();
+    point_format.is_compressed = true;
+    builder.point_format = point_format;
+    let writer = Writer::new(Cursor::new(Vec::new()), builder.into_header().unwrap()).unwrap();
+    let empty = writer.into_inner().unwrap().into_inner();
+    assert_eq!(read_las(&empty, "t.las").unwrap().points.len(), 0);
+}
+
+/// An item whose size is not its type's (here point 10 at 21 bytes and GPS
+/// time at 7: the same total) would have the decoder read past its slices
+/// with unchecked reads in release builds: a format error.
+#[test]
+fn laszip_items_have_their_fixed_sizes() {
+    let bytes = write_file((1, 2), 3, true);
+    let vlr = bytes
+        .windows(14)
+        .position(|w| w == b"laszip encoded")
+        .unwrap()
+        - 2;
+    let items = vlr + 54 + 34;
+    assert_eq!(u16::from_le_bytes([bytes[items], bytes[items + 1]]), 6);
+    let mut odd = bytes.clone();
+    odd[items + 2..items + 4].copy_from_slice(&21u16.to_le_bytes());
+    odd[items + 8..items + 10].copy_from_slice(&7u16.to_le_bytes());
+    let p = problem(read_las(&odd, "t.las"), "LAZ");
+    assert!(p.contains("item of type 6 is 21 bytes, not 20"), "{p}");
+}

@@ -84,6 +84,12 @@ impl Clone for PointCloud {
     }
 }
 
+/// The largest magnitude of a coordinate (metres) a [`PointCloud`] accepts, and
+/// of a pose's translation in a query: a million kilometres. Beyond it squared
+/// distances, quadric features and variances can overflow to infinity, and the
+/// probabilities would be NaN.
+pub const MAX_COORDINATE: Real = 1e9;
+
 fn validate_points(points: &[Point3]) -> Result<()> {
     if points.is_empty() {
         return Err(Error::invalid("point cloud is empty"));
@@ -97,6 +103,28 @@ fn validate_points(points: &[Point3]) -> Result<()> {
             points[i].coords.as_slice()
         )));
     }
+    if let Some(i) = points.iter().position(|p| p.coords.amax() > MAX_COORDINATE) {
+        return Err(Error::invalid(format!(
+            "point {i} has a coordinate beyond +-{MAX_COORDINATE:e} m: {:?}",
+            points[i].coords.as_slice()
+        )));
+    }
+    Ok(())
+}
+
+/// Covariances whose entries reach beyond `MAX_COORDINATE^2` (a standard
+/// deviation beyond [`MAX_COORDINATE`]) overflow in the same way.
+fn validate_covariance_scale(covariances: &[Matrix3]) -> Result<()> {
+    let limit = MAX_COORDINATE * MAX_COORDINATE;
+    if let Some(i) = covariances
+        .iter()
+        .position(|c| c.iter().any(|x| !x.is_finite()) || c.amax() > limit)
+    {
+        return Err(Error::invalid(format!(
+            "point {i}: covariance entry {:e} is beyond ({MAX_COORDINATE:e} m)^2",
+            covariances[i].amax()
+        )));
+    }
     Ok(())
 }
 
@@ -106,6 +134,7 @@ impl PointCloud {
     pub fn new(points: Vec<Point3>, noise: &NoiseModel) -> Result<Self> {
         validate_points(&points)?;
         let covariances = noise.covariances(&points)?;
+        validate_covariance_scale(&covariances)?;
         let rho = match noise {
             NoiseModel::Sensor(model, viewpoint) => model.noise_correlation(&points, viewpoint)?,
             _ => 0.0,

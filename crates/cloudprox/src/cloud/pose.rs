@@ -6,8 +6,9 @@ use nalgebra::{Rotation3, Translation3, UnitQuaternion};
 
 /// The rigid pose of a 4x4 homogeneous matrix `[R t; 0 0 0 1]`.
 ///
-/// Rejects non-finite entries, a last row other than `[0, 0, 0, 1]`, and an `R`
-/// that is not a rotation (`|R^T R - I| > 1e-6` or `det R < 0`, i.e. scaling,
+/// Rejects non-finite entries, a translation beyond
+/// [`MAX_COORDINATE`](crate::cloud::MAX_COORDINATE), a last row other than
+/// `[0, 0, 0, 1]`, and an `R` that is not a rotation (`|R^T R - I| > 1e-6` or `det R < 0`, i.e. scaling,
 /// shear or a reflection). Rotations within that tolerance are re-orthonormalized.
 pub fn pose_from_matrix(m: &Matrix4) -> Result<Pose> {
     if m.iter().any(|x| !x.is_finite()) {
@@ -32,6 +33,13 @@ pub fn pose_from_matrix(m: &Matrix4) -> Result<Pose> {
     // rotation, the nearest unit quaternion for one within the tolerance.
     let rot = Rotation3::from_matrix_unchecked(r);
     let t: Vector3 = m.fixed_view::<3, 1>(0, 3).into_owned();
+    if t.amax() > crate::cloud::MAX_COORDINATE {
+        return Err(Error::invalid(format!(
+            "pose's translation {:?} is beyond +-{:e} m",
+            t.as_slice(),
+            crate::cloud::MAX_COORDINATE
+        )));
+    }
     Ok(Pose::from_parts(
         Translation3::from(t),
         UnitQuaternion::new_normalize(*UnitQuaternion::from_rotation_matrix(&rot).quaternion()),
@@ -41,6 +49,28 @@ pub fn pose_from_matrix(m: &Matrix4) -> Result<Pose> {
 /// The 4x4 homogeneous matrix of a pose.
 pub fn pose_to_matrix(pose: &Pose) -> Matrix4 {
     pose.to_homogeneous()
+}
+
+/// Checks a query's pose: finite, with a unit rotation and a translation within
+/// [`MAX_COORDINATE`](crate::cloud::MAX_COORDINATE) (a `Pose` built from parts
+/// can hold NaN or an overflowing translation; `what` names it in the error).
+pub(crate) fn validate_pose(pose: &Pose, what: &str) -> Result<()> {
+    let q = pose.rotation.quaternion();
+    if !(q.coords.iter().all(|c| c.is_finite()) && (q.norm() - 1.0).abs() < 1e-6) {
+        return Err(Error::invalid(format!(
+            "{what}: the rotation is not a finite unit quaternion ({:?})",
+            q.coords.as_slice()
+        )));
+    }
+    let t = &pose.translation.vector;
+    if t.iter().any(|c| !c.is_finite()) || t.amax() > crate::cloud::MAX_COORDINATE {
+        return Err(Error::invalid(format!(
+            "{what}: the translation {:?} is not finite or beyond +-{:e} m",
+            t.as_slice(),
+            crate::cloud::MAX_COORDINATE
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

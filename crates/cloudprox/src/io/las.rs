@@ -11,13 +11,24 @@
 //! signature, finite and non-zero scales, finite offsets, a point count that the
 //! data can hold (an uncompressed file must contain every point record its
 //! header promises; a compressed one must not end early), and the extended
-//! records and LAZ chunk table that the crate would otherwise size its buffers
-//! from. Points are then read in batches, so a hostile count never allocates
+//! records, the LAZ chunk table and the layer sizes of LAS 1.4 LAZ chunks that
+//! the crate would otherwise size its buffers from. Points are then read in batches, so a hostile count never allocates
 //! more than the file can hold. Every error of the crate becomes an
 //! [`Error::Format`] naming the file, with the format `LAS` or `LAZ` (compressed).
+//!
+//! The LAZ decoder can still panic on corrupt compressed points (its arithmetic
+//! decoder has no way to tell them from valid ones). That panic is caught and
+//! becomes an [`Error::Format`] too, and it prints nothing: the first call of
+//! [`read_las`] installs, once per process, a panic hook that stays silent for
+//! panics raised on a thread while it is inside the decoder and hands every
+//! other panic to the hook that was there before. (A hook installed later by
+//! the program replaces it; a decoder panic then prints through that hook, and
+//! is still returned as an error.)
 
+use std::cell::Cell;
 use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Once;
 
 use crate::error::{Error, Result};
 use crate::io::{ByteCursor, CloudData, CloudDataBuilder};
@@ -164,8 +175,18 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
         }
     }
     if compressed {
-        check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
+        let layers = check_laszip_items(&mut cur, header_size, vlrs, record_len)?;
         check_chunk_table(bytes, &mut cur, offset_to_points)?;
+        if let Some(chunks) = layers {
+            check_layered_chunks(
+                bytes,
+                &mut cur,
+                offset_to_points,
+                record_len,
+                count,
+                &chunks,
+            )?;
+        }
     }
     Ok(HeaderFacts {
         compressed,
@@ -176,13 +197,15 @@ fn check_header(bytes: &[u8], name: &str, format: &'static str) -> Result<Header
 }
 
 /// The LAZ items (in the `laszip encoded` record) must add up to the point
-/// record length, or the decoder writes past its buffer.
+/// record length, or the decoder writes past its buffer. Returns how the
+/// chunks are laid out when the points are compressed in layers (LAS 1.4
+/// point formats), `None` otherwise.
 fn check_laszip_items(
     cur: &mut ByteCursor,
     header_size: u16,
     vlrs: u32,
     record_len: u64,
-) -> Result<()> {
+) -> Result<Option<LayeredChunks>> {
     cur.seek(usize::from(header_size))?;
     // Variable length records: a 54-byte header, then `length` bytes.
     for _ in 0..vlrs {
@@ -198,6 +221,9 @@ fn check_laszip_items(
         if user_id.starts_with(b"laszip encoded") && record_id == 22204 {
             let data = cur.take(length)?;
             let mut items = ByteCursor::new(data, "", "LAZ");
+            let compressor = items
+                .u16_le()
+                .map_err(|_| cur.error("the laszip record is too short"))?;
             items
                 .seek(32)
                 .map_err(|_| cur.error("the laszip record is too short"))?;
@@ -205,15 +231,41 @@ fn check_laszip_items(
                 .u16_le()
                 .map_err(|_| cur.error("the laszip record is too short"))?;
             let mut total = 0u64;
+            let mut layers = 0u64;
             for _ in 0..n {
-                let _kind = items.u16_le();
+                let kind = items.u16_le().unwrap_or(0);
                 let size = items.u16_le().map_err(|_| {
                     cur.error(format!(
                         "the laszip record at offset {start} lists {n} items but is only {length} bytes"
                     ))
                 })?;
                 let _version = items.u16_le();
+                // The decoder reads each item's fixed size from the record's
+                // bytes without checking it (unchecked reads in release builds).
+                let fixed = match kind {
+                    6 => Some(20),
+                    7 | 12 => Some(8),
+                    8 | 11 => Some(6),
+                    9 | 13 => Some(29),
+                    10 => Some(30),
+                    _ => None,
+                };
+                if fixed.is_some_and(|f| f != size) {
+                    return Err(cur.error(format!(
+                        "the laszip record's item of type {kind} is {size} bytes, not {}",
+                        fixed.unwrap_or(0)
+                    )));
+                }
                 total += u64::from(size);
+                // Layers per item in laz 0.13: point 14 has 9, RGB 1, RGB+NIR 2,
+                // wave packet 1, extra bytes one per byte.
+                layers += match kind {
+                    10 => 9,
+                    11 | 13 => 1,
+                    12 => 2,
+                    14 => u64::from(size),
+                    _ => 0,
+                };
             }
             if total != record_len {
                 return Err(cur.error(format!(
@@ -221,13 +273,92 @@ fn check_laszip_items(
                      records are {record_len} bytes"
                 )));
             }
-            return Ok(());
+            // The decoder compresses in layers whenever the items are the
+            // LAS 1.4 ones, whatever the compressor field says.
+            return Ok((layers > 0).then_some(LayeredChunks {
+                layers,
+                // Compressor 1 (point-wise, one chunk) has no chunk table offset.
+                table_offset: compressor != 1,
+                // Offset 12: the number of points in a chunk (u32::MAX: variable).
+                chunk_size: u32::from_le_bytes(
+                    data.get(12..16)
+                        .and_then(|b| b.try_into().ok())
+                        .unwrap_or([0; 4]),
+                ),
+            }));
         }
         if cur.take(length).is_err() {
             break;
         }
     }
     // No laszip record: the las crate reports it.
+    Ok(None)
+}
+
+/// How a file compressed in layers lays out its chunks (from its `laszip`
+/// record).
+struct LayeredChunks {
+    /// Layers per chunk.
+    layers: u64,
+    /// Whether the point data starts with the 8-byte chunk table offset.
+    table_offset: bool,
+    /// Points per chunk (`u32::MAX`: each chunk says how many it holds).
+    chunk_size: u32,
+}
+
+/// A layered chunk is its first point (uncompressed), its number of points,
+/// the byte size of each of its layers, then the layers. The decoder
+/// allocates (and zeroes) each layer at the size it reads, up to 4 GiB, before
+/// it reads the layer, so every chunk's sizes must fit in the file. The
+/// chunks are walked in order until they hold the header's point count.
+fn check_layered_chunks(
+    bytes: &[u8],
+    cur: &mut ByteCursor,
+    data_start: u64,
+    record_len: u64,
+    count: u64,
+    chunks: &LayeredChunks,
+) -> Result<()> {
+    let len = bytes.len() as u64;
+    let mut pos = data_start + if chunks.table_offset { 8 } else { 0 };
+    let mut points = 0u64;
+    let mut chunk = 0u64;
+    while points < count {
+        let sizes_at = pos
+            .checked_add(record_len + 4)
+            .filter(|&p| p.checked_add(4 * chunks.layers).is_some_and(|e| e <= len))
+            .ok_or_else(|| {
+                cur.error(format!(
+                    "truncated: chunk {chunk} (from offset {pos}) and its {} layer sizes do \
+                     not fit in the file ({len} bytes)",
+                    chunks.layers
+                ))
+            })?;
+        cur.seek(sizes_at as usize - 4)?;
+        let in_chunk = u64::from(cur.u32_le()?);
+        let mut total = 0u64;
+        for _ in 0..chunks.layers {
+            total += u64::from(cur.u32_le()?);
+        }
+        let left = cur.remaining() as u64;
+        if total > left {
+            return Err(cur.error(format!(
+                "truncated: the layers of chunk {chunk} (from offset {pos}) add up to {total} \
+                 bytes, only {left} are left"
+            )));
+        }
+        let held = if chunks.chunk_size == u32::MAX {
+            in_chunk
+        } else {
+            u64::from(chunks.chunk_size)
+        };
+        if held == 0 {
+            return Err(cur.error(format!("chunk {chunk} (from offset {pos}) holds no point")));
+        }
+        points = points.saturating_add(held);
+        pos = (cur.position() as u64) + total;
+        chunk += 1;
+    }
     Ok(())
 }
 
@@ -312,6 +443,44 @@ fn field_names(format: las::point::Format) -> Vec<String> {
     names
 }
 
+thread_local! {
+    /// Whether this thread is inside the `las`/`laz` decoder (see [`quietly`]).
+    static IN_DECODER: Cell<bool> = const { Cell::new(false) };
+}
+
+static QUIET_HOOK: Once = Once::new();
+
+/// Clears [`IN_DECODER`] when the decoder call ends, by return or by unwind.
+struct DecoderScope(bool);
+
+impl Drop for DecoderScope {
+    fn drop(&mut self) {
+        IN_DECODER.with(|f| f.set(self.0));
+    }
+}
+
+/// Runs `f` (a call into the `las` crate) with its panics caught and silent:
+/// a panic is returned as its message, and the panic hook prints nothing for
+/// it. Panics elsewhere, on this thread or others, reach the previous hook.
+fn quietly<T>(f: impl FnOnce() -> T) -> std::result::Result<T, String> {
+    QUIET_HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !IN_DECODER.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let _scope = DecoderScope(IN_DECODER.with(|flag| flag.replace(true)));
+    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default()
+    })
+}
+
 /// Reads a LAS or LAZ file from its bytes; `name` is used in errors.
 ///
 /// # Errors
@@ -321,24 +490,15 @@ fn field_names(format: las::point::Format) -> Vec<String> {
 pub fn read_las(bytes: &[u8], name: &str) -> Result<CloudData> {
     let format = format_name(bytes, name);
     let facts = check_header(bytes, name, format)?;
-    // The crate is not ours: a panic inside it on a corrupt file still becomes
-    // a format error rather than unwinding into the caller.
-    match catch_unwind(AssertUnwindSafe(|| {
-        read_points(bytes, name, format, &facts)
-    })) {
+    // The crate is not ours: a panic inside it on a corrupt file becomes a
+    // format error rather than unwinding into the caller, and prints nothing.
+    match quietly(|| read_points(bytes, name, format, &facts)) {
         Ok(result) => result,
-        Err(payload) => {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(Error::format(
-                name,
-                format,
-                format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
-            ))
-        }
+        Err(what) => Err(Error::format(
+            name,
+            format,
+            format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
+        )),
     }
 }
 

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use crate::bvh::BvhWorkspace;
 use crate::classify::{SocpSolver, SolveStatus};
-use crate::cloud::PointCloud;
+use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{crossing_probabilities, normal_quantile, Aggregation};
@@ -75,6 +75,8 @@ pub(crate) fn collide_with_workspace(
     workspace: &mut BvhWorkspace,
 ) -> Result<CollisionResult> {
     request.validate()?;
+    validate_pose(pose_a, "pose_a")?;
+    validate_pose(pose_b, "pose_b")?;
     let start = Instant::now();
     let mut stats = QueryStats::default();
     // Pose of A in B's frame: all the work happens in B's frame.

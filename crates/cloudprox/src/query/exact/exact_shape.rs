@@ -3,6 +3,7 @@
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 
 use crate::bvh::Aabb;
+use crate::cloud::MAX_COORDINATE;
 use crate::error::{Error, Result};
 use crate::shape::Mesh;
 use crate::Real;
@@ -49,8 +50,9 @@ impl ExactShape {
     /// closed: closed convex parts get GJK/EPA, other closed parts containment.
     ///
     /// # Errors
-    /// [`Error::InvalidInput`] if there is no part, or parry rejects a part (the
-    /// message names the part and parry's reason).
+    /// [`Error::InvalidInput`] if there is no part, a vertex is beyond
+    /// [`MAX_COORDINATE`], or parry rejects a part (the message names the part
+    /// and parry's reason).
     pub fn new(parts: &[Mesh]) -> Result<Self> {
         Self::build(parts, true)
     }
@@ -72,6 +74,17 @@ impl ExactShape {
         }
         let mut out = Vec::with_capacity(parts.len());
         for (i, m) in parts.iter().enumerate() {
+            // parry asserts (panics) on the degenerate projections that
+            // overflowing coordinates produce.
+            if let Some(v) = m
+                .vertices()
+                .iter()
+                .position(|v| v.coords.amax() > MAX_COORDINATE)
+            {
+                return Err(Error::invalid(format!(
+                    "part {i}: vertex {v} is beyond +-{MAX_COORDINATE:e} m"
+                )));
+            }
             let diag = m.aabb().half_extents().norm() * 2.0;
             let part = if solid && m.is_convex(CONVEX_TOLERANCE * diag.max(Real::MIN_POSITIVE)) {
                 let c = ConvexPolyhedron::from_convex_mesh(m.vertices().to_vec(), m.faces())
