@@ -136,7 +136,11 @@ def test_points_round_trip(tmp_path: Path, case: tuple[str, str | None]) -> None
     assert got.fields == ["x", "y", "z"]
     assert got.normals is None
     assert got.covariances is None
-    assert got.sensor_pose is None
+    if ext == "pcd":  # the default VIEWPOINT: the sensor at the origin
+        assert got.sensor_pose_is_default
+        np.testing.assert_array_equal(got.sensor_pose, np.eye(4))
+    else:
+        assert got.sensor_pose is None and not got.sensor_pose_is_default
     assert got.grid_shape is None
     assert got.pixels is None
     assert got.skipped == 0
@@ -385,7 +389,9 @@ def test_cloudprox_reads_what_open3d_writes(
         assert got.normals is not None
         np.testing.assert_array_equal(got.normals, f32(nrm))
         assert got.fields == ["x", "y", "z", "normal_x", "normal_y", "normal_z"]
-        assert got.sensor_pose is None  # Open3D writes the identity VIEWPOINT
+        # Open3D writes the identity VIEWPOINT: PCL's default, the origin.
+        assert got.sensor_pose_is_default
+        np.testing.assert_array_equal(got.sensor_pose, np.eye(4))
     elif name == "binary.ply":
         np.testing.assert_array_equal(got.points, pts)
         assert got.normals is not None
@@ -631,14 +637,34 @@ def test_cloudfile_made_for_writing(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     "viewpoint", ["VIEWPOINT 0 0 0 1 0 0 0\n", ""], ids=["identity-viewpoint", "no-viewpoint"]
 )
-def test_sensor_without_viewpoint(tmp_path: Path, viewpoint: str) -> None:
+def test_default_viewpoint_is_the_sensor_at_the_origin(
+    tmp_path: Path, viewpoint: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A raw sensor frame (a VLP-16 scan, a depth image) is written with PCL's
+    # default VIEWPOINT, or none: the sensor at the origin, as PCL reads it.
     path = tmp_path / "plain.pcd"
     path.write_text(
         "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
         f"{viewpoint}POINTS 2\nDATA ascii\n0 0 1\n0.5 0 2\n"
     )
     cf = cp.io.read_point_cloud(path)
-    assert cf.sensor_pose is None
+    assert cf.sensor_pose_is_default
+    np.testing.assert_array_equal(cf.sensor_pose, np.eye(4))
+    cam = cp.Lidar()
+    cloud = cf.to_point_cloud(sensor=cam, discretization=False)
+    np.testing.assert_array_equal(cloud.covariances, cam.covariances(cf.points, [0.0, 0.0, 0.0]))
+    # `cloudprox info` says the pose is the format's default.
+    from cloudprox.cli import main
+
+    assert main(["info", str(path)]) == 0
+    assert "the PCD default VIEWPOINT" in capsys.readouterr().out
+
+
+def test_sensor_without_viewpoint(tmp_path: Path) -> None:
+    path = tmp_path / "plain.xyz"
+    path.write_text("0 0 1\n0.5 0 2\n")
+    cf = cp.io.read_point_cloud(path)
+    assert cf.sensor_pose is None and not cf.sensor_pose_is_default
     with pytest.raises(InvalidInputError, match="records no sensor viewpoint") as exc:
         cf.to_point_cloud(sensor=cp.DepthCamera())
     assert str(path) in str(exc.value)

@@ -120,12 +120,13 @@ def test_pcd(name: str) -> None:
         if truth["nonfinite"] == 0:
             np.testing.assert_array_equal(cf.pixels, np.arange(n_finite))
     viewpoint: tuple[float, ...] | None = truth["viewpoint"]  # type: ignore[assignment]
-    if viewpoint is None or tuple(viewpoint) == IDENTITY_VIEWPOINT:
-        # PCL writes the identity when it knows no viewpoint: "no sensor pose".
-        assert cf.sensor_pose is None
-    else:
-        assert cf.sensor_pose is not None
-        np.testing.assert_allclose(cf.sensor_pose, viewpoint_pose(viewpoint), atol=1e-12)
+    # PCL reads a VIEWPOINT, the default identity included (written or left
+    # out), as the sensor pose.
+    assert cf.sensor_pose is not None
+    default = viewpoint is None or tuple(viewpoint) == IDENTITY_VIEWPOINT
+    assert cf.sensor_pose_is_default == default
+    want = np.eye(4) if viewpoint is None else viewpoint_pose(viewpoint)
+    np.testing.assert_allclose(cf.sensor_pose, want, atol=1e-12)
 
 
 @pytest.mark.parametrize("name", cases("pcd"))

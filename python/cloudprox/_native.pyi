@@ -869,7 +869,16 @@ class CloudFile:
         """Per-point covariances ``(n, 3, 3)`` stored in the file, or ``None``."""
     @property
     def sensor_pose(self) -> _FloatArray | None:
-        """The sensor's pose ``(4, 4)`` recorded in the file (PCD ``VIEWPOINT``), or ``None``."""
+        """The sensor's pose ``(4, 4)`` recorded in the file (PCD ``VIEWPOINT``), or ``None``.
+
+        A PCD that leaves ``VIEWPOINT`` at the format's default reads as the identity.
+        """
+    @property
+    def sensor_pose_is_default(self) -> bool:
+        """Whether ``sensor_pose`` is the PCD default ``VIEWPOINT`` (the identity).
+
+        Written or left out, it is the sensor at the origin looking along +z.
+        """
     @property
     def grid_shape(self) -> tuple[int, int] | None:
         """``(height, width)`` of an organized cloud, or ``None``."""

@@ -583,6 +583,7 @@ def file_info(path: str) -> dict[str, Any]:
         "has_normals": scan.normals is not None,
         "has_covariances": scan.covariances is not None,
         "sensor_pose": None if scan.sensor_pose is None else np.asarray(scan.sensor_pose).tolist(),
+        "sensor_pose_is_default": scan.sensor_pose_is_default,
     }
     if len(pts):
         info["bounds"] = [pts.min(axis=0).tolist(), pts.max(axis=0).tolist()]
@@ -619,6 +620,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
             )
         elif key == "sensor_pose" and value is not None:
             value = "origin (" + ", ".join(f"{row[3]:.4g}" for row in value[:3]) + ")"
+            if info.get("sensor_pose_is_default"):
+                value += ", the PCD default VIEWPOINT (identity)"
+        elif key == "sensor_pose_is_default":
+            continue
         elif key == "fields":
             value = " ".join(value)
         elif isinstance(value, float):

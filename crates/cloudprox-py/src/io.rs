@@ -301,7 +301,8 @@ impl PyCloudFile {
             .transpose()
     }
 
-    /// The sensor's pose `(4, 4)` recorded in the file (PCD `VIEWPOINT`), or `None`.
+    /// The sensor's pose `(4, 4)` recorded in the file (PCD `VIEWPOINT`, the
+    /// identity when the file leaves it at the format's default), or `None`.
     #[getter]
     fn sensor_pose<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
         self.data
@@ -309,6 +310,13 @@ impl PyCloudFile {
             .as_ref()
             .map(|p| pose_py(py, p))
             .transpose()
+    }
+
+    /// Whether `sensor_pose` is the PCD format's default `VIEWPOINT` (the
+    /// identity, written or left out): the sensor at the origin looking along +z.
+    #[getter]
+    fn sensor_pose_is_default(&self) -> bool {
+        self.data.sensor_is_default
     }
 
     /// `(height, width)` of an organized cloud, or `None`.

@@ -83,9 +83,14 @@ fn assert_pose_close(a: &Pose, b: &Pose) {
 }
 
 /// The cloud as the writer stores it: points and normals as `f32`,
-/// covariances exact.
+/// covariances exact; no sensor pose becomes the default `VIEWPOINT` (the
+/// identity), which reads back as the sensor at the origin.
 fn rounded(cloud: &CloudData) -> CloudData {
     let mut c = cloud.clone();
+    if c.sensor.is_none() {
+        c.sensor = Some(Pose::identity());
+        c.sensor_is_default = true;
+    }
     for p in &mut c.points {
         *p = p.map(|v| f64::from(v as f32));
     }
@@ -165,7 +170,7 @@ fn compressor_shrinks_repetitive_clouds() {
     let cloud = CloudData::from_points(vec![Point3::new(1.0, 2.0, 3.0); 1000]);
     let bytes = write_pcd(&cloud, Encoding::BinaryCompressed).unwrap();
     assert!(bytes.len() < 2000, "{} bytes", bytes.len());
-    assert_eq!(read_pcd(&bytes, "t.pcd").unwrap(), cloud);
+    assert_eq!(read_pcd(&bytes, "t.pcd").unwrap(), rounded(&cloud));
 }
 
 const ORGANIZED: &str = "# .PCD v0.7 - Point Cloud Data file format
@@ -208,12 +213,17 @@ fn organized_with_nan_holes_and_viewpoint() {
     assert_eq!(sensor.translation.vector, Vector3::new(1.0, 2.0, 3.0));
     let r = sensor.rotation * Vector3::x();
     assert!((r - Vector3::new(-1.0, 0.0, 0.0)).norm() < 1e-12);
-    // The identity viewpoint means "unknown": no sensor.
-    let identity = ORGANIZED.replace("VIEWPOINT 1 2 3 0 0 0 1", "VIEWPOINT 0 0 0 1 0 0 0");
-    assert!(read_pcd(identity.as_bytes(), "o.pcd")
-        .unwrap()
-        .sensor
-        .is_none());
+    assert!(!c.sensor_is_default);
+    // The identity viewpoint, written or left out, is PCL's default: the sensor
+    // at the origin (a raw sensor frame), flagged as the default.
+    for text in [
+        ORGANIZED.replace("VIEWPOINT 1 2 3 0 0 0 1", "VIEWPOINT 0 0 0 1 0 0 0"),
+        ORGANIZED.replace("VIEWPOINT 1 2 3 0 0 0 1\n", ""),
+    ] {
+        let c = read_pcd(text.as_bytes(), "o.pcd").unwrap();
+        assert_eq!(c.sensor, Some(Pose::identity()));
+        assert!(c.sensor_is_default);
+    }
     let zero = ORGANIZED.replace("VIEWPOINT 1 2 3 0 0 0 1", "VIEWPOINT 1 2 3 0 0 0 0");
     format_err(read_pcd(zero.as_bytes(), "o.pcd"), "quaternion");
 }
@@ -247,7 +257,7 @@ fn reads_hand_written_binary_with_descriptors() {
         c.points,
         [Point3::new(1.5, -2.0, 0.25), Point3::new(3.0, 4.0, 5.0)]
     );
-    assert!(c.sensor.is_none() && c.grid.is_none());
+    assert!(c.sensor == Some(Pose::identity()) && c.sensor_is_default && c.grid.is_none());
     for cut in [bytes.len() - 1, bytes.len() - 21, bytes.len() - 22] {
         format_err(
             read_pcd(&bytes[..cut], "b.pcd"),

@@ -49,6 +49,11 @@ pub struct CloudData {
     /// The sensor's pose in the cloud's frame when the file records it (PCD
     /// `VIEWPOINT`); its translation is the sensor origin of the noise models.
     pub sensor: Option<Pose>,
+    /// Whether `sensor` is the PCD format's default viewpoint: the identity
+    /// (`VIEWPOINT 0 0 0 1 0 0 0`), written or left out. PCL reads it as the
+    /// sensor at the origin looking along +z, as a raw lidar or camera frame
+    /// has it; a file written without knowing its viewpoint carries it too.
+    pub sensor_is_default: bool,
     /// The organized layout (PCD with `HEIGHT > 1`, organized PointCloud2).
     pub grid: Option<Grid>,
     /// The names of all per-point fields in the file, in file order.
@@ -155,6 +160,11 @@ impl CloudDataBuilder {
         if self.organized.is_some() {
             self.pixels.push(index as u32);
         }
+    }
+
+    /// Sets whether the sensor pose is the format's default viewpoint.
+    pub fn set_sensor_is_default(&mut self, default: bool) {
+        self.data.sensor_is_default = default;
     }
 
     /// Sets the sensor pose (PCD `VIEWPOINT`).

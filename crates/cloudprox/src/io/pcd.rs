@@ -13,9 +13,10 @@
 //! each kept point is in [`CloudData::grid`], and NaN points (the holes of a
 //! depth image) are counted in [`CloudData::skipped`].
 //!
-//! `VIEWPOINT tx ty tz qw qx qy qz` becomes [`CloudData::sensor`] only when it
-//! is not the identity `0 0 0 1 0 0 0` (PCL writes the identity when it knows no
-//! viewpoint, so the identity means "unknown").
+//! `VIEWPOINT tx ty tz qw qx qy qz` becomes [`CloudData::sensor`], as PCL reads
+//! it: the identity `0 0 0 1 0 0 0`, written or left out (the format's
+//! default), is the sensor at the origin looking along +z (a raw sensor frame),
+//! and [`CloudData::sensor_is_default`] says so.
 //!
 //! Writing: `x y z` and normals as `F4`, the type PCL's point types, Open3D
 //! and RViz read (Open3D reads `F8` binary values as 0), so coordinates
@@ -389,18 +390,23 @@ fn push_point(b: &mut CloudDataBuilder, l: &Layout, index: usize, v: &dyn Fn(usi
     b.push(index, p, n, c);
 }
 
-fn sensor(v: Option<[f64; 7]>, name: &str) -> Result<Option<Pose>> {
-    let Some(v) = v else { return Ok(None) };
-    if v == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0] {
-        return Ok(None);
+/// The sensor pose of a `VIEWPOINT` (the identity when there is none, as PCL
+/// reads it) and whether it is that default.
+fn sensor(v: Option<[f64; 7]>, name: &str) -> Result<(Pose, bool)> {
+    let v = v.unwrap_or(DEFAULT_VIEWPOINT);
+    if v == DEFAULT_VIEWPOINT {
+        return Ok((Pose::identity(), true));
     }
     let q = UnitQuaternion::try_new(Quaternion::new(v[3], v[4], v[5], v[6]), 1e-12)
         .ok_or_else(|| err(name, "VIEWPOINT quaternion qw qx qy qz is zero"))?;
-    Ok(Some(Pose::from_parts(
-        Translation3::new(v[0], v[1], v[2]),
-        q,
-    )))
+    Ok((
+        Pose::from_parts(Translation3::new(v[0], v[1], v[2]), q),
+        false,
+    ))
 }
+
+/// The PCD format's default `VIEWPOINT tx ty tz qw qx qy qz`.
+const DEFAULT_VIEWPOINT: [f64; 7] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
 
 /// Reads a PCD file.
 ///
@@ -423,7 +429,9 @@ pub fn read_pcd(bytes: &[u8], name: &str) -> Result<CloudData> {
         l.covs.is_some(),
         cap,
     );
-    b.set_sensor(sensor(h.viewpoint, name)?);
+    let (pose, default) = sensor(h.viewpoint, name)?;
+    b.set_sensor(Some(pose));
+    b.set_sensor_is_default(default);
     let step = h
         .fields
         .iter()
