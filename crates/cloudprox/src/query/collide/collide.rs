@@ -170,6 +170,34 @@ pub(crate) fn collide_with_workspace(
                 request,
                 !request.decide_only,
             )?;
+            // A context sample (beyond the noise's reach of the other cloud) that
+            // the surface puts on the wrong side shows a surface too rigid for the
+            // patch (a wrapped or saddle-shaped contact): cut it and fit the
+            // halves. So does a crossing element pair the surface does not
+            // describe (known once the crossings are computed, which a patch cut
+            // for its context does not need).
+            let big_enough = na >= MIN_CUT_POINTS && pts.len() - na >= MIN_CUT_POINTS;
+            let mut cut_misfit = |misfit: bool, stats: &mut QueryStats| {
+                let halves = (misfit && big_enough)
+                    .then(|| cut(&patch, &pa, &pb))
+                    .flatten();
+                if let Some((l, r)) = halves {
+                    stats.misfit_cuts += 1;
+                    todo.push(r);
+                    todo.push(l);
+                    return true;
+                }
+                false
+            };
+            let context_misfit = ia
+                .iter()
+                .map(|&i| !core.0[i as usize])
+                .chain(ib.iter().map(|&i| !core.1[i as usize]))
+                .zip(&fit.probabilities)
+                .any(|(context, &p)| context && p >= 0.5);
+            if cut_misfit(context_misfit, &mut stats) {
+                continue;
+            }
             // The element surfaces' crossings, and whether some crossing pair
             // lies where the separating surface does not describe it.
             let crossings = surfaces.map(|(ea, eb)| {
@@ -177,26 +205,8 @@ pub(crate) fn collide_with_workspace(
                 let sep = &fit.classification.separator;
                 element_crossings(ea, &ia, &rel, eb, &ib, &id, sep, reach)
             });
-            // A context sample (beyond the noise's reach of the other cloud) that
-            // the surface puts on the wrong side shows a surface too rigid for the
-            // patch (a wrapped or saddle-shaped contact): cut it and fit the
-            // halves. So does a crossing element pair the surface does not
-            // describe.
-            let misfit = ia
-                .iter()
-                .map(|&i| !core.0[i as usize])
-                .chain(ib.iter().map(|&i| !core.1[i as usize]))
-                .zip(&fit.probabilities)
-                .any(|(context, &p)| context && p >= 0.5)
-                || crossings.as_ref().is_some_and(|c| c.2);
-            let big_enough = na >= MIN_CUT_POINTS && pts.len() - na >= MIN_CUT_POINTS;
-            if misfit && big_enough {
-                if let Some((l, r)) = cut(&patch, &pa, &pb) {
-                    stats.misfit_cuts += 1;
-                    todo.push(r);
-                    todo.push(l);
-                    continue;
-                }
+            if cut_misfit(crossings.as_ref().is_some_and(|c| c.2), &mut stats) {
+                continue;
             }
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
