@@ -365,20 +365,15 @@ pub(crate) fn elements_within_reach(
 /// and counts 0: a deep crossing shows where the surfaces cross, not far from
 /// it. The element's value is the largest over its probes.
 ///
-/// The second value says whether some pair that would cross (`Phi(-g/s) >=
-/// 1/2`) lies where the separating surface does not describe it: `x` and `y`
-/// on the same side of it, both farther from it than the pair spans (the
-/// pair's length plus `h/2 + reach_sds s`; the distance to the surface read as
-/// `|f| / |grad f|` at the nearer end). There the surface's normal says nothing about which
-/// side either surface is on (a patch's quadric wrapped around a contact
-/// elsewhere, running across two flat faces 4 sigma apart), and the patch is
-/// cut like a misfit.
+/// Also returned: the largest crossing probability of a pair that lies where
+/// the separating surface does not describe it, and the largest of the others
+/// (see [`ElementCrossings`]).
 pub(crate) fn element_crossing_probabilities(
     own: &ElementSide<'_>,
     other: &ElementSide<'_>,
     sep: &Separator,
     reach_sds: Real,
-) -> (Vec<Real>, bool) {
+) -> ElementCrossings {
     let po: Vec<Posed<'_>> = own
         .elements
         .iter()
@@ -389,8 +384,11 @@ pub(crate) fn element_crossing_probabilities(
         .iter()
         .map(|&e| Posed::new(e, &other.pose))
         .collect();
-    let mut out = vec![0.0; po.len()];
-    let mut undescribed = false;
+    let mut out = ElementCrossings {
+        values: vec![0.0; po.len()],
+        described_max: 0.0,
+        undescribed_max: 0.0,
+    };
     let active = within_reach_of(&po, &pt, reach_sds);
     for_each_facing(&po, &pt, &active, |f| {
         let (_, g) = sep.value_and_gradient_local(&nalgebra::center(&f.x, &f.y));
@@ -410,16 +408,49 @@ pub(crate) fn element_crossing_probabilities(
         let span = (f.y - f.x).norm();
         if span <= f.allowed + reach_sds * sd {
             let p = wrong_side(gap, sd);
-            if p >= 0.5 && !undescribed {
+            if p < 0.5 {
+                out.described_max = out.described_max.max(p);
+            } else if p > out.undescribed_max.min(out.described_max) {
+                // Only a pair that would cross and could raise one of the two
+                // maxima needs the test.
                 let (fx, fy) = (sep.value_local(&f.x), sep.value_local(&f.y));
                 let near_end = fx.abs().min(fy.abs()) / gn;
-                undescribed = fx * fy > 0.0 && near_end > span + f.allowed + reach_sds * sd;
+                if fx * fy > 0.0 && near_end > span + f.allowed + reach_sds * sd {
+                    out.undescribed_max = out.undescribed_max.max(p);
+                } else {
+                    out.described_max = out.described_max.max(p);
+                }
             }
-            out[f.own] = Real::max(out[f.own], p);
+            out.values[f.own] = Real::max(out.values[f.own], p);
         }
         true
     });
-    (out, undescribed)
+    out
+}
+
+/// The crossing probabilities of one side's elements
+/// ([`element_crossing_probabilities`]), and the largest crossing probability
+/// among the pairs the separating surface describes and among those it does
+/// not.
+///
+/// A pair that would cross (`Phi(-g/s) >= 1/2`) is *undescribed* when `x` and
+/// `y` lie on the same side of the separating surface, both farther from it
+/// than the pair spans (the pair's length plus `h/2 + reach_sds s`; the
+/// distance to the surface read as `|f| / |grad f|` at the nearer end). There
+/// the surface's normal says nothing about which side either surface is on (a
+/// patch's quadric wrapped around a contact elsewhere, running across two flat
+/// faces 4 sigma apart). When such a pair would raise the patch's value above
+/// what the described pairs give, the patch is cut like a misfit; when the
+/// described pairs already give as much (a deep interpenetration, read as a
+/// certain crossing where the surface runs between the two clouds), the
+/// undescribed pairs change nothing and the patch is kept.
+pub(crate) struct ElementCrossings {
+    /// The crossing probability of each element of the side.
+    pub values: Vec<Real>,
+    /// The largest over the pairs the separating surface describes.
+    pub described_max: Real,
+    /// The largest over the pairs it does not describe (0 if none).
+    pub undescribed_max: Real,
 }
 
 #[cfg(test)]

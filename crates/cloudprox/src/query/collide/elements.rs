@@ -14,9 +14,10 @@ use crate::Real;
 /// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
 /// in the separator's frame; `ib` of B's), that the fitted surface of the
 /// element it stands for crosses the other side's
-/// ([`element_crossing_probabilities`]), and whether some pair that would
-/// cross lies where the separating surface does not describe it (the patch is
-/// then cut like a misfit).
+/// ([`element_crossing_probabilities`]), and whether some pair that the
+/// separating surface does not describe would raise the patch's value above
+/// what the described pairs give (the patch is then cut like a misfit; see
+/// [`crate::probability::element::ElementCrossings`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn element_crossings(
     ea: &SurfaceElements,
@@ -33,8 +34,10 @@ pub(crate) fn element_crossings(
         element_side(ea, &ua, pose_a, 1.0),
         element_side(eb, &ub, pose_b, -1.0),
     );
-    let (qa, undescribed_a) = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
-    let (qb, undescribed_b) = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
+    let ca = element_crossing_probabilities(&sa, &sb, sep, reach_sds);
+    let cb = element_crossing_probabilities(&sb, &sa, sep, reach_sds);
+    let undescribed =
+        ca.undescribed_max.max(cb.undescribed_max) > ca.described_max.max(cb.described_max);
     let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
         let owner = els.sample_owner();
         idx.iter()
@@ -46,9 +49,9 @@ pub(crate) fn element_crossings(
             .collect::<Vec<Real>>()
     };
     (
-        per_sample(ea, ia, &ua, &qa),
-        per_sample(eb, ib, &ub, &qb),
-        undescribed_a || undescribed_b,
+        per_sample(ea, ia, &ua, &ca.values),
+        per_sample(eb, ib, &ub, &cb.values),
+        undescribed,
     )
 }
 
