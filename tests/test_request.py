@@ -221,3 +221,22 @@ def test_robot_queries_take_a_request(tmp_path: Path) -> None:
     assert motion.states_total >= 1
     with pytest.raises(cp.InvalidInputError, match=r"unknown option 'nope'.*broad_phase"):
         cp.collide_robot(arm, q, cloud, request=request, nope=1)
+    stats = by_request.stats
+    assert isinstance(stats, cp.RobotStats) and stats.links_with_geometry > 0
+    assert json.loads(json.dumps(stats.to_dict())) == stats.to_dict()
+    assert stats["time_seconds"] == stats.time_seconds > 0.0
+    with pytest.raises(KeyError):
+        stats["nope"]
+
+
+def test_query_stats_are_typed(spheres) -> None:
+    a, b = spheres
+    r = cp.collide(a, b, pose_b=sphere_gap_pose(2.0))
+    stats = r.stats
+    assert isinstance(stats, cp.QueryStats) and stats == r.stats
+    assert stats.patches == len(r.regions) and stats.time_seconds > 0.0
+    assert isinstance(stats.points_classified, int) and isinstance(stats.pruned_bound, float)
+    d = stats.to_dict()
+    assert json.loads(json.dumps(d)) == d
+    assert all(d[name] == getattr(stats, name) for name in d)
+    assert repr(stats).startswith("QueryStats(near_regions=")

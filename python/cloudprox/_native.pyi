@@ -38,6 +38,7 @@ __all__ = [
     "Robot",
     "RobotBatchResult",
     "RobotCollisionResult",
+    "RobotStats",
     "SelfFilter",
     "SolverError",
     "StereoCamera",
@@ -1302,14 +1303,42 @@ class RobotCollisionResult:
     def self_collisions(self) -> list[tuple[str, str]]:
         """Pairs of non-adjacent links that intersect; not part of ``probability``."""
     @property
-    def stats(self) -> dict[str, int | float]:
-        """Counters and timings of the query.
+    def stats(self) -> RobotStats:
+        """Counters and timings of the query."""
 
-        Keys: ``links_with_geometry``, ``links_queried``, ``links_after_decision``
-        (with ``decide_only``, the links left once one reached the collision
-        threshold), ``broad_phase_nodes``, ``self_pairs_checked``,
-        ``node_pairs_visited`` (int), ``time_seconds`` (float).
+@final
+class RobotStats:
+    """Counters and timings of one :func:`collide_robot` query (``RobotCollisionResult.stats``)."""
+
+    @property
+    def links_with_geometry(self) -> int:
+        """Links with geometry."""
+    @property
+    def links_queried(self) -> int:
+        """Links queried against the cloud (the others skipped by the broad phase or the decision)."""
+    @property
+    def links_after_decision(self) -> int:
+        """With ``decide_only``, the links left once one reached the collision threshold."""
+    @property
+    def broad_phase_nodes(self) -> int:
+        """Hierarchy nodes of the cloud visited by the broad phase."""
+    @property
+    def self_pairs_checked(self) -> int:
+        """Link pairs tested for self-collision."""
+    @property
+    def node_pairs_visited(self) -> int:
+        """Node pairs visited by the per-link queries, summed."""
+    @property
+    def time_seconds(self) -> float:
+        """Wall time of the query (seconds)."""
+    def to_dict(self) -> dict[str, int | float]:
+        """Return the statistics as a dict of ``int`` and ``float``, ready for JSON."""
+    def __getitem__(self, key: str, /) -> int | float:
+        """Return the attribute ``key``, for code written against the former dict.
+
+        Prefer the attributes.
         """
+    def __eq__(self, value: object, /) -> bool: ...
 
 @final
 class RobotBatchResult:
@@ -1380,7 +1409,7 @@ def collide_robot(
     both clouds' element hulls). Their query would read 0. Every
     other link is queried as :func:`collide` does; with ``decide_only=True`` the
     links after the first whose probability reaches ``threshold_collision`` are
-    left (probability NaN, ``stats["links_after_decision"]``): the state is
+    left (probability NaN, ``stats.links_after_decision``): the state is
     collision whatever they hold. Self-collision between non-adjacent links
     (exact meshes, ``self_collision=True``) is reported apart.
     ``request`` is a :class:`CollisionRequest` (the link queries' options);

@@ -459,7 +459,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
                     for name, link in result.links.items()
                 },
                 "self_collisions": [list(p) for p in result.self_collisions],
-                "stats": result.stats,
+                "stats": result.stats.to_dict(),
             }
             print(json.dumps(doc, indent=2))
             return 0
@@ -471,8 +471,8 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         )
         console.print(
             f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
-            f"links queried: {result.stats['links_queried']}   "
-            f"time: {1e3 * result.stats['time_seconds']:.2f} ms"
+            f"links queried: {result.stats.links_queried}   "
+            f"time: {1e3 * result.stats.time_seconds:.2f} ms"
         )
         for name, link in result.links.items():
             if link.queried:

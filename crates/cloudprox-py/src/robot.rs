@@ -430,6 +430,103 @@ impl PyLinkCollision {
     }
 }
 
+/// Counters and timings of one ``collide_robot`` query
+/// (``RobotCollisionResult.stats``).
+#[pyclass(name = "RobotStats", frozen, module = "cloudprox._native")]
+pub struct PyRobotStats {
+    inner: RobotStats,
+}
+
+#[pymethods]
+impl PyRobotStats {
+    /// Links with geometry.
+    #[getter]
+    fn links_with_geometry(&self) -> usize {
+        self.inner.links_with_geometry
+    }
+
+    /// Links queried against the cloud (the others were skipped by the broad
+    /// phase, or left once the query was decided).
+    #[getter]
+    fn links_queried(&self) -> usize {
+        self.inner.links_queried
+    }
+
+    /// Links left unqueried because an earlier link's probability had reached
+    /// the collision threshold (``decide_only`` only).
+    #[getter]
+    fn links_after_decision(&self) -> usize {
+        self.inner.links_after_decision
+    }
+
+    /// Hierarchy nodes of the cloud visited by the broad phase.
+    #[getter]
+    fn broad_phase_nodes(&self) -> usize {
+        self.inner.broad_phase_nodes
+    }
+
+    /// Link pairs tested for self-collision.
+    #[getter]
+    fn self_pairs_checked(&self) -> usize {
+        self.inner.self_pairs_checked
+    }
+
+    /// Node pairs visited by the per-link queries, summed.
+    #[getter]
+    fn node_pairs_visited(&self) -> usize {
+        self.inner.node_pairs_visited
+    }
+
+    /// Wall time of the query, in seconds.
+    #[getter]
+    fn time_seconds(&self) -> f64 {
+        self.inner.time_seconds
+    }
+
+    /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        // Destructured without `..`: a new core field must be added here.
+        let RobotStats {
+            links_with_geometry,
+            links_queried,
+            links_after_decision,
+            broad_phase_nodes,
+            self_pairs_checked,
+            node_pairs_visited,
+            time_seconds,
+        } = &self.inner;
+        let d = PyDict::new(py);
+        d.set_item("links_with_geometry", links_with_geometry)?;
+        d.set_item("links_queried", links_queried)?;
+        d.set_item("links_after_decision", links_after_decision)?;
+        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
+        d.set_item("self_pairs_checked", self_pairs_checked)?;
+        d.set_item("node_pairs_visited", node_pairs_visited)?;
+        d.set_item("time_seconds", time_seconds)?;
+        Ok(d)
+    }
+
+    /// The attribute ``key`` (``s["time_seconds"]`` is ``s.time_seconds``), for
+    /// code written against the dict this used to be; prefer the attributes.
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        self.to_dict(py)?
+            .get_item(key)?
+            .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(key.to_string()))
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner == other.inner
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.inner;
+        format!(
+            "RobotStats(links_with_geometry={}, links_queried={}, time_seconds={})",
+            s.links_with_geometry, s.links_queried, s.time_seconds
+        )
+    }
+}
+
 /// The answer of `collide_robot`.
 #[pyclass(name = "RobotCollisionResult", frozen, module = "cloudprox._native")]
 pub struct PyRobotCollisionResult {
@@ -524,27 +621,12 @@ impl PyRobotCollisionResult {
         self.self_collisions.clone()
     }
 
-    /// Counters and timings, as a dict.
+    /// Counters and timings (a new `RobotStats` each time).
     #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let RobotStats {
-            links_with_geometry,
-            links_queried,
-            links_after_decision,
-            broad_phase_nodes,
-            self_pairs_checked,
-            node_pairs_visited,
-            time_seconds,
-        } = &self.stats;
-        let d = PyDict::new(py);
-        d.set_item("links_with_geometry", links_with_geometry)?;
-        d.set_item("links_queried", links_queried)?;
-        d.set_item("links_after_decision", links_after_decision)?;
-        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
-        d.set_item("self_pairs_checked", self_pairs_checked)?;
-        d.set_item("node_pairs_visited", node_pairs_visited)?;
-        d.set_item("time_seconds", time_seconds)?;
-        Ok(d)
+    fn stats(&self) -> PyRobotStats {
+        PyRobotStats {
+            inner: self.stats.clone(),
+        }
     }
 
     fn __repr__(&self) -> String {
