@@ -93,6 +93,9 @@ def test_equality_hash_repr() -> None:
     b = cp.CollisionRequest().replace(surface="linear")
     assert a == b and hash(a) == hash(b) and len({a, b}) == 1
     assert a != cp.CollisionRequest()
+    zero = cp.CollisionRequest(threshold_free=0.0)
+    minus_zero = cp.CollisionRequest(threshold_free=-0.0)
+    assert zero == minus_zero and hash(zero) == hash(minus_zero)
     assert a != "CollisionRequest"
     text = repr(a)
     assert text.startswith("CollisionRequest(surface='linear', aggregation='max', ")

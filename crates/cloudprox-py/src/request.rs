@@ -16,7 +16,7 @@ use cloudprox::probability::Aggregation;
 use cloudprox::query::{CollisionRequest, QueryModel};
 use cloudprox::uncertainty::RobustModel;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyDict, PyFloat, PyTuple};
 
 use crate::error::{invalid_input, CoreResultExt};
 
@@ -291,10 +291,17 @@ impl PyCollisionRequest {
         self.inner == other.inner
     }
 
-    fn __hash__(&self) -> u64 {
+    fn __hash__(&self, py: Python<'_>) -> PyResult<u64> {
+        // Equal requests hash equal: floats by value (`-0.0 + 0.0` is `0.0`).
         let mut h = DefaultHasher::new();
-        format!("{:?}", self.inner).hash(&mut h);
-        h.finish()
+        for (k, v) in self.dict(py)?.iter() {
+            k.to_string().hash(&mut h);
+            match v.extract::<f64>() {
+                Ok(x) if v.is_instance_of::<PyFloat>() => (x + 0.0).to_bits().hash(&mut h),
+                _ => v.to_string().hash(&mut h),
+            }
+        }
+        Ok(h.finish())
     }
 
     /// Pickle support: the options, given back to the constructor.
