@@ -227,9 +227,7 @@ def test_robot_queries_take_a_request(tmp_path: Path) -> None:
     stats = by_request.stats
     assert isinstance(stats, cp.RobotStats) and stats.links_with_geometry > 0
     assert json.loads(json.dumps(stats.to_dict())) == stats.to_dict()
-    assert stats["time_seconds"] == stats.time_seconds > 0.0
-    with pytest.raises(KeyError):
-        stats["nope"]
+    assert stats.time_seconds > 0.0
 
 
 def test_query_stats_are_typed(spheres) -> None:

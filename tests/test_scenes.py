@@ -31,7 +31,6 @@ def test_meshes_and_exact_queries_from_python() -> None:
         "penetration_depth": None,
         "signed_distance": r.distance,
     }
-    assert r["distance"] == r.distance  # the former dict's keys still read
     # (Offset sideways a little: EPA misjudges the depth of two boxes whose faces
     # are exactly coplanar.)
     many = cloudprox.exact_proximity_many(

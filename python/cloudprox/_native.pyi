@@ -503,11 +503,6 @@ class Proximity:
         """``distance``, or minus the depth when intersecting (NaN when the depth is unknown)."""
     def to_dict(self) -> dict[str, bool | float | None]:
         """Return the four attributes as a dict."""
-    def __getitem__(self, key: str, /) -> bool | float | None:
-        """Return the attribute ``key``, for code written against the former dict.
-
-        Prefer the attributes.
-        """
     def __eq__(self, value: object, /) -> bool: ...
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
     @staticmethod
@@ -1333,11 +1328,6 @@ class RobotStats:
         """Wall time of the query (seconds)."""
     def to_dict(self) -> dict[str, int | float]:
         """Return the statistics as a dict of ``int`` and ``float``, ready for JSON."""
-    def __getitem__(self, key: str, /) -> int | float:
-        """Return the attribute ``key``, for code written against the former dict.
-
-        Prefer the attributes.
-        """
     def __eq__(self, value: object, /) -> bool: ...
 
 @final

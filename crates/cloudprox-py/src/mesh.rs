@@ -128,17 +128,6 @@ impl PyProximity {
         Ok(d)
     }
 
-    /// The attribute ``key`` (``p["distance"]`` is ``p.distance``), for code
-    /// written against the dict this used to be; prefer the attributes.
-    fn __getitem__<'py>(slf: &Bound<'py, Self>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-        match key {
-            "intersecting" | "distance" | "penetration_depth" | "signed_distance" => {
-                slf.getattr(key)
-            }
-            _ => Err(pyo3::exceptions::PyKeyError::new_err(key.to_string())),
-        }
-    }
-
     fn __eq__(&self, other: &Self) -> bool {
         self.inner == other.inner
     }

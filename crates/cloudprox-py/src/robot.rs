@@ -506,14 +506,6 @@ impl PyRobotStats {
         Ok(d)
     }
 
-    /// The attribute ``key`` (``s["time_seconds"]`` is ``s.time_seconds``), for
-    /// code written against the dict this used to be; prefer the attributes.
-    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-        self.to_dict(py)?
-            .get_item(key)?
-            .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(key.to_string()))
-    }
-
     fn __eq__(&self, other: &Self) -> bool {
         self.inner == other.inner
     }

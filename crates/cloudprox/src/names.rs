@@ -32,8 +32,8 @@ pub fn unknown_name<'a>(
 /// named_options!(Surface, "surface", { Linear => "linear", Quadric => "quadric" });
 /// ```
 ///
-/// The form `named_options!(@names Ty, "option", [A, B])` is for an enum that
-/// writes its own `name()` and `from_name()`: it adds the rest.
+/// (The inner form `named_options!(@names Ty, "option", [A, B])` adds what
+/// needs only `name()` and `from_name()`.)
 macro_rules! named_options {
     (@names $ty:ident, $option:literal, [$($variant:ident),+ $(,)?]) => {
         impl $ty {

@@ -12,7 +12,3 @@ pub use collide::{
     collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
     CollisionResult, ContactRegion, MeshSampling, QueryModel, QueryStats,
 };
-
-// `QueryModel` writes its own `name()` and `from_name()` (in
-// `collide/request.rs`); this adds `ALL`, `OPTION`, `Display` and `FromStr`.
-crate::names::named_options!(@names QueryModel, "model", [Elements, Points]);
