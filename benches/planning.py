@@ -246,24 +246,24 @@ def grasps(
             pose: np.ndarray = pose,
             approach: np.ndarray = approach,
             centre: np.ndarray = centre,
-        ) -> dict:
+        ) -> cp.Proximity:
             pose[:3, 3] = centre - s * approach
             return cp.exact_proximity(shape, scene, pose)
 
         lo_s, hi_s = 0.0, 0.5
-        if at(hi_s)["intersecting"]:
+        if at(hi_s).intersecting:
             continue
         for _ in range(30):  # first contact coming in along the approach
             mid = 0.5 * (lo_s + hi_s)
-            lo_s, hi_s = (lo_s, mid) if not at(mid)["intersecting"] else (mid, hi_s)
+            lo_s, hi_s = (lo_s, mid) if not at(mid).intersecting else (mid, hi_s)
         s = hi_s + target
         r = at(s)
-        if bool(r["intersecting"]) != (target < 0):
+        if bool(r.intersecting) != (target < 0):
             continue
         # free: the exact distance; in contact: the travel past first contact (the
         # meshes are not convex: the depth is that travel, as in benches/realmesh.py)
         out_poses.append(pose.copy())
-        dist.append(target if target < 0 else float(r["distance"]))
+        dist.append(target if target < 0 else float(r.distance))
     poses_a = np.array(out_poses)
     d = np.array(dist)
     p_cp = np.array([r.probability for r in cp.collide_many(gripper, cloud, poses_a)])

@@ -109,34 +109,34 @@ def poses(
         d = rng.normal(size=3)
         d /= np.linalg.norm(d)
 
-        def at(t: float, pose: np.ndarray = pose, d: np.ndarray = d) -> dict:
+        def at(t: float, pose: np.ndarray = pose, d: np.ndarray = d) -> cp.Proximity:
             pose[:3, 3] = t * d
             return cp.exact_proximity(a, b, pose)
 
         # First contact along the direction (the objects overlap at t = 0).
         lo, hi = 0.0, 2.0 * DIAGONAL
-        if at(hi)["intersecting"] or not at(lo)["intersecting"]:
+        if at(hi).intersecting or not at(lo).intersecting:
             continue
         for _ in range(40):
             mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if at(mid)["intersecting"] else (lo, mid)
+            lo, hi = (mid, hi) if at(mid).intersecting else (lo, mid)
         contact = hi
         if target >= 0.0:
             # Bisect the exact distance on the free side of first contact.
             lo, hi = contact, 2.0 * DIAGONAL
-            if at(hi)["distance"] < target:
+            if at(hi).distance < target:
                 continue
             for _ in range(40):
                 mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if at(mid)["distance"] < target else (lo, mid)
+                lo, hi = (mid, hi) if at(mid).distance < target else (lo, mid)
             r = at(hi)
-            if r["intersecting"]:
+            if r.intersecting:
                 continue
-            sd = float(r["distance"])
+            sd = float(r.distance)
         else:
             # Penetration: travel past first contact (the meshes are not convex,
             # so the depth is the travel, as in the real-scan experiment).
-            if not at(contact + target)["intersecting"]:
+            if not at(contact + target).intersecting:
                 continue
             sd = target
         if abs(sd - target) > sigma:

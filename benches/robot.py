@@ -6,7 +6,7 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
 
 * **Cost per configuration**, one thread (``RAYON_NUM_THREADS=1``): cloudprox's
   ``collide_robot`` with each model (surface elements, the default, and points;
-  its own ``stats["time_seconds"]``: forward kinematics, broad phase and
+  its own ``stats.time_seconds``: forward kinematics, broad phase and
   queries, self-collision off) against python-fcl's ``collide()`` of
   the robot's exact link meshes (a ``DynamicAABBTreeCollisionManager``) against
   the exact scene meshes (the anchor) and against the collision map's occupied
@@ -238,9 +238,9 @@ def main() -> None:
         t_cp = {
             model: np.array(
                 [
-                    cp.collide_robot(robot, q, cloud, self_collision=False, model=model).stats[
-                        "time_seconds"
-                    ]
+                    cp.collide_robot(
+                        robot, q, cloud, self_collision=False, model=model
+                    ).stats.time_seconds
                     for q in sel
                 ]
             )

@@ -68,7 +68,7 @@ def test_interpenetration_and_clearance(request, model: str) -> None:
     assert far.probability < 0.01
     assert far.state == "free"
     # Beyond the hierarchy's reach nothing is classified at all.
-    assert sweep[15.0].stats["points_classified"] <= far.stats["points_classified"]
+    assert sweep[15.0].stats.points_classified <= far.stats.points_classified
 
 
 def test_result_fields(sweep, spheres) -> None:
@@ -80,7 +80,8 @@ def test_result_fields(sweep, spheres) -> None:
     assert r.probability == pytest.approx(
         max(r.probabilities_a.max(), r.probabilities_b.max()), abs=0.0
     )
-    assert set(r.stats) == {
+    assert isinstance(r.stats, cp.QueryStats)
+    assert set(r.stats.to_dict()) == {
         "node_pairs_visited",
         "leaf_pairs",
         "near_regions",
@@ -95,12 +96,12 @@ def test_result_fields(sweep, spheres) -> None:
         "time_seconds",
     }
     assert all(
-        isinstance(v, int) for k, v in r.stats.items() if k not in ("pruned_bound", "time_seconds")
+        isinstance(v, int)
+        for k, v in r.stats.to_dict().items()
+        if k not in ("pruned_bound", "time_seconds")
     )
-    assert r.stats["patches"] == len(r.regions) > 0
-    assert r.stats["points_classified"] == sum(
-        len(g.indices_a) + len(g.indices_b) for g in r.regions
-    )
+    assert r.stats.patches == len(r.regions) > 0
+    assert r.stats.points_classified == sum(len(g.indices_a) + len(g.indices_b) for g in r.regions)
     assert "CollisionResult(probability=" in repr(r)
     for region in r.regions:
         assert region.indices_a.dtype == np.int64 and region.indices_b.dtype == np.int64
@@ -253,7 +254,7 @@ def test_options_take_effect(spheres) -> None:
     a, b = spheres
     pose_b = sphere_gap_pose(4.0)
     default = cp.collide(a, b, pose_b=pose_b)
-    explicit = cp.collide(a, b, pose_b=pose_b, **cp.default_options())
+    explicit = cp.collide(a, b, pose_b=pose_b, **cp.CollisionRequest().to_dict())
     assert explicit.probability == default.probability
     # The paper's model's options (aggregations, patch size).
     base = cp.collide(a, b, pose_b=pose_b, model="points")
@@ -278,14 +279,14 @@ def test_options_take_effect(spheres) -> None:
     # the same points, the same P as the hierarchy (which finds one region here).
     hier = cp.collide(a, b, pose_b=sphere_gap_pose(2.0), model="points")
     brute = cp.collide(a, b, pose_b=sphere_gap_pose(2.0), use_hierarchy=False, model="points")
-    assert hier.stats["near_regions"] == 1
-    assert brute.stats["points_classified"] == hier.stats["points_classified"] > 0
+    assert hier.stats.near_regions == 1
+    assert brute.stats.points_classified == hier.stats.points_classified > 0
     assert brute.probability == pytest.approx(hier.probability, abs=1e-9)
-    assert brute.stats["node_pairs_visited"] == 0
+    assert brute.stats.node_pairs_visited == 0
 
 
-def test_default_options_match_documented_defaults() -> None:
-    assert cp.default_options() == {
+def test_request_defaults_match_documented_defaults() -> None:
+    assert cp.CollisionRequest().to_dict() == {
         "surface": "quadric",
         "aggregation": "max",
         "threshold_collision": 0.9,
@@ -293,21 +294,20 @@ def test_default_options_match_documented_defaults() -> None:
         "prune_epsilon": 1e-3,
         "region_max_points": 2000,
         "near_context": 2.0,
-        "lambda_": 100.0,
+        "slack_weight": 100.0,
         "robust_eta": 0.9,
         "robust_model": "gaussian",
         "solver": "barrier",
         "use_hierarchy": True,
-        "model": cp.default_options()["model"],
+        "model": "points",
         "decide_only": False,
     }
-    assert cp.default_options()["model"] in ("elements", "points")
-    names = cp.option_names()
-    assert set(names["model"]) == {"elements", "points"}
+    names = cp.CollisionRequest.choices()
+    assert names["model"] == ("elements", "points")
     assert names["surface"] == ("linear", "quadric")
-    assert set(names["aggregation"]) == {"surface", "max", "union", "independent"}
-    assert set(names["robust_model"]) == {"gaussian", "chebyshev"}
-    assert set(names["solver"]) == {"barrier", "clarabel"}
+    assert names["aggregation"] == ("surface", "max", "union", "independent")
+    assert names["robust_model"] == ("gaussian", "chebyshev")
+    assert names["solver"] == ("barrier", "clarabel")
 
 
 def test_queries_run_in_threads_with_the_same_answers(spheres) -> None:
@@ -364,7 +364,7 @@ def test_elements_model_classifies_tens_of_samples_and_reports_every_point(spher
     pose_b = sphere_gap_pose(1.0)
     el = cp.collide(a, b, pose_b=pose_b, model="elements")
     pts = cp.collide(a, b, pose_b=pose_b, model="points")
-    assert 0 < el.stats["points_classified"] < pts.stats["points_classified"]
+    assert 0 < el.stats.points_classified < pts.stats.points_classified
     # Per-point probabilities are Eq. 3 of every point of the elements in the
     # region, against the region's surface: the same points the region lists.
     region = el.regions[0]

@@ -119,7 +119,7 @@ def bad_last_row() -> np.ndarray:
         ),
         ({"solver": "ecos"}, r"unknown solver 'ecos'; valid names: 'barrier', 'clarabel'"),
         ({"robust_eta": 1.0}, r"robust_eta must be in \[0.5, 1\), got 1"),
-        ({"lambda_": 0.0}, r"lambda must be finite and > 0"),
+        ({"slack_weight": 0.0}, r"slack_weight must be finite and > 0"),
         ({"prune_epsilon": 1.0}, r"prune_epsilon must be in \[0, 1\)"),
         ({"region_max_points": 4}, r"region_max_points must be >= 8"),
         ({"region_max_points": -1}, r"region_max_points must be a non-negative integer, got -1"),

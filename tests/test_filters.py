@@ -174,7 +174,12 @@ def test_crop_box_agrees_with_open3d() -> None:
 
 def test_voxel_lattice_count_centroids_counts() -> None:
     pts, voxel = voxel_lattice()
-    centroids, covs, counts = filters.voxel_downsample(pts, V)
+    voxels = filters.voxel_downsample(pts, V)
+    assert isinstance(voxels, cp.Voxels)
+    centroids, covs, counts = voxels
+    assert voxels.points is not None and voxels.covariances is None
+    np.testing.assert_array_equal(voxels.counts, counts)
+    np.testing.assert_array_equal(voxels[0], centroids)
     assert covs is None
     assert centroids.shape == (K**3, 3) and counts.shape == (K**3,)
     assert counts.dtype == np.int64

@@ -221,7 +221,7 @@ OPTIONS: dict[str, st.SearchStrategy[Any]] = {
     "prune_epsilon": FLOATS,
     "region_max_points": st.integers(-5, 5000),
     "near_context": FLOATS,
-    "lambda_": FLOATS,
+    "slack_weight": FLOATS,
     "robust_eta": FLOATS,
     "robust_model": st.sampled_from(["gaussian", "chebyshev", "cauchy"]),
     "solver": st.sampled_from(["barrier", "clarabel", "newton"]),

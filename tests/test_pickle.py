@@ -139,3 +139,15 @@ def test_bad_states_are_refused() -> None:
         cp.RobotBatchResult._from_state(([0.5], ["maybe"], [False], [0.5], 1))
     with pytest.raises(cp.InvalidInputError, match="inconsistent lengths"):
         cp.RobotBatchResult._from_state(([0.5], ["free"], [False], [0.5, 0.1], 1))
+
+
+def test_request_stats_and_proximity_roundtrip() -> None:
+    request = cp.CollisionRequest(surface="linear", threshold_free=0.05, decide_only=True)
+    assert roundtrip(request) == request
+    base = cp.sample_sphere(400, 0.1)
+    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
+    stats = cp.collide(a, a, pose_b=translation(0.199), request=request).stats
+    assert roundtrip(stats) == stats and roundtrip(stats).to_dict() == stats.to_dict()
+    cube = cp.ExactShape([cp.Mesh.cuboid(0.1, 0.1, 0.1)])
+    near = cp.exact_proximity(cube, cube, None, translation(0.5))
+    assert roundtrip(near) == near and roundtrip(near).to_dict() == near.to_dict()

@@ -181,6 +181,12 @@ def test_bad_planning_input(ompl: None, arm: cp.Robot, cloud: cp.PointCloud) -> 
         ChanceConstraint(arm, cloud, max_probability=1.5)
     with pytest.raises(ValueError, match="decide_only needs max_probability"):
         ChanceConstraint(arm, cloud, max_probability=0.95, decide_only=True)
+    request = cp.CollisionRequest(decide_only=True, threshold_collision=0.6)
+    with pytest.raises(ValueError, match=r"threshold_collision \(0.6\)"):
+        ChanceConstraint(arm, cloud, max_probability=0.7, request=request)
+    # A request's own settings are kept (no automatic decide_only).
+    kept = ChanceConstraint(arm, cloud, max_probability=0.05, request=cp.CollisionRequest())
+    assert kept.state_options == {"request": cp.CollisionRequest()}
     with pytest.raises(ValueError, match=r"q_start must have shape \(4,\)"):
         plan(arm, cloud, [0.0, 0.0], Q1, time_limit=1.0)
     with pytest.raises(ValueError, match="finite joint limits"):

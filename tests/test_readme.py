@@ -70,3 +70,16 @@ def test_readme_python_lines(folder: Path, monkeypatch: pytest.MonkeyPatch) -> N
     probability, state = out.getvalue().split()[:2]
     assert state == "collision"
     assert float(probability) >= 0.9
+
+
+def test_readme_api_python_block() -> None:
+    """The Python section's block: a request, a query, typed statistics."""
+    code = _block("api-python")
+    assert "request=" in code and "CollisionRequest(" in code
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, str(README), "exec"), {})
+    fields = out.getvalue().split()
+    assert 0.0 <= float(fields[0]) <= 1.0
+    assert fields[1] in ("free", "contact", "collision")
+    assert float(fields[-1]) > 0.0

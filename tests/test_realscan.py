@@ -77,9 +77,9 @@ def test_reconstruction_of_a_noisy_sphere_lies_on_it() -> None:
     shape = surface_shape(mesh)
     probe = cp.ExactShape([cp.Mesh.cuboid(0.05, 0.05, 0.05)])
     inside = cp.exact_proximity(probe, shape)
-    assert not inside["intersecting"] and inside["distance"] > 0.4
+    assert not inside.intersecting and inside.distance > 0.4
     across = cp.exact_proximity(probe, shape, _pose((0.5, 0.0, 0.0)))
-    assert across["intersecting"]
+    assert across.intersecting
 
 
 def test_tiles_partition_the_triangles() -> None:

@@ -140,14 +140,14 @@ def test_a_link_pushed_into_a_wall_collides(arm: cp.Robot) -> None:
     for _, region in hit.regions:
         assert abs(region.point[0] - 0.40) < 0.03
     assert hit.self_collisions == []
-    assert hit.stats["links_with_geometry"] == 6
+    assert hit.stats.links_with_geometry == 6
 
 
 def test_far_from_the_cloud_no_link_is_queried(arm: cp.Robot) -> None:
     r = cp.collide_robot(arm, [0.4, -0.3, 0.05, 0.0], wall_cloud(x0=5.0))
     assert r.probability == 0.0 and r.state == "free"
-    assert r.stats["links_queried"] == 0
-    assert r.stats["broad_phase_nodes"] == 6  # one hierarchy root per link
+    assert r.stats.links_queried == 0
+    assert r.stats.broad_phase_nodes == 6  # one hierarchy root per link
 
 
 def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
@@ -159,7 +159,7 @@ def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
     assert fast.probability >= 0.9 and full.links["link2"].probability >= 0.9
     after = [fast.links[n] for n in ("link3", "link4", "tool")]
     assert all(np.isnan(x.probability) and not x.queried and x.result is None for x in after)
-    assert fast.stats["links_after_decision"] == 3 and full.stats["links_after_decision"] == 0
+    assert fast.stats.links_after_decision == 3 and full.stats.links_after_decision == 0
     assert all(full.links[n].queried for n in ("link3", "link4", "tool"))
     batch = cp.collide_robot_many(arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True)
     assert list(batch.states) == ["collision", "free"]

@@ -11,13 +11,26 @@ def test_meshes_and_exact_queries_from_python() -> None:
     cube = cloudprox.Mesh.cuboid(0.1, 0.1, 0.1)
     assert cube.area == pytest.approx(0.24) and cube.volume == pytest.approx(0.008)
     assert cube.is_closed and cube.is_convex()
-    pts, normals, faces = cube.sample(500, seed=1)
+    sample = cube.sample(500, seed=1)
+    assert isinstance(sample, cloudprox.MeshSample)
+    pts, normals, faces = sample
+    assert sample.points is not None and sample[0] is not None and len(sample) == 3
+    np.testing.assert_array_equal(sample.normals, normals)
+    np.testing.assert_array_equal(sample.faces, faces)
     assert pts.shape == (500, 3) and normals.shape == (500, 3) and faces.shape == (500,)
     assert np.allclose(np.max(np.abs(pts), axis=1), 0.1)
     shape = cloudprox.ExactShape([cube])
     assert shape.part_kinds == ["convex"]
     r = cloudprox.exact_proximity(shape, shape, None, make_pose((0.5, 0.0, 0.0)))
-    assert not r["intersecting"] and r["distance"] == pytest.approx(0.3)
+    assert isinstance(r, cloudprox.Proximity)
+    assert not r.intersecting and r.distance == pytest.approx(0.3)
+    assert r.penetration_depth is None and r.signed_distance == r.distance
+    assert r.to_dict() == {
+        "intersecting": False,
+        "distance": r.distance,
+        "penetration_depth": None,
+        "signed_distance": r.distance,
+    }
     # (Offset sideways a little: EPA misjudges the depth of two boxes whose faces
     # are exactly coplanar.)
     many = cloudprox.exact_proximity_many(

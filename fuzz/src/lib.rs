@@ -475,7 +475,7 @@ struct RequestInput {
     region_max_points: Opt<u16>,
     use_hierarchy: bool,
     decide_only: bool,
-    lambda: Opt<Num>,
+    slack_weight: Opt<Num>,
     robust_eta: Opt<Num>,
     chebyshev: bool,
     clarabel: bool,
@@ -534,7 +534,7 @@ impl RequestInput {
             },
             ..ClassifySettings::default()
         };
-        num(self.lambda, &mut c.lambda);
+        num(self.slack_weight, &mut c.slack_weight);
         num(self.robust_eta, &mut c.robust_eta);
         num(self.solver_tol, &mut c.solver_tol);
         let mut iters = 100u8;

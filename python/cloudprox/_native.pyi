@@ -9,9 +9,9 @@ object's own frame to the world; ``None`` means identity.
 """
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any, Final, Literal, TypedDict, final
+from typing import Any, Final, Literal, final
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,7 @@ __version__: Final[str]
 __all__ = [
     "CloudFile",
     "CloudproxError",
+    "CollisionRequest",
     "CollisionResult",
     "ContactRegion",
     "DepthCamera",
@@ -29,15 +30,21 @@ __all__ = [
     "Lidar",
     "LinkCollision",
     "Mesh",
+    "MeshSample",
     "MotionResult",
     "PointCloud",
+    "Proximity",
+    "QueryStats",
     "Robot",
     "RobotBatchResult",
     "RobotCollisionResult",
+    "RobotStats",
     "SelfFilter",
     "SolverError",
     "StereoCamera",
+    "Voxels",
     "__version__",
+    "_read_mesh_counted",
     "add_noise",
     "check_motion",
     "collide",
@@ -45,11 +52,9 @@ __all__ = [
     "collide_robot",
     "collide_robot_many",
     "crop_box",
-    "default_options",
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
-    "option_names",
     "parse_mesh",
     "read_mesh",
     "read_point_cloud",
@@ -311,17 +316,55 @@ class CollisionResult:
     def regions(self) -> list[ContactRegion]:
         """The classified patches of the near regions."""
     @property
-    def stats(self) -> dict[str, int | float]:
-        """Counters and timings of the query.
+    def stats(self) -> QueryStats:
+        """Counters and timings of the query."""
 
-        Keys: ``node_pairs_visited``, ``leaf_pairs``, ``near_regions``, ``patches``,
-        ``misfit_cuts`` (patches cut because one surface misfit them),
-        ``patches_beyond_reach`` (patches of the elements model pruned because no
-        element faces the other side within the noise's reach), ``points_classified``, ``solver_iterations``, ``barrier_fallbacks`` (patches
-        where the barrier method gave way to Clarabel), ``solver_fallbacks`` (patches
-        that fell back to a plane) (int),
-        ``pruned_bound`` and ``time_seconds`` (float).
-        """
+@final
+class QueryStats:
+    """Counters and timings of one :func:`collide` query (``CollisionResult.stats``)."""
+
+    @property
+    def node_pairs_visited(self) -> int:
+        """Node pairs of the two hierarchies tested during the traversal."""
+    @property
+    def leaf_pairs(self) -> int:
+        """Leaf pairs kept (not pruned)."""
+    @property
+    def near_regions(self) -> int:
+        """Connected near regions."""
+    @property
+    def patches(self) -> int:
+        """Patches classified (``len(result.regions)``)."""
+    @property
+    def misfit_cuts(self) -> int:
+        """Patches cut in two because one surface misfit them."""
+    @property
+    def patches_beyond_reach(self) -> int:
+        """Patches of the elements model pruned because no element faces the other side within the noise's reach."""
+    @property
+    def points_classified(self) -> int:
+        """Points of both clouds that went into a classifier."""
+    @property
+    def solver_iterations(self) -> int:
+        """Interior-point iterations over all patches."""
+    @property
+    def barrier_fallbacks(self) -> int:
+        """Patches where the barrier method gave way to Clarabel."""
+    @property
+    def solver_fallbacks(self) -> int:
+        """Patches whose solve fell back to a plane (``ContactRegion.status == "fallback"``)."""
+    @property
+    def pruned_bound(self) -> float:
+        """Upper bound on the probability that any pruned point is on the wrong side."""
+    @property
+    def time_seconds(self) -> float:
+        """Wall time of the query (seconds)."""
+    def to_dict(self) -> dict[str, int | float]:
+        """Return the statistics as a dict of ``int`` and ``float``, ready for JSON."""
+    def __eq__(self, value: object, /) -> bool: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    @staticmethod
+    def _from_state(state: tuple[int, ...]) -> QueryStats: ...
 
 @final
 class Mesh:
@@ -375,7 +418,7 @@ class Mesh:
         """Return a copy moved by the ``(4, 4)`` rigid transform ``transform``."""
     def sample(
         self, n: int | None = None, *, density: float | None = None, seed: int = 0
-    ) -> tuple[_FloatArray, _FloatArray, _IntArray]:
+    ) -> MeshSample:
         """Sample the surface uniformly (faces chosen with probability proportional to area).
 
         Parameters
@@ -389,11 +432,10 @@ class Mesh:
 
         Returns
         -------
-        points : ndarray, shape (k, 3)
-        normals : ndarray, shape (k, 3)
-            Unit outward normal of each point's face.
-        faces : ndarray of int64, shape (k,)
-            Face index of each point.
+        MeshSample
+            ``points`` ``(k, 3)``, ``normals`` ``(k, 3)`` (unit outward normal of
+            each point's face) and ``faces`` ``(k,)`` (face index of each point);
+            unpacks as ``points, normals, faces``.
 
         Raises
         ------
@@ -401,6 +443,23 @@ class Mesh:
             If not exactly one of ``n`` and ``density`` is given, or the mesh has
             zero area.
         """
+
+@final
+class MeshSample:
+    """What :meth:`Mesh.sample` returns; unpacks as ``points, normals, faces``."""
+
+    @property
+    def points(self) -> _FloatArray:
+        """The sampled points, shape ``(k, 3)``."""
+    @property
+    def normals(self) -> _FloatArray:
+        """The unit outward normal of each point's face, shape ``(k, 3)``."""
+    @property
+    def faces(self) -> _IntArray:
+        """The index of the face each point lies on, shape ``(k,)``."""
+    def __iter__(self) -> Iterator[Any]: ...
+    def __getitem__(self, key: int, /) -> Any: ...
+    def __len__(self) -> int: ...
 
 @final
 class ExactShape:
@@ -426,23 +485,42 @@ class ExactShape:
         """Per part, ``"convex"``, ``"solid"`` (closed mesh) or ``"surface"``."""
     def __len__(self) -> int: ...
 
-class _Proximity(TypedDict):
-    intersecting: bool
-    distance: float
-    penetration_depth: float | None
-    signed_distance: float
+@final
+class Proximity:
+    """What :func:`exact_proximity` returns: whether two shapes intersect, and how far apart or how deep."""
+
+    @property
+    def intersecting(self) -> bool:
+        """Whether the solids (or surfaces, for open parts) intersect."""
+    @property
+    def distance(self) -> float:
+        """The distance between the shapes (metres); 0 when intersecting."""
+    @property
+    def penetration_depth(self) -> float | None:
+        """The largest depth over intersecting convex part pairs; ``None`` when unknown."""
+    @property
+    def signed_distance(self) -> float:
+        """``distance``, or minus the depth when intersecting (NaN when the depth is unknown)."""
+    def to_dict(self) -> dict[str, bool | float | None]:
+        """Return the four attributes as a dict."""
+    def __eq__(self, value: object, /) -> bool: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    @staticmethod
+    def _from_state(
+        intersecting: bool, distance: float, penetration_depth: float | None
+    ) -> Proximity: ...
 
 def exact_proximity(
     a: ExactShape,
     b: ExactShape,
     pose_a: npt.ArrayLike | None = None,
     pose_b: npt.ArrayLike | None = None,
-) -> _Proximity:
+) -> Proximity:
     """Exact proximity of two posed objects (the ground truth of the evaluation).
 
     Returns
     -------
-    dict
+    Proximity
         ``intersecting``; ``distance`` (0 when intersecting); ``penetration_depth``,
         the largest over intersecting convex part pairs (``None`` when a
         non-convex part intersects); ``signed_distance`` (distance, or minus the
@@ -476,44 +554,21 @@ def exact_proximity_many(
         ``penetration_depth`` (NaN when unknown) and ``signed_distance``.
     """
 
-def collide(
-    a: PointCloud | Mesh | Any,
-    b: PointCloud | Mesh | Any,
-    pose_a: npt.ArrayLike | None = None,
-    pose_b: npt.ArrayLike | None = None,
-    *,
-    surface: _SurfaceName | None = None,
-    aggregation: _AggregationName | None = None,
-    threshold_collision: float | None = None,
-    threshold_free: float | None = None,
-    prune_epsilon: float | None = None,
-    region_max_points: int | None = None,
-    near_context: float | None = None,
-    lambda_: float | None = None,
-    robust_eta: float | None = None,
-    robust_model: _RobustModelName | None = None,
-    solver: _SolverName | None = None,
-    use_hierarchy: bool | None = None,
-    mesh_spacing: float | None = None,
-    model: _ModelName | None = None,
-    decide_only: bool | None = None,
-) -> CollisionResult:
-    """Probabilistic collision query between two noisy point clouds.
+@final
+class CollisionRequest:
+    """The options of a collision query, as one immutable value.
 
-    Every option left at ``None`` takes the Rust default (``CollisionRequest::default()``,
-    listed by :func:`default_options`). The GIL is released during the query.
-
-    Either side may be a mesh (``Mesh``, a trimesh ``Trimesh`` or an Open3D
-    ``TriangleMesh``): an exact surface, sampled every ``mesh_spacing`` metres into
-    a cloud without sensor noise whose covariance is its own discretization
-    (``spacing^2 / 12`` across each sample's face, none along its normal).
+    Accepted by :func:`collide`, :func:`collide_many`, :func:`collide_robot`,
+    :func:`collide_robot_many` and :func:`check_motion` as ``request=``. Every
+    option is keyword-only; one left out (or ``None``) takes the Rust core's
+    default, so ``CollisionRequest()`` shows the defaults. Unknown enum names,
+    values out of their domain and thresholds out of order raise
+    :class:`InvalidInputError` naming the option (and the valid names).
+    Requests are frozen (compare equal option by option, hash and pickle);
+    :meth:`replace` gives a modified copy.
 
     Parameters
     ----------
-    a, b : PointCloud or mesh
-        The two clouds, or one cloud and one mesh.
-    pose_a, pose_b : array_like, shape (4, 4), optional
-        Rigid poses of the clouds (own frame to world); ``None`` is the identity.
     surface : {"quadric", "linear"}, optional
         Family of the separating surface (default ``"quadric"``).
     aggregation : {"max", "surface", "union", "independent"}, optional
@@ -535,12 +590,13 @@ def collide(
     region_max_points : int, optional
         Near regions larger than this are split into patches (default 2000, ``>= 8``):
         a bound on the cost of one solve. Regions are also cut where one surface
-        misfits (``stats["misfit_cuts"]``).
+        misfits (``QueryStats.misfit_cuts``).
     near_context : float, optional
         Context kept around the near points, in sampling spacings (each point's
         distance to its 6th nearest neighbour; default 2, ``>= 0.5``).
-    lambda_ : float, optional
-        Weight of the slacks in the classifier (default 100).
+    slack_weight : float, optional
+        Weight of the slack term of the classifier against ``|w|^2 / 2``
+        (``lambda`` in the formulas; default 100, close to a hard margin).
     robust_eta : float, optional
         Confidence of each point's chance constraint, in ``[0.5, 1)`` (default 0.9).
     robust_model : {"gaussian", "chebyshev"}, optional
@@ -551,10 +607,6 @@ def collide(
     use_hierarchy : bool, optional
         ``False`` finds the near points by testing every point pair and classifies
         them in one region (the brute-force reference; default ``True``).
-    mesh_spacing : float, optional
-        Sampling spacing of a mesh side (metres; default: half the cloud's median
-        spacing, its distance to the 6th nearest neighbour). A ``Mesh`` keeps its
-        last samplings, so repeated queries do not sample it again.
     model : {"points", "elements"}, optional
         What is classified (default ``"points"``): every point (the paper's
         method), or the cloud's *surface elements*: groups of points that fit a
@@ -570,6 +622,130 @@ def collide(
         stops at the first patch that reaches ``threshold_collision``. The state
         is that of the full query.
 
+    Examples
+    --------
+    >>> import cloudprox as cp
+    >>> request = cp.CollisionRequest(surface="linear", threshold_free=0.05)
+    >>> request.replace(model="elements").model
+    'elements'
+    """
+
+    def __new__(
+        cls,
+        *,
+        surface: _SurfaceName | None = None,
+        aggregation: _AggregationName | None = None,
+        threshold_collision: float | None = None,
+        threshold_free: float | None = None,
+        prune_epsilon: float | None = None,
+        region_max_points: int | None = None,
+        near_context: float | None = None,
+        slack_weight: float | None = None,
+        robust_eta: float | None = None,
+        robust_model: _RobustModelName | None = None,
+        solver: _SolverName | None = None,
+        use_hierarchy: bool | None = None,
+        model: _ModelName | None = None,
+        decide_only: bool | None = None,
+    ) -> CollisionRequest: ...
+    @property
+    def surface(self) -> _SurfaceName:
+        """Family of the separating surface."""
+    @property
+    def aggregation(self) -> _AggregationName:
+        """How per-point probabilities become ``P``."""
+    @property
+    def threshold_collision(self) -> float:
+        """``P`` at or above this reads ``"collision"``."""
+    @property
+    def threshold_free(self) -> float:
+        """``P`` at or below this reads ``"free"``."""
+    @property
+    def prune_epsilon(self) -> float:
+        """Node pairs whose crossing bound is below this are pruned."""
+    @property
+    def region_max_points(self) -> int:
+        """Near regions with more points are split into patches."""
+    @property
+    def near_context(self) -> float:
+        """Context kept around a near region, in sampling spacings."""
+    @property
+    def slack_weight(self) -> float:
+        """Weight of the classifier's slack term (``lambda`` in the formulas)."""
+    @property
+    def robust_eta(self) -> float:
+        """Confidence of each point's chance constraint."""
+    @property
+    def robust_model(self) -> _RobustModelName:
+        """Noise assumption of the chance constraints."""
+    @property
+    def solver(self) -> _SolverName:
+        """Solver of the classifier."""
+    @property
+    def use_hierarchy(self) -> bool:
+        """``False``: every point pair is tested (the brute-force reference)."""
+    @property
+    def model(self) -> _ModelName:
+        """What is classified: points or surface elements."""
+    @property
+    def decide_only(self) -> bool:
+        """Return as soon as the state is decided."""
+    def replace(self, **changes: Any) -> CollisionRequest:
+        """Return a copy with the given options changed (``None`` leaves one as it is).
+
+        Raises
+        ------
+        InvalidInputError
+            On an unknown option name or a value out of its domain.
+        """
+    def to_dict(self) -> dict[str, str | float | int | bool]:
+        """Return the options as a dict, ready for JSON; ``CollisionRequest(**d)`` rebuilds it."""
+    @staticmethod
+    def choices() -> dict[str, tuple[str, ...]]:
+        """Return the valid names of the enum options (``surface``, ``aggregation``, ``robust_model``, ``solver``, ``model``)."""
+    def __eq__(self, value: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+def collide(
+    a: PointCloud | Mesh | Any,
+    b: PointCloud | Mesh | Any,
+    pose_a: npt.ArrayLike | None = None,
+    pose_b: npt.ArrayLike | None = None,
+    *,
+    request: CollisionRequest | None = None,
+    mesh_spacing: float | None = None,
+    **options: Any,
+) -> CollisionResult:
+    """Probabilistic collision query between two noisy point clouds.
+
+    The options are ``request`` (a :class:`CollisionRequest`; default: the Rust
+    defaults). Keyword options named as :class:`CollisionRequest`'s are a
+    shortcut: ``collide(a, b, surface="linear")`` is
+    ``collide(a, b, request=CollisionRequest(surface="linear"))``, and given
+    with ``request`` they override its fields. The GIL is released during the
+    query.
+
+    Either side may be a mesh (``Mesh``, a trimesh ``Trimesh`` or an Open3D
+    ``TriangleMesh``): an exact surface, sampled every ``mesh_spacing`` metres into
+    a cloud without sensor noise whose covariance is its own discretization
+    (``spacing^2 / 12`` across each sample's face, none along its normal).
+
+    Parameters
+    ----------
+    a, b : PointCloud or mesh
+        The two clouds, or one cloud and one mesh.
+    pose_a, pose_b : array_like, shape (4, 4), optional
+        Rigid poses of the clouds (own frame to world); ``None`` is the identity.
+    request : CollisionRequest, optional
+        The options of the query (default ``CollisionRequest()``).
+    mesh_spacing : float, optional
+        Sampling spacing of a mesh side (metres; default: half the cloud's median
+        spacing, its distance to the 6th nearest neighbour). A ``Mesh`` keeps its
+        last samplings, so repeated queries do not sample it again.
+    **options
+        Options of :class:`CollisionRequest`, overriding ``request``'s.
+
     Returns
     -------
     CollisionResult
@@ -581,7 +757,8 @@ def collide(
         On a bad pose, an unknown option name or an option out of its domain, or
         two meshes.
     TypeError
-        If a side is neither a cloud nor a mesh.
+        If a side is neither a cloud nor a mesh, or ``request`` is not a
+        :class:`CollisionRequest`.
     """
 
 def collide_many(
@@ -590,21 +767,9 @@ def collide_many(
     poses_a: npt.ArrayLike,
     pose_b: npt.ArrayLike | None = None,
     *,
-    surface: _SurfaceName | None = None,
-    aggregation: _AggregationName | None = None,
-    threshold_collision: float | None = None,
-    threshold_free: float | None = None,
-    prune_epsilon: float | None = None,
-    region_max_points: int | None = None,
-    near_context: float | None = None,
-    lambda_: float | None = None,
-    robust_eta: float | None = None,
-    robust_model: _RobustModelName | None = None,
-    solver: _SolverName | None = None,
-    use_hierarchy: bool | None = None,
+    request: CollisionRequest | None = None,
     mesh_spacing: float | None = None,
-    model: _ModelName | None = None,
-    decide_only: bool | None = None,
+    **options: Any,
 ) -> list[CollisionResult]:
     """Run :func:`collide` for many poses of ``a``, in parallel.
 
@@ -616,7 +781,7 @@ def collide_many(
         Poses of ``a``.
     pose_b : array_like, shape (4, 4), optional
         Pose of ``b``; ``None`` is the identity.
-    surface, aggregation, threshold_collision, threshold_free, prune_epsilon, region_max_points, near_context, lambda_, robust_eta, robust_model, solver, use_hierarchy, mesh_spacing, model, decide_only
+    request, mesh_spacing, **options
         As in :func:`collide`.
 
     Returns
@@ -624,27 +789,6 @@ def collide_many(
     list of CollisionResult
         One result per pose, in the order of ``poses_a``; identical to calling
         :func:`collide` in a loop.
-    """
-
-def default_options() -> dict[str, str | float | int | bool]:
-    """Return the default of every option of :func:`collide`, read from the Rust defaults.
-
-    Returns
-    -------
-    dict
-        ``surface``, ``aggregation``, ``threshold_collision``, ``threshold_free``,
-        ``prune_epsilon``, ``region_max_points``, ``near_context``, ``lambda_``, ``robust_eta``,
-        ``robust_model``, ``solver``, ``use_hierarchy``, ``model`` and ``decide_only``.
-    """
-
-def option_names() -> dict[str, tuple[str, ...]]:
-    """Return the valid names of the string options.
-
-    Returns
-    -------
-    dict
-        ``surface``, ``aggregation``, ``robust_model``, ``solver`` and ``model``, each a tuple of
-        names.
     """
 
 def sample_sphere(n: int, radius: float = 1.0, center: npt.ArrayLike | None = None) -> _FloatArray:
@@ -933,8 +1077,23 @@ def write_point_cloud(
 ) -> None:
     """Write a point cloud (see :func:`cloudprox.io.write_point_cloud`)."""
 
-def read_mesh(path: str, format: str = "auto") -> tuple[Mesh, int]:
-    """Read a mesh file; returns the mesh and the number of dropped degenerate faces."""
+def read_mesh(path: str | os.PathLike[str], format: str = "auto") -> Mesh:
+    """Read a triangle mesh (STL ascii/binary, OBJ, PLY, OFF).
+
+    Polygons are split into fans of triangles and STL vertices are welded.
+    Triangles that repeat a vertex are dropped with a
+    :class:`~cloudprox.DegenerateFacesWarning` giving their number.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    cloudprox.FormatError
+        If its content is corrupt, truncated or unsupported.
+    """
+
+def _read_mesh_counted(path: str | os.PathLike[str], format: str = "auto") -> tuple[Mesh, int]:
+    """:func:`read_mesh` without the warning: the mesh and the number of faces dropped."""
 
 def write_mesh(
     path: str,
@@ -975,8 +1134,25 @@ def voxel_downsample(
     voxel_size: float,
     covariances: npt.ArrayLike | None = None,
     merge: str = "mean",
-) -> tuple[_FloatArray, _FloatArray | None, _IntArray]:
+) -> Voxels:
     """One point per occupied voxel (see :mod:`cloudprox.filters`)."""
+
+@final
+class Voxels:
+    """What :func:`voxel_downsample` returns; unpacks as ``points, covariances, counts``."""
+
+    @property
+    def points(self) -> _FloatArray:
+        """The centroid of each voxel's members, shape ``(m, 3)``."""
+    @property
+    def covariances(self) -> npt.NDArray[np.float64] | None:
+        """The merged covariance of each voxel, ``(m, 3, 3)``; ``None`` without input covariances."""
+    @property
+    def counts(self) -> _IntArray:
+        """The number of input points in each voxel, shape ``(m,)``."""
+    def __iter__(self) -> Iterator[Any]: ...
+    def __getitem__(self, key: int, /) -> Any: ...
+    def __len__(self) -> int: ...
 
 def statistical_outlier_removal(
     points: npt.ArrayLike, k: int | None = None, std_ratio: float = ...
@@ -1008,8 +1184,12 @@ class SelfFilter:
     def apply(self, points: npt.ArrayLike) -> _IntArray:
         """Return the indices (ascending) of the points not on the robot."""
 
-def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> tuple[Mesh, int]:
-    """Read a mesh from bytes (see :func:`cloudprox.io.parse_mesh`)."""
+def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> Mesh:
+    """Read a triangle mesh from bytes in memory (e.g. a member of a zip archive).
+
+    As :func:`read_mesh`; ``format`` must be given (``"stl"``, ``"obj"``,
+    ``"ply"`` or ``"off"``) and ``name`` is used in messages.
+    """
 
 # ---------------------------------------------------------------- robots (issue 11)
 
@@ -1118,14 +1298,37 @@ class RobotCollisionResult:
     def self_collisions(self) -> list[tuple[str, str]]:
         """Pairs of non-adjacent links that intersect; not part of ``probability``."""
     @property
-    def stats(self) -> dict[str, int | float]:
-        """Counters and timings of the query.
+    def stats(self) -> RobotStats:
+        """Counters and timings of the query."""
 
-        Keys: ``links_with_geometry``, ``links_queried``, ``links_after_decision``
-        (with ``decide_only``, the links left once one reached the collision
-        threshold), ``broad_phase_nodes``, ``self_pairs_checked``,
-        ``node_pairs_visited`` (int), ``time_seconds`` (float).
-        """
+@final
+class RobotStats:
+    """Counters and timings of one :func:`collide_robot` query (``RobotCollisionResult.stats``)."""
+
+    @property
+    def links_with_geometry(self) -> int:
+        """Links with geometry."""
+    @property
+    def links_queried(self) -> int:
+        """Links queried against the cloud (the others skipped by the broad phase or the decision)."""
+    @property
+    def links_after_decision(self) -> int:
+        """With ``decide_only``, the links left once one reached the collision threshold."""
+    @property
+    def broad_phase_nodes(self) -> int:
+        """Hierarchy nodes of the cloud visited by the broad phase."""
+    @property
+    def self_pairs_checked(self) -> int:
+        """Link pairs tested for self-collision."""
+    @property
+    def node_pairs_visited(self) -> int:
+        """Node pairs visited by the per-link queries, summed."""
+    @property
+    def time_seconds(self) -> float:
+        """Wall time of the query (seconds)."""
+    def to_dict(self) -> dict[str, int | float]:
+        """Return the statistics as a dict of ``int`` and ``float``, ready for JSON."""
+    def __eq__(self, value: object, /) -> bool: ...
 
 @final
 class RobotBatchResult:
@@ -1181,6 +1384,8 @@ def collide_robot(
     q: npt.ArrayLike,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
+    *,
+    request: CollisionRequest | None = None,
     **options: Any,
 ) -> RobotCollisionResult:
     """Query the robot at configuration ``q`` (root at ``base_pose``) against a cloud.
@@ -1194,12 +1399,14 @@ def collide_robot(
     both clouds' element hulls). Their query would read 0. Every
     other link is queried as :func:`collide` does; with ``decide_only=True`` the
     links after the first whose probability reaches ``threshold_collision`` are
-    left (probability NaN, ``stats["links_after_decision"]``): the state is
+    left (probability NaN, ``stats.links_after_decision``): the state is
     collision whatever they hold. Self-collision between non-adjacent links
     (exact meshes, ``self_collision=True``) is reported apart.
-    ``options`` are those of :func:`collide` plus ``mesh_spacing``,
-    ``broad_phase`` and ``self_collision``; unknown names raise
-    :class:`InvalidInputError`. The GIL is released.
+    ``request`` is a :class:`CollisionRequest` (the link queries' options);
+    ``options`` are the keyword options of :class:`CollisionRequest`
+    (overriding ``request``'s) plus ``mesh_spacing``, ``broad_phase`` and
+    ``self_collision``; unknown names raise :class:`InvalidInputError`. The GIL
+    is released.
     """
 
 def collide_robot_many(
@@ -1207,6 +1414,8 @@ def collide_robot_many(
     qs: npt.ArrayLike,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
+    *,
+    request: CollisionRequest | None = None,
     **options: Any,
 ) -> RobotBatchResult:
     """:func:`collide_robot` for each row of the ``(m, dof)`` array ``qs``, in parallel, GIL released."""
@@ -1217,6 +1426,8 @@ def check_motion(
     q1: npt.ArrayLike,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
+    *,
+    request: CollisionRequest | None = None,
     **options: Any,
 ) -> MotionResult:
     """Check the straight joint-space motion from ``q0`` to ``q1`` against the cloud.

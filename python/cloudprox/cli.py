@@ -38,11 +38,10 @@ import numpy as np
 
 from cloudprox import __version__
 from cloudprox._native import (
+    CollisionRequest,
     CollisionResult,
     PointCloud,
     collide,
-    default_options,
-    option_names,
 )
 from cloudprox.exceptions import CloudproxError
 
@@ -95,7 +94,10 @@ def result_to_dict(result: CollisionResult) -> dict[str, Any]:
             }
             for r in result.regions
         ],
-        "stats": {k: (_finite(v) if isinstance(v, float) else v) for k, v in result.stats.items()},
+        "stats": {
+            k: (_finite(v) if isinstance(v, float) else v)
+            for k, v in result.stats.to_dict().items()
+        },
     }
 
 
@@ -153,7 +155,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             f"{result.probability:.3g}",
             f"[{style}]{result.state}[/{style}]",
             str(len(result.regions)),
-            f"{1e3 * result.stats['time_seconds']:.1f}",
+            f"{1e3 * result.stats.time_seconds:.1f}",
         )
     console.print(table)
 
@@ -225,15 +227,22 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         ]
     except (PipelineError, FileNotFoundError) as e:
         raise CliError(str(e)) from None
-    options: dict[str, Any] = {
-        k: getattr(args, k)
-        for k in ("model", "surface", "aggregation", "solver", "mesh_spacing")
-        if getattr(args, k) is not None
-    }
-    if args.decide_only:
-        options["decide_only"] = True
+    request = CollisionRequest(
+        model=args.model,
+        surface=args.surface,
+        aggregation=args.aggregation,
+        solver=args.solver,
+        decide_only=args.decide_only,
+    )
     _check_view_arguments(args)
-    result = collide(sides[0].obj, sides[1].obj, poses[0], poses[1], **options)
+    result = collide(
+        sides[0].obj,
+        sides[1].obj,
+        poses[0],
+        poses[1],
+        request=request,
+        mesh_spacing=args.mesh_spacing,
+    )
 
     def scene() -> Any:
         from cloudprox.view import collision_scene
@@ -272,7 +281,7 @@ def _cmd_collide(args: argparse.Namespace) -> int:
             )
     console.print(
         f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
-        f"regions: {len(result.regions)}   time: {1e3 * result.stats['time_seconds']:.2f} ms"
+        f"regions: {len(result.regions)}   time: {1e3 * result.stats.time_seconds:.2f} ms"
     )
     for k, r in enumerate(result.regions):
         point = ", ".join(f"{x:+.4f}" for x in r.point)
@@ -283,7 +292,8 @@ def _cmd_collide(args: argparse.Namespace) -> int:
             f"{r.surface} surface, {r.status}"
         )
     stats = ", ".join(
-        f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in result.stats.items()
+        f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}"
+        for k, v in result.stats.to_dict().items()
     )
     console.print(f"stats: {stats}")
     _write_views(args, scene)
@@ -449,7 +459,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
                     for name, link in result.links.items()
                 },
                 "self_collisions": [list(p) for p in result.self_collisions],
-                "stats": result.stats,
+                "stats": result.stats.to_dict(),
             }
             print(json.dumps(doc, indent=2))
             return 0
@@ -461,8 +471,8 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         )
         console.print(
             f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
-            f"links queried: {result.stats['links_queried']}   "
-            f"time: {1e3 * result.stats['time_seconds']:.2f} ms"
+            f"links queried: {result.stats.links_queried}   "
+            f"time: {1e3 * result.stats.time_seconds:.2f} ms"
         )
         for name, link in result.links.items():
             if link.queried:
@@ -792,7 +802,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def _add_query_arguments(
-    col: argparse.ArgumentParser, defaults: dict[str, Any], names: dict[str, Any]
+    col: argparse.ArgumentParser, defaults: CollisionRequest, names: dict[str, tuple[str, ...]]
 ) -> None:
     """Add the arguments of one query between two files (``collide`` and ``view``)."""
     col.add_argument("a", metavar="A", help="point-cloud or mesh file of side A")
@@ -855,7 +865,7 @@ def _add_query_arguments(
         choices=names["model"],
         default=None,
         help="what is classified: surface elements fitted to the points, or every point "
-        f"(the paper's method) (default: {defaults['model']})",
+        f"(the paper's method) (default: {defaults.model})",
     )
     col.add_argument(
         "--decide-only",
@@ -866,19 +876,19 @@ def _add_query_arguments(
         "--surface",
         choices=names["surface"],
         default=None,
-        help=f"separating surface (default: {defaults['surface']})",
+        help=f"separating surface (default: {defaults.surface})",
     )
     col.add_argument(
         "--aggregation",
         choices=names["aggregation"],
         default=None,
-        help=f"aggregation of per-point probabilities (default: {defaults['aggregation']})",
+        help=f"aggregation of per-point probabilities (default: {defaults.aggregation})",
     )
     col.add_argument(
         "--solver",
         choices=names["solver"],
         default=None,
-        help=f"SOCP solver (default: {defaults['solver']})",
+        help=f"SOCP solver (default: {defaults.solver})",
     )
     col.add_argument("--json", action="store_true", help="print the result as JSON")
     _add_view_arguments(col)
@@ -926,8 +936,8 @@ def build_parser() -> argparse.ArgumentParser:
     argparse.ArgumentParser
         The parser :func:`main` uses.
     """
-    defaults = default_options()
-    names = option_names()
+    defaults = CollisionRequest()
+    names = CollisionRequest.choices()
     parser = argparse.ArgumentParser(
         prog="cloudprox",
         description="Probabilistic collision queries between noisy point clouds.",

@@ -11,7 +11,7 @@ re-exported here::
 
 A solve that does not converge is *not* an error: it falls back to a plane and is
 reported as data (``ContactRegion.status == "fallback"`` and
-``CollisionResult.stats["solver_fallbacks"]``). Missing files raise the builtin
+``CollisionResult.stats.solver_fallbacks``). Missing files raise the builtin
 ``FileNotFoundError``.
 
 Warnings: :class:`DegenerateFacesWarning` when a mesh file's faces that repeat a

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
@@ -32,9 +31,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from cloudprox._native import CloudFile, Mesh
-from cloudprox._native import parse_mesh as _parse_mesh
-from cloudprox._native import read_mesh as _read_mesh
+from cloudprox._native import CloudFile, Mesh, parse_mesh, read_mesh
 from cloudprox._native import read_point_cloud as _read_point_cloud
 from cloudprox._native import read_pointcloud2 as _read_pointcloud2
 from cloudprox._native import write_mesh as _write_mesh
@@ -132,45 +129,6 @@ def write_point_cloud(
         write_ascii=write_ascii,
         compressed=compressed,
     )
-
-
-def read_mesh(path: PathLike, format: MeshFormatName = "auto") -> Mesh:
-    """Read a triangle mesh (STL ascii/binary, OBJ, PLY, OFF).
-
-    Polygons are split into fans of triangles and STL vertices are welded.
-    Triangles that repeat a vertex are dropped with a
-    :class:`DegenerateFacesWarning` giving their number.
-
-    Raises
-    ------
-    FileNotFoundError
-        If the file does not exist.
-    cloudprox.FormatError
-        If its content is corrupt, truncated or unsupported.
-    """
-    mesh, dropped = _read_mesh(os.fspath(path), format)
-    _warn_dropped(os.fspath(path), dropped)
-    return mesh
-
-
-def _warn_dropped(source: str, dropped: int) -> None:
-    if dropped:
-        warnings.warn(
-            f"{source}: dropped {dropped} degenerate face(s) that repeat a vertex",
-            DegenerateFacesWarning,
-            stacklevel=3,
-        )
-
-
-def parse_mesh(data: bytes, format: MeshFormatName, name: str = "<bytes>") -> Mesh:
-    """Read a triangle mesh from bytes in memory (e.g. a member of a zip archive).
-
-    As :func:`read_mesh`; ``format`` must be given (``"stl"``, ``"obj"``,
-    ``"ply"`` or ``"off"``) and ``name`` is used in messages.
-    """
-    mesh, dropped = _parse_mesh(data, format, name)
-    _warn_dropped(name, dropped)
-    return mesh
 
 
 def write_mesh(

@@ -25,8 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cloudprox import filters, io
-from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera
-from cloudprox._native import read_mesh as _native_read_mesh
+from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera, _read_mesh_counted
 
 __all__ = [
     "MESH_EXTENSIONS",
@@ -235,7 +234,7 @@ def is_mesh_file(path: str) -> bool:
 
 def read_mesh_file(path: str) -> tuple[Mesh, int]:
     """Read a mesh file; also return the number of degenerate faces dropped (no warning)."""
-    return _native_read_mesh(path)
+    return _read_mesh_counted(path)
 
 
 def _apply_filter(
@@ -253,7 +252,8 @@ def _apply_filter(
         keep = filters.crop_box(points, box[:3], box[3:])
     elif step.name == "voxel":
         size = _float(step.args[0], "voxel size")
-        new_points, new_covs, _ = filters.voxel_downsample(points, size, covariances=covs)
+        voxels = filters.voxel_downsample(points, size, covariances=covs)
+        new_points, new_covs = voxels.points, voxels.covariances
         return new_points, new_covs, None
     elif step.name == "outliers":
         k = _int(step.args[0], "outliers K") if step.args else filters.SOR_DEFAULT_K

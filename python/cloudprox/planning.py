@@ -33,7 +33,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from cloudprox._native import PointCloud, Robot, check_motion, collide_robot, default_options
+from cloudprox._native import (
+    CollisionRequest,
+    PointCloud,
+    Robot,
+    check_motion,
+    collide_robot,
+)
 
 __all__ = ["ChanceConstraint", "PlanResult", "plan", "plan_joint_space"]
 
@@ -96,8 +102,10 @@ class ChanceConstraint:
         The chance constraint, in ``[0, 1)``: a valid state has a collision
         probability at most this (and no self-collision).
     **options
-        Options of :func:`cloudprox.collide_robot`, plus ``resolution`` of
-        :func:`cloudprox.check_motion`. Unless ``decide_only`` is given, it is on
+        Options of :func:`cloudprox.collide_robot` (``request=`` a
+        :class:`cloudprox.CollisionRequest` and keyword options), plus
+        ``resolution`` of :func:`cloudprox.check_motion`. Unless a ``request``
+        or ``decide_only`` is given, ``decide_only`` is on
         when ``max_probability`` is below 0.5, with ``threshold_collision`` 0.5
         unless given: a query may then stop at the first patch that reaches
         that threshold, which is above the constraint anyway, so its answer for
@@ -121,15 +129,17 @@ class ChanceConstraint:
     ) -> None:
         if not (np.isfinite(max_probability) and 0.0 <= max_probability < 1.0):
             raise ValueError(f"max_probability must be in [0, 1), got {max_probability}")
-        if max_probability < 0.5 and "decide_only" not in options:
+        request: CollisionRequest | None = options.get("request")
+        if max_probability < 0.5 and "decide_only" not in options and request is None:
             # A query may stop at the first patch whose probability reaches the
             # collision threshold: 0.5 (its lowest) unless given, above the constraint.
             options.setdefault("threshold_collision", 0.5)
             options["decide_only"] = True
-        threshold = float(
-            options.get("threshold_collision", default_options()["threshold_collision"])
+        effective = (request or CollisionRequest()).replace(
+            **{k: options[k] for k in ("threshold_collision", "decide_only") if k in options}
         )
-        if options.get("decide_only") and max_probability >= threshold:
+        threshold = effective.threshold_collision
+        if effective.decide_only and max_probability >= threshold:
             raise ValueError(
                 f"decide_only needs max_probability ({max_probability}) below "
                 f"threshold_collision ({threshold}): a query may stop at that probability"

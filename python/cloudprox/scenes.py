@@ -220,7 +220,7 @@ class SceneObject:
             the penetration depth).
         """
         return {
-            group: float(exact_proximity(self.exact, shape, pose)["signed_distance"])
+            group: exact_proximity(self.exact, shape, pose).signed_distance
             for group, shape in other.group_shapes.items()
         }
 
@@ -349,7 +349,7 @@ class Scene:
 
     def exact_gap(self, pose: npt.ArrayLike) -> float:
         """Exact signed distance between the piano at ``pose`` and the room (metres)."""
-        return float(exact_proximity(self.piano.exact, self.room.exact, pose)["signed_distance"])
+        return exact_proximity(self.piano.exact, self.room.exact, pose).signed_distance
 
 
 def build_scene(sigma: float = 0.005, points: int = 3000, seed: int = 0) -> Scene:

@@ -8,8 +8,9 @@ use cloudprox::filter::{
 };
 use cloudprox::io::Grid;
 use cloudprox::math::{Point3, Pose};
-use numpy::{PyArray1, PyArray2, PyArray3};
+use numpy::{PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::{PyIterator, PyTuple};
 
 use crate::convert::{
     indices_to_py, matrices3_from, matrices3_to_py, points_from, points_to_py, pose_from,
@@ -53,16 +54,82 @@ pub fn crop_box<'py>(
     Ok(indices_to_py(py, &keep))
 }
 
-/// What `voxel_downsample` returns: centroids, merged covariances, counts.
-type Voxels<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Option<Bound<'py, PyArray3<f64>>>,
-    Bound<'py, PyArray1<i64>>,
-);
+/// What ``voxel_downsample`` returns: one point per occupied voxel, with the
+/// merged covariances and the member counts. Unpacks as
+/// ``points, covariances, counts = voxel_downsample(...)``.
+#[pyclass(name = "Voxels", frozen, module = "cloudprox._native")]
+pub struct PyVoxels {
+    points: Py<PyArray2<f64>>,
+    covariances: Option<Py<PyArray3<f64>>>,
+    counts: Py<PyArray1<i64>>,
+}
+
+impl PyVoxels {
+    fn as_tuple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let items = [
+            self.points.clone_ref(py).into_any(),
+            self.covariances
+                .as_ref()
+                .map_or_else(|| py.None(), |c| c.clone_ref(py).into_any()),
+            self.counts.clone_ref(py).into_any(),
+        ];
+        PyTuple::new(py, items)
+    }
+}
+
+#[pymethods]
+impl PyVoxels {
+    /// The centroid of each voxel's members, shape ``(m, 3)``.
+    #[getter]
+    fn points(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
+        self.points.clone_ref(py)
+    }
+
+    /// The merged covariance of each voxel, shape ``(m, 3, 3)``; ``None`` when
+    /// no covariances were given.
+    #[getter]
+    fn covariances(&self, py: Python<'_>) -> Option<Py<PyArray3<f64>>> {
+        self.covariances.as_ref().map(|c| c.clone_ref(py))
+    }
+
+    /// The number of input points in each voxel, shape ``(m,)``, int64.
+    #[getter]
+    fn counts(&self, py: Python<'_>) -> Py<PyArray1<i64>> {
+        self.counts.clone_ref(py)
+    }
+
+    /// ``points``, ``covariances``, ``counts``, in that order (for unpacking).
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
+        self.as_tuple(py)?.try_iter()
+    }
+
+    /// ``(points, covariances, counts)[index]``.
+    fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyAny>> {
+        self.as_tuple(py)?.as_any().get_item(index)
+    }
+
+    #[allow(clippy::unused_self)]
+    fn __len__(&self) -> usize {
+        3
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Voxels(points={}, covariances={})",
+            self.points.bind(py).len(),
+            if self.covariances.is_some() {
+                "yes"
+            } else {
+                "None"
+            }
+        )
+    }
+}
 
 /// Voxel downsampling: one point per occupied voxel of side `voxel_size` (the
 /// centroid of its members), with merged covariances (`merge="mean"`: the mean
-/// of the members'; `"independent"`: their sum over n^2) and member counts.
+/// of the members'; `"independent"`: their sum over n^2) and member counts, as a
+/// `Voxels`.
 #[pyfunction]
 #[pyo3(signature = (points, voxel_size, covariances=None, merge="mean"))]
 pub fn voxel_downsample<'py>(
@@ -71,7 +138,7 @@ pub fn voxel_downsample<'py>(
     voxel_size: f64,
     covariances: Option<&Bound<'py, PyAny>>,
     merge: &str,
-) -> PyResult<Voxels<'py>> {
+) -> PyResult<PyVoxels> {
     let points = points_from(points, "points")?;
     let covs = covariances
         .map(|c| matrices3_from(c, "covariances"))
@@ -90,14 +157,15 @@ pub fn voxel_downsample<'py>(
         filter::voxel_downsample_with(&points, covs.as_deref(), voxel_size, merge)
     })?;
     let counts: Vec<i64> = v.counts.iter().map(|&c| i64::from(c)).collect();
-    Ok((
-        points_to_py(py, &v.points)?,
-        v.covariances
+    Ok(PyVoxels {
+        points: points_to_py(py, &v.points)?.unbind(),
+        covariances: v
+            .covariances
             .as_ref()
-            .map(|c| matrices3_to_py(py, c))
+            .map(|c| matrices3_to_py(py, c).map(Bound::unbind))
             .transpose()?,
-        PyArray1::from_vec(py, counts),
-    ))
+        counts: PyArray1::from_vec(py, counts).unbind(),
+    })
 }
 
 /// Indices (ascending) of the points kept by statistical outlier removal (PCL's

@@ -1,6 +1,7 @@
 //! File reading and writing: `CloudFile`, `read_point_cloud`, `write_point_cloud`,
 //! `read_mesh`, `write_mesh`.
 
+use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -491,11 +492,41 @@ pub fn write_point_cloud(
     })
 }
 
-/// Reads a mesh file (STL, OBJ, PLY, OFF); returns the mesh and the number of
-/// faces dropped because they repeat a vertex.
+/// Emits `DegenerateFacesWarning` (from `cloudprox.exceptions`) when faces
+/// were dropped, attributed to the caller's line.
+fn warn_dropped(py: Python<'_>, source: &str, dropped: usize) -> PyResult<()> {
+    if dropped == 0 {
+        return Ok(());
+    }
+    let category = py
+        .import("cloudprox.exceptions")?
+        .getattr("DegenerateFacesWarning")?;
+    let msg = format!("{source}: dropped {dropped} degenerate face(s) that repeat a vertex");
+    let msg = CString::new(msg.replace('\0', "")).unwrap_or_default();
+    PyErr::warn(py, &category, &msg, 1)
+}
+
+/// Reads a triangle mesh (STL ascii/binary, OBJ, PLY, OFF; `format` `"auto"`
+/// guesses from the extension).
+///
+/// Polygons are split into fans of triangles and STL vertices are welded.
+/// Triangles that repeat a vertex are dropped with a `DegenerateFacesWarning`
+/// giving their number. A missing file raises `FileNotFoundError`; a corrupt,
+/// truncated or unsupported one `cloudprox.FormatError`.
 #[pyfunction]
 #[pyo3(signature = (path, format="auto"))]
-pub fn read_mesh(py: Python<'_>, path: PathBuf, format: &str) -> PyResult<(PyMesh, usize)> {
+pub fn read_mesh(py: Python<'_>, path: PathBuf, format: &str) -> PyResult<PyMesh> {
+    let source = path.to_string_lossy().into_owned();
+    let (mesh, dropped) = read_mesh_counted(py, path, format)?;
+    warn_dropped(py, &source, dropped)?;
+    Ok(mesh)
+}
+
+/// `read_mesh` without the warning: the mesh and the number of degenerate faces
+/// dropped (for the command line, which reports them itself).
+#[pyfunction]
+#[pyo3(name = "_read_mesh_counted", signature = (path, format="auto"))]
+pub fn read_mesh_counted(py: Python<'_>, path: PathBuf, format: &str) -> PyResult<(PyMesh, usize)> {
     let format = mesh_format(py, format)?;
     let data = run_detached(py, move || io::read_mesh(&path, format))?;
     Ok((PyMesh::wrap(data.mesh), data.dropped_faces))
@@ -621,8 +652,9 @@ pub fn write_pointcloud2<'py>(py: Python<'py>, cloud: &Bound<'py, PyAny>) -> PyR
     Ok((d, PyBytes::new(py, &bytes)))
 }
 
-/// Reads a mesh from bytes in memory (`format`: stl, obj, ply or off; `name`
-/// is used in errors); returns the mesh and the number of dropped degenerate faces.
+/// Reads a triangle mesh from bytes in memory (e.g. a member of a zip archive),
+/// as `read_mesh`; `format` must be given (`"stl"`, `"obj"`, `"ply"` or
+/// `"off"`) and `name` is used in messages.
 #[pyfunction]
 #[pyo3(signature = (data, format, name="<bytes>"))]
 pub fn parse_mesh(
@@ -630,7 +662,7 @@ pub fn parse_mesh(
     data: &Bound<'_, PyBytes>,
     format: &str,
     name: &str,
-) -> PyResult<(PyMesh, usize)> {
+) -> PyResult<PyMesh> {
     let Some(format) = mesh_format(py, format)? else {
         return Err(invalid_input(
             py,
@@ -638,7 +670,8 @@ pub fn parse_mesh(
         ));
     };
     let bytes = data.as_bytes().to_vec();
-    let name = name.to_string();
-    let data = run_detached(py, move || io::read_mesh_bytes(&bytes, &name, format))?;
-    Ok((PyMesh::wrap(data.mesh), data.dropped_faces))
+    let source = name.to_string();
+    let data = run_detached(py, move || io::read_mesh_bytes(&bytes, &source, format))?;
+    warn_dropped(py, name, data.dropped_faces)?;
+    Ok(PyMesh::wrap(data.mesh))
 }

@@ -7,9 +7,9 @@
 //! | `error.rs` | exception hierarchy, core error and panic mapping |
 //! | `convert.rs` | numpy <-> nalgebra conversion and shape checks |
 //! | `cloud.rs` | `PointCloud` |
-//! | `request.rs` | query options -> `CollisionRequest` |
+//! | `request.rs` | `CollisionRequest`: the query options |
 //! | `collide.rs` | `collide`, `collide_many` |
-//! | `result.rs` | `CollisionResult`, `ContactRegion` |
+//! | `result.rs` | `CollisionResult`, `ContactRegion`, `QueryStats` |
 //! | `filter.rs` | sensor-cloud filters: crop box, voxel, outliers, shadow, self |
 //! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
@@ -47,9 +47,12 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<result::PyContactRegion>()?;
     m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
-    m.add_function(wrap_pyfunction!(request::default_options, m)?)?;
-    m.add_function(wrap_pyfunction!(request::option_names, m)?)?;
+    m.add_class::<request::PyCollisionRequest>()?;
+    m.add_class::<result::PyQueryStats>()?;
     m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<mesh::PyMeshSample>()?;
+    m.add_class::<mesh::PyProximity>()?;
+    m.add_class::<filter::PyVoxels>()?;
     m.add_class::<filter::PySelfFilter>()?;
     m.add_function(wrap_pyfunction!(filter::crop_box, m)?)?;
     m.add_function(wrap_pyfunction!(filter::voxel_downsample, m)?)?;
@@ -59,6 +62,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::read_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_point_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(io::read_mesh_counted, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(io::parse_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_pointcloud2, m)?)?;
@@ -76,6 +80,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<robot::PyLinkCollision>()?;
     m.add_class::<robot::PyRobotCollisionResult>()?;
+    m.add_class::<robot::PyRobotStats>()?;
     m.add_class::<robot::PyRobotBatchResult>()?;
     m.add_class::<robot::PyMotionResult>()?;
     m.add_function(wrap_pyfunction!(robot::collide_robot, m)?)?;

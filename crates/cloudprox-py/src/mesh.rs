@@ -12,19 +12,164 @@ use cloudprox::shape::Mesh;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyIterator, PyTuple};
 
 use crate::convert::{
     points_from, points_to_py, pose_from, poses_from, rows3_to_py, shape_str, vec_to_py,
 };
 use crate::error::{invalid_input, run_detached};
 
-/// What `Mesh.sample` returns: points, normals and face indices.
-type SampleArrays<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray1<i64>>,
-);
+/// What ``Mesh.sample`` returns: the samples, their surface normals and the
+/// face each lies on. Unpacks as ``points, normals, faces = mesh.sample(...)``.
+#[pyclass(name = "MeshSample", frozen, module = "cloudprox._native")]
+pub struct PyMeshSample {
+    points: Py<PyArray2<f64>>,
+    normals: Py<PyArray2<f64>>,
+    faces: Py<PyArray1<i64>>,
+}
+
+impl PyMeshSample {
+    fn as_tuple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let items = [
+            self.points.clone_ref(py).into_any(),
+            self.normals.clone_ref(py).into_any(),
+            self.faces.clone_ref(py).into_any(),
+        ];
+        PyTuple::new(py, items)
+    }
+}
+
+#[pymethods]
+impl PyMeshSample {
+    /// The sampled points, shape ``(k, 3)``.
+    #[getter]
+    fn points(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
+        self.points.clone_ref(py)
+    }
+
+    /// The unit normal of the face under each point, shape ``(k, 3)``.
+    #[getter]
+    fn normals(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
+        self.normals.clone_ref(py)
+    }
+
+    /// The index of the face each point lies on, shape ``(k,)``, int64.
+    #[getter]
+    fn faces(&self, py: Python<'_>) -> Py<PyArray1<i64>> {
+        self.faces.clone_ref(py)
+    }
+
+    /// ``points``, ``normals``, ``faces``, in that order (for unpacking).
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
+        self.as_tuple(py)?.try_iter()
+    }
+
+    /// ``(points, normals, faces)[index]``.
+    fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyAny>> {
+        self.as_tuple(py)?.as_any().get_item(index)
+    }
+
+    #[allow(clippy::unused_self)]
+    fn __len__(&self) -> usize {
+        3
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!("MeshSample(points={})", self.points.bind(py).len())
+    }
+}
+
+/// The pickled form of a `Proximity`: intersecting, distance, penetration depth.
+type ProximityState = (bool, f64, Option<f64>);
+
+/// The answer of ``exact_proximity``: whether two exact shapes intersect and
+/// how far apart (or how deep) they are.
+#[pyclass(name = "Proximity", frozen, module = "cloudprox._native")]
+pub struct PyProximity {
+    inner: ExactProximity,
+}
+
+#[pymethods]
+impl PyProximity {
+    /// Whether the two solids (or surfaces, for open parts) intersect.
+    #[getter]
+    fn intersecting(&self) -> bool {
+        self.inner.intersecting
+    }
+
+    /// The distance between the shapes in metres; 0 when they intersect.
+    #[getter]
+    fn distance(&self) -> f64 {
+        self.inner.distance
+    }
+
+    /// When intersecting: the largest penetration depth over the intersecting
+    /// pairs of parts, if every such pair is convex; ``None`` otherwise.
+    #[getter]
+    fn penetration_depth(&self) -> Option<f64> {
+        self.inner.penetration_depth
+    }
+
+    /// ``distance`` when apart, ``-penetration_depth`` when intersecting (NaN
+    /// when the depth is unknown).
+    #[getter]
+    fn signed_distance(&self) -> f64 {
+        self.inner.signed_distance()
+    }
+
+    /// The four attributes as a dict (``penetration_depth`` may be ``None``,
+    /// ``signed_distance`` NaN).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("intersecting", self.inner.intersecting)?;
+        d.set_item("distance", self.inner.distance)?;
+        d.set_item("penetration_depth", self.inner.penetration_depth)?;
+        d.set_item("signed_distance", self.inner.signed_distance())?;
+        Ok(d)
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner == other.inner
+    }
+
+    /// Pickle support: `intersecting`, `distance` and `penetration_depth`.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ProximityState)> {
+        let r = &slf.get().inner;
+        Ok((
+            slf.getattr("_from_state")?,
+            (r.intersecting, r.distance, r.penetration_depth),
+        ))
+    }
+
+    /// Rebuilds a pickled proximity (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(intersecting: bool, distance: f64, penetration_depth: Option<f64>) -> Self {
+        Self {
+            inner: ExactProximity {
+                intersecting,
+                distance,
+                penetration_depth,
+            },
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        let depth = self
+            .inner
+            .penetration_depth
+            .map_or("None".to_string(), |d| format!("{d}"));
+        format!(
+            "Proximity(intersecting={}, distance={}, penetration_depth={})",
+            if self.inner.intersecting {
+                "True"
+            } else {
+                "False"
+            },
+            self.inner.distance,
+            depth
+        )
+    }
+}
 
 /// An `(m, 3)` integer array-like as triangle indices.
 pub(crate) fn faces_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
@@ -221,16 +366,16 @@ impl PyMesh {
     }
 
     /// Area-weighted uniform samples of the surface: `n` points, or
-    /// `round(density * area)` with `density` (points per square metre). Returns
-    /// `(points (k, 3), normals (k, 3), faces (k,))`.
+    /// `round(density * area)` with `density` (points per square metre), as a
+    /// `MeshSample` (`points` `(k, 3)`, `normals` `(k, 3)`, `faces` `(k,)`).
     #[pyo3(signature = (n=None, *, density=None, seed=0))]
-    fn sample<'py>(
+    fn sample(
         &self,
-        py: Python<'py>,
+        py: Python<'_>,
         n: Option<i64>,
         density: Option<f64>,
         seed: u64,
-    ) -> PyResult<SampleArrays<'py>> {
+    ) -> PyResult<PyMeshSample> {
         let mesh = Arc::clone(&self.inner);
         let sample = match (n, density) {
             (Some(n), None) => {
@@ -243,11 +388,11 @@ impl PyMesh {
             _ => return Err(invalid_input(py, "give exactly one of n and density")),
         };
         let faces: Vec<i64> = sample.faces.iter().map(|&f| i64::from(f)).collect();
-        Ok((
-            points_to_py(py, &sample.points)?,
-            rows3_to_py(py, sample.normals.iter().copied())?,
-            PyArray1::from_vec(py, faces),
-        ))
+        Ok(PyMeshSample {
+            points: points_to_py(py, &sample.points)?.unbind(),
+            normals: rows3_to_py(py, sample.normals.iter().copied())?.unbind(),
+            faces: PyArray1::from_vec(py, faces).unbind(),
+        })
     }
 
     /// Pickle support: `Mesh(vertices, faces)` (the samples cache is not kept).
@@ -325,18 +470,7 @@ impl PyExactShape {
     }
 }
 
-fn proximity_dict<'py>(py: Python<'py>, r: &ExactProximity) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("intersecting", r.intersecting)?;
-    d.set_item("distance", r.distance)?;
-    d.set_item("penetration_depth", r.penetration_depth)?;
-    d.set_item("signed_distance", r.signed_distance())?;
-    Ok(d)
-}
-
-/// Exact proximity of `a` at `pose_a` and `b` at `pose_b`: a dict with
-/// `intersecting`, `distance`, `penetration_depth` (None if unknown) and
-/// `signed_distance`.
+/// Exact proximity of `a` at `pose_a` and `b` at `pose_b`, as a `Proximity`.
 #[pyfunction]
 #[pyo3(signature = (a, b, pose_a=None, pose_b=None))]
 pub fn exact_proximity<'py>(
@@ -345,12 +479,12 @@ pub fn exact_proximity<'py>(
     b: &Bound<'py, PyExactShape>,
     pose_a: Option<&Bound<'py, PyAny>>,
     pose_b: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyProximity> {
     let pa = pose_from(py, pose_a, "pose_a")?;
     let pb = pose_from(py, pose_b, "pose_b")?;
     let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
-    let r = run_detached(py, move || Ok(core_exact(&pa, &sa, &pb, &sb)))?;
-    proximity_dict(py, &r)
+    let inner = run_detached(py, move || Ok(core_exact(&pa, &sa, &pb, &sb)))?;
+    Ok(PyProximity { inner })
 }
 
 /// [`exact_proximity`] for poses `(m, 4, 4)` of `a`, in parallel: a dict of arrays

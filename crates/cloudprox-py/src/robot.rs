@@ -19,30 +19,13 @@ use crate::convert::{check_shape, pose_from, to_f64_array, vec_to_py};
 use crate::error::{invalid_input, run_detached, CoreResultExt};
 use crate::filter::PySelfFilter;
 use crate::mesh::PyMesh;
-use crate::request::RequestOptions;
+use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, PyContactRegion};
 
-/// Names of the options of `collide_robot` beyond those of `collide`.
-const ROBOT_OPTIONS: [&str; 3] = ["mesh_spacing", "broad_phase", "self_collision"];
-/// Names of the options of `check_motion` beyond those of `collide_robot`.
-const MOTION_OPTIONS: [&str; 2] = ["resolution", "max_probability"];
-/// Names of the options shared with `collide`.
-const COLLIDE_OPTIONS: [&str; 14] = [
-    "surface",
-    "aggregation",
-    "threshold_collision",
-    "threshold_free",
-    "prune_epsilon",
-    "region_max_points",
-    "near_context",
-    "lambda_",
-    "robust_eta",
-    "robust_model",
-    "solver",
-    "use_hierarchy",
-    "model",
-    "decide_only",
-];
+/// The keywords of `collide_robot` that are not request options.
+const ROBOT_KEYWORDS: [&str; 4] = ["request", "mesh_spacing", "broad_phase", "self_collision"];
+/// The keywords of `check_motion` beyond those of `collide_robot`.
+const MOTION_KEYWORDS: [&str; 2] = ["resolution", "max_probability"];
 
 fn extract<'py, T: FromPyObjectOwned<'py>>(
     py: Python<'py>,
@@ -54,14 +37,17 @@ fn extract<'py, T: FromPyObjectOwned<'py>>(
         .map_err(|_| invalid_input(py, format!("option {key} must be {kind}")))
 }
 
-/// The keyword options of a robot query, parsed (unknown names are errors).
+/// The request of a robot query: `request` with the keyword options applied
+/// (the request options of `CollisionRequest`, overriding its fields, and the
+/// robot's own; unknown names are errors).
 fn motion_request(
     py: Python<'_>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
     options: Option<&Bound<'_, PyDict>>,
     motion: bool,
 ) -> PyResult<MotionRequest> {
-    let mut req = RequestOptions::default();
     let mut out = MotionRequest::default();
+    let collide_options = PyDict::new(py);
     if let Some(options) = options {
         for (k, v) in options.iter() {
             let key: String = k.extract()?;
@@ -69,24 +55,6 @@ fn motion_request(
                 continue;
             }
             match key.as_str() {
-                "surface" => req.surface = Some(extract(py, &v, &key, "a str")?),
-                "aggregation" => req.aggregation = Some(extract(py, &v, &key, "a str")?),
-                "threshold_collision" => {
-                    req.threshold_collision = Some(extract(py, &v, &key, "a float")?);
-                }
-                "threshold_free" => req.threshold_free = Some(extract(py, &v, &key, "a float")?),
-                "prune_epsilon" => req.prune_epsilon = Some(extract(py, &v, &key, "a float")?),
-                "region_max_points" => {
-                    req.region_max_points = Some(extract(py, &v, &key, "an int")?);
-                }
-                "near_context" => req.near_context = Some(extract(py, &v, &key, "a float")?),
-                "lambda_" => req.lambda = Some(extract(py, &v, &key, "a float")?),
-                "robust_eta" => req.robust_eta = Some(extract(py, &v, &key, "a float")?),
-                "robust_model" => req.robust_model = Some(extract(py, &v, &key, "a str")?),
-                "solver" => req.solver = Some(extract(py, &v, &key, "a str")?),
-                "use_hierarchy" => req.use_hierarchy = Some(extract(py, &v, &key, "a bool")?),
-                "model" => req.model = Some(extract(py, &v, &key, "a str")?),
-                "decide_only" => req.decide_only = Some(extract(py, &v, &key, "a bool")?),
                 "mesh_spacing" => {
                     out.robot.mesh_spacing = Some(extract(py, &v, &key, "a float")?);
                 }
@@ -98,24 +66,15 @@ fn motion_request(
                 "max_probability" if motion => {
                     out.max_probability = Some(extract(py, &v, &key, "a float")?);
                 }
-                _ => {
-                    let mut valid: Vec<&str> = COLLIDE_OPTIONS.to_vec();
-                    valid.extend(ROBOT_OPTIONS);
-                    if motion {
-                        valid.extend(MOTION_OPTIONS);
-                    }
-                    return Err(invalid_input(
-                        py,
-                        format!(
-                            "unknown option '{key}'; valid options: {}",
-                            valid.join(", ")
-                        ),
-                    ));
-                }
+                _ => collide_options.set_item(key, v)?,
             }
         }
     }
-    out.robot.collide = req.build(py)?;
+    let mut also_valid = ROBOT_KEYWORDS.to_vec();
+    if motion {
+        also_valid.extend(MOTION_KEYWORDS);
+    }
+    out.robot.collide = request_from(py, request, Some(&collide_options), &also_valid)?;
     out.robot.validate().or_py(py)?;
     Ok(out)
 }
@@ -471,6 +430,95 @@ impl PyLinkCollision {
     }
 }
 
+/// Counters and timings of one ``collide_robot`` query
+/// (``RobotCollisionResult.stats``).
+#[pyclass(name = "RobotStats", frozen, module = "cloudprox._native")]
+pub struct PyRobotStats {
+    inner: RobotStats,
+}
+
+#[pymethods]
+impl PyRobotStats {
+    /// Links with geometry.
+    #[getter]
+    fn links_with_geometry(&self) -> usize {
+        self.inner.links_with_geometry
+    }
+
+    /// Links queried against the cloud (the others were skipped by the broad
+    /// phase, or left once the query was decided).
+    #[getter]
+    fn links_queried(&self) -> usize {
+        self.inner.links_queried
+    }
+
+    /// Links left unqueried because an earlier link's probability had reached
+    /// the collision threshold (``decide_only`` only).
+    #[getter]
+    fn links_after_decision(&self) -> usize {
+        self.inner.links_after_decision
+    }
+
+    /// Hierarchy nodes of the cloud visited by the broad phase.
+    #[getter]
+    fn broad_phase_nodes(&self) -> usize {
+        self.inner.broad_phase_nodes
+    }
+
+    /// Link pairs tested for self-collision.
+    #[getter]
+    fn self_pairs_checked(&self) -> usize {
+        self.inner.self_pairs_checked
+    }
+
+    /// Node pairs visited by the per-link queries, summed.
+    #[getter]
+    fn node_pairs_visited(&self) -> usize {
+        self.inner.node_pairs_visited
+    }
+
+    /// Wall time of the query, in seconds.
+    #[getter]
+    fn time_seconds(&self) -> f64 {
+        self.inner.time_seconds
+    }
+
+    /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        // Destructured without `..`: a new core field must be added here.
+        let RobotStats {
+            links_with_geometry,
+            links_queried,
+            links_after_decision,
+            broad_phase_nodes,
+            self_pairs_checked,
+            node_pairs_visited,
+            time_seconds,
+        } = &self.inner;
+        let d = PyDict::new(py);
+        d.set_item("links_with_geometry", links_with_geometry)?;
+        d.set_item("links_queried", links_queried)?;
+        d.set_item("links_after_decision", links_after_decision)?;
+        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
+        d.set_item("self_pairs_checked", self_pairs_checked)?;
+        d.set_item("node_pairs_visited", node_pairs_visited)?;
+        d.set_item("time_seconds", time_seconds)?;
+        Ok(d)
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner == other.inner
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.inner;
+        format!(
+            "RobotStats(links_with_geometry={}, links_queried={}, time_seconds={})",
+            s.links_with_geometry, s.links_queried, s.time_seconds
+        )
+    }
+}
+
 /// The answer of `collide_robot`.
 #[pyclass(name = "RobotCollisionResult", frozen, module = "cloudprox._native")]
 pub struct PyRobotCollisionResult {
@@ -565,27 +613,12 @@ impl PyRobotCollisionResult {
         self.self_collisions.clone()
     }
 
-    /// Counters and timings, as a dict.
+    /// Counters and timings (a new `RobotStats` each time).
     #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let RobotStats {
-            links_with_geometry,
-            links_queried,
-            links_after_decision,
-            broad_phase_nodes,
-            self_pairs_checked,
-            node_pairs_visited,
-            time_seconds,
-        } = &self.stats;
-        let d = PyDict::new(py);
-        d.set_item("links_with_geometry", links_with_geometry)?;
-        d.set_item("links_queried", links_queried)?;
-        d.set_item("links_after_decision", links_after_decision)?;
-        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
-        d.set_item("self_pairs_checked", self_pairs_checked)?;
-        d.set_item("node_pairs_visited", node_pairs_visited)?;
-        d.set_item("time_seconds", time_seconds)?;
-        Ok(d)
+    fn stats(&self) -> PyRobotStats {
+        PyRobotStats {
+            inner: self.stats.clone(),
+        }
     }
 
     fn __repr__(&self) -> String {
@@ -608,17 +641,18 @@ fn robot_arg(robot: &Bound<'_, PyAny>) -> PyResult<Arc<Robot>> {
 
 /// The robot at configuration `q` (root at `base_pose`) against the cloud.
 #[pyfunction]
-#[pyo3(signature = (robot, q, cloud, base_pose=None, **options))]
+#[pyo3(signature = (robot, q, cloud, base_pose=None, *, request=None, **options))]
 pub fn collide_robot(
     py: Python<'_>,
     robot: &Bound<'_, PyAny>,
     q: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRobotCollisionResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, options, false)?.robot;
+    let request = motion_request(py, request, options, false)?.robot;
     let q = config_from(q, "q")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
@@ -726,17 +760,18 @@ impl PyRobotBatchResult {
 /// `collide_robot` for each row of the `(m, dof)` array `qs`, in parallel
 /// (rayon) with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (robot, qs, cloud, base_pose=None, **options))]
+#[pyo3(signature = (robot, qs, cloud, base_pose=None, *, request=None, **options))]
 pub fn collide_robot_many(
     py: Python<'_>,
     robot: &Bound<'_, PyAny>,
     qs: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRobotBatchResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, options, false)?.robot;
+    let request = motion_request(py, request, options, false)?.robot;
     let arr = to_f64_array(qs, "qs")?;
     check_shape(
         &arr,
@@ -843,7 +878,7 @@ impl PyMotionResult {
 
 /// The straight joint-space motion from `q0` to `q1` against the cloud.
 #[pyfunction]
-#[pyo3(signature = (robot, q0, q1, cloud, base_pose=None, **options))]
+#[pyo3(signature = (robot, q0, q1, cloud, base_pose=None, *, request=None, **options))]
 pub fn check_motion(
     py: Python<'_>,
     robot: &Bound<'_, PyAny>,
@@ -851,10 +886,11 @@ pub fn check_motion(
     q1: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyMotionResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, options, true)?;
+    let request = motion_request(py, request, options, true)?;
     let q0 = config_from(q0, "q0")?;
     let q1 = config_from(q1, "q1")?;
     let base = pose_from(py, base_pose, "base_pose")?;

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release --example sweep -- [n_points] [linear|quadric]`
 //!
-//! Environment overrides for experiments: `LAMBDA` (slack weight), `ETA` (robust
+//! Environment overrides for experiments: `SLACK_WEIGHT`, `ETA` (robust
 //! confidence), `RMAX` (largest patch), `CTX` (near context in spacings), `DISC=1`
 //! (add the discretization error), `MODEL` (`elements` or `points`).
 
@@ -28,7 +28,7 @@ fn main() {
         .classify(
             ClassifySettings::builder()
                 .surface(surface)
-                .lambda(env("LAMBDA", 100.0))
+                .slack_weight(env("SLACK_WEIGHT", 100.0))
                 .robust_eta(env("ETA", 0.9))
                 .build()
                 .unwrap(),

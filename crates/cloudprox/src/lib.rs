@@ -58,6 +58,7 @@ pub mod error;
 pub mod filter;
 pub mod io;
 pub mod math;
+mod names;
 pub mod probability;
 pub mod query;
 pub mod robot;

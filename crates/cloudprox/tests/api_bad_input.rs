@@ -57,7 +57,7 @@ fn bad_requests() {
     assert!(
         msg(CollisionRequest::builder().region_max_points(2).build()).contains("region_max_points")
     );
-    assert!(msg(ClassifySettings::builder().lambda(0.0).build()).contains("lambda"));
+    assert!(msg(ClassifySettings::builder().slack_weight(0.0).build()).contains("slack_weight"));
     assert!(msg(ClassifySettings::builder().robust_eta(1.0).build()).contains("robust_eta"));
     assert!(msg(ClassifySettings::builder().solver_tol(0.0).build()).contains("solver_tol"));
     assert!(msg(ClassifySettings::builder().solver_max_iter(0).build()).contains("solver_max_iter"));

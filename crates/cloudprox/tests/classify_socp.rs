@@ -53,7 +53,7 @@ fn objective(
         let f = b + w.iter().zip(&phi).map(|(a, p)| a * p).sum::<f64>();
         let g: Vector3 = w.iter().zip(&jac).map(|(a, j)| j * *a).sum();
         let spread = g.dot(&(cov / (sep.scale * sep.scale) * g)).max(0.0).sqrt();
-        total += s.lambda * (1.0 - c * f + r * spread).max(0.0);
+        total += s.slack_weight * (1.0 - c * f + r * spread).max(0.0);
     }
     total
 }

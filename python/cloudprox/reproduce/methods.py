@@ -41,6 +41,7 @@ from scipy.spatial import cKDTree
 from scipy.special import ndtr
 
 from cloudprox._native import (
+    CollisionRequest,
     CollisionResult,
     ExactShape,
     PointCloud,
@@ -218,13 +219,12 @@ def cloudprox_answer(
     :func:`cloudprox.distributed.collide_many`: the same answers, as Ray tasks).
     """
     piano, room = draw.clouds()
-    results = (many or collide_many)(
-        piano, room, poses, surface=surface, aggregation=aggregation, model=model
-    )
+    request = CollisionRequest(surface=surface, aggregation=aggregation, model=model)
+    results = (many or collide_many)(piano, room, poses, request=request)
     return MethodAnswer(
         np.array([r.probability for r in results]),
         np.array([r.state for r in results]),
-        np.array([r.stats["time_seconds"] for r in results]),
+        np.array([r.stats.time_seconds for r in results]),
     )
 
 

@@ -18,7 +18,7 @@
 //! problem (centred, divided by their RMS radius) and the covariances scaled by
 //! the same factor squared.
 //!
-//! - [`ClassifySettings`]: surface type, `lambda`, `robust_eta`, solver limits;
+//! - [`ClassifySettings`]: surface type, `slack_weight` (`lambda`), `robust_eta`, solver limits;
 //! - [`Surface`] and [`Separator`]: the feature maps and the trained `f`, `grad f`;
 //! - [`train`]: assembles and solves the problem; [`Classification`] and
 //!   [`SolveStatus`] report the outcome as data (a failed solve is not an error:

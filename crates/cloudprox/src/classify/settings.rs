@@ -17,24 +17,10 @@ pub enum SocpSolver {
     Clarabel,
 }
 
-impl SocpSolver {
-    /// Parses `"barrier"` or `"clarabel"`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "barrier" => Some(SocpSolver::Barrier),
-            "clarabel" => Some(SocpSolver::Clarabel),
-            _ => None,
-        }
-    }
-
-    /// The lowercase name, as [`SocpSolver::from_name`] reads it.
-    pub fn name(self) -> &'static str {
-        match self {
-            SocpSolver::Barrier => "barrier",
-            SocpSolver::Clarabel => "clarabel",
-        }
-    }
-}
+crate::names::named_options!(SocpSolver, "solver", {
+    Barrier => "barrier",
+    Clarabel => "clarabel",
+});
 
 /// How separating surfaces are trained. Build with [`ClassifySettingsBuilder`] or
 /// take [`ClassifySettings::default`].
@@ -42,9 +28,10 @@ impl SocpSolver {
 pub struct ClassifySettings {
     /// Surface family (default [`Surface::Quadric`]).
     pub surface: Surface,
-    /// Weight `lambda` of the slacks against `1/2 |w|^2`, in normalized coordinates
-    /// (default 100: close to a hard margin, so the surface sits mid-gap).
-    pub lambda: Real,
+    /// The slack weight: the weight (`lambda` in the formulas) of the slacks
+    /// against `1/2 |w|^2`, in normalized coordinates (default 100: close to a
+    /// hard margin, so the surface sits mid-gap).
+    pub slack_weight: Real,
     /// Confidence `eta` of each point's chance constraint, in `[0.5, 1)` (default 0.9).
     pub robust_eta: Real,
     /// Distribution assumption behind `r = r(eta)` (default Gaussian).
@@ -61,7 +48,7 @@ impl Default for ClassifySettings {
     fn default() -> Self {
         Self {
             surface: Surface::Quadric,
-            lambda: 100.0,
+            slack_weight: 100.0,
             robust_eta: 0.9,
             robust_model: RobustModel::Gaussian,
             solver: SocpSolver::Barrier,
@@ -79,10 +66,10 @@ impl ClassifySettings {
 
     /// Checks every field's domain.
     pub fn validate(&self) -> Result<()> {
-        if !(self.lambda.is_finite() && self.lambda > 0.0) {
+        if !(self.slack_weight.is_finite() && self.slack_weight > 0.0) {
             return Err(Error::invalid(format!(
-                "lambda must be finite and > 0, got {}",
-                self.lambda
+                "slack_weight must be finite and > 0, got {}",
+                self.slack_weight
             )));
         }
         self.robust_model.radius(self.robust_eta)?;
@@ -116,9 +103,9 @@ impl ClassifySettingsBuilder {
         self.inner.surface = surface;
         self
     }
-    /// Slack weight `lambda`.
-    pub fn lambda(mut self, lambda: Real) -> Self {
-        self.inner.lambda = lambda;
+    /// Slack weight (`lambda` in the formulas).
+    pub fn slack_weight(mut self, weight: Real) -> Self {
+        self.inner.slack_weight = weight;
         self
     }
     /// Chance-constraint confidence `eta`.

@@ -90,7 +90,7 @@ pub fn train(
             &norm,
             labels,
             settings.surface,
-            settings.lambda,
+            settings.slack_weight,
             r,
             settings.solver_tol,
         ) {
@@ -110,7 +110,7 @@ pub fn train(
             });
         }
     }
-    let problem = assemble(&norm, labels, settings.surface, settings.lambda, r);
+    let problem = assemble(&norm, labels, settings.surface, settings.slack_weight, r);
     let solver_settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(settings.solver_max_iter)

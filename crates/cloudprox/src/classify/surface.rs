@@ -18,29 +18,17 @@ pub enum Surface {
     Quadric,
 }
 
+crate::names::named_options!(Surface, "surface", {
+    Linear => "linear",
+    Quadric => "quadric",
+});
+
 impl Surface {
     /// Dimension of the feature map.
     pub fn dim(self) -> usize {
         match self {
             Surface::Linear => 3,
             Surface::Quadric => 9,
-        }
-    }
-
-    /// Parses `"linear"` or `"quadric"`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "linear" => Some(Surface::Linear),
-            "quadric" => Some(Surface::Quadric),
-            _ => None,
-        }
-    }
-
-    /// The lowercase name, as [`Surface::from_name`] reads it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Surface::Linear => "linear",
-            Surface::Quadric => "quadric",
         }
     }
 

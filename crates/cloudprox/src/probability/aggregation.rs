@@ -41,6 +41,13 @@ pub enum Aggregation {
     Independent,
 }
 
+crate::names::named_options!(Aggregation, "aggregation", {
+    Surface => "surface",
+    Max => "max",
+    Union => "union",
+    Independent => "independent",
+});
+
 impl Aggregation {
     /// Aggregates `probabilities` (an empty slice gives 0); for `Surface`, the
     /// surface probabilities `q_i` (their maximum).
@@ -54,27 +61,6 @@ impl Aggregation {
                 let log_free: Real = it.map(|p| (-p).ln_1p()).sum();
                 -log_free.exp_m1()
             }
-        }
-    }
-
-    /// Parses `"surface"`, `"max"`, `"union"` or `"independent"`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "surface" => Some(Aggregation::Surface),
-            "max" => Some(Aggregation::Max),
-            "union" => Some(Aggregation::Union),
-            "independent" => Some(Aggregation::Independent),
-            _ => None,
-        }
-    }
-
-    /// The lowercase name, as [`Aggregation::from_name`] reads it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Aggregation::Surface => "surface",
-            Aggregation::Max => "max",
-            Aggregation::Union => "union",
-            Aggregation::Independent => "independent",
         }
     }
 }

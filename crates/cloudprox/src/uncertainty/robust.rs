@@ -16,24 +16,12 @@ pub enum RobustModel {
     Chebyshev,
 }
 
+crate::names::named_options!(RobustModel, "robust_model", {
+    Gaussian => "gaussian",
+    Chebyshev => "chebyshev",
+});
+
 impl RobustModel {
-    /// Parses `"gaussian"` or `"chebyshev"`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "gaussian" => Some(RobustModel::Gaussian),
-            "chebyshev" => Some(RobustModel::Chebyshev),
-            _ => None,
-        }
-    }
-
-    /// The lowercase name, as [`RobustModel::from_name`] reads it.
-    pub fn name(self) -> &'static str {
-        match self {
-            RobustModel::Gaussian => "gaussian",
-            RobustModel::Chebyshev => "chebyshev",
-        }
-    }
-
     /// The radius `r` for confidence `eta` in `[0.5, 1)`.
     pub fn radius(self, eta: Real) -> Result<Real> {
         if !(0.5..1.0).contains(&eta) {

@@ -24,24 +24,10 @@ pub enum QueryModel {
     Points,
 }
 
-impl QueryModel {
-    /// Parses `"elements"` or `"points"`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "elements" => Some(QueryModel::Elements),
-            "points" => Some(QueryModel::Points),
-            _ => None,
-        }
-    }
-
-    /// The lowercase name, as [`QueryModel::from_name`] reads it.
-    pub fn name(self) -> &'static str {
-        match self {
-            QueryModel::Elements => "elements",
-            QueryModel::Points => "points",
-        }
-    }
-}
+crate::names::named_options!(QueryModel, "model", {
+    Elements => "elements",
+    Points => "points",
+});
 
 /// Options of [`crate::query::collide()`]. Build with [`CollisionRequestBuilder`] or
 /// take [`CollisionRequest::default`].
