@@ -50,8 +50,7 @@ def scene_meshes() -> dict[str, cp.Mesh]:
     """Return the exact scene: the table top and the objects on it, world frame."""
     (x0, x1), (y0, y1), t = TABLE
     table = cp.Mesh.cuboid((x1 - x0) / 2, (y1 - y0) / 2, t / 2)
-    pose = np.eye(4)
-    pose[:3, 3] = ((x0 + x1) / 2, (y0 + y1) / 2, -t / 2)
+    pose = cp.pose.from_translation(((x0 + x1) / 2, (y0 + y1) / 2, -t / 2))
     out = {"table": table.transformed(pose)}
     for name, up, height, (x, y), yaw in OBJECTS:
         mesh = cp.io.read_mesh(real_file(name))

@@ -55,8 +55,7 @@ def spheres(points: int) -> view.Scene:
     base = cp.synthetic.sample_sphere(half, 0.1)
     a = cp.PointCloud(cp.synthetic.add_noise(base, sigma, seed=1), sigma=sigma)
     b = cp.PointCloud(cp.synthetic.add_noise(base, sigma, seed=2), sigma=sigma)
-    pose_b = np.eye(4)
-    pose_b[0, 3] = 0.2 + 0.5 * sigma
+    pose_b = cp.pose.from_translation((0.2 + 0.5 * sigma, 0.0, 0.0))
     return view.collision_scene(cp.collide(a, b, pose_b=pose_b))
 
 

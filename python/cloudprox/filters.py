@@ -22,7 +22,7 @@ ascending), so that points, covariances and pixels can be subset alike::
     points, covs = points[keep], covs[keep]
 
 Parameters left ``None`` take the Rust core's defaults (written once, there):
-:data:`SOR_DEFAULT_K` and :data:`SOR_DEFAULT_STD_RATIO` for the outlier filter,
+``SOR_DEFAULT_K`` (20) and ``SOR_DEFAULT_STD_RATIO`` (2.0) for the outlier filter,
 a 10 degree angle, a window of 1 and ``k = 8`` for the shadow filter, a 1 cm
 padding for the self filter. Bad parameters raise
 :class:`cloudprox.InvalidInputError` naming them.

@@ -37,7 +37,7 @@ from cloudprox._native import write_mesh as _write_mesh
 from cloudprox._native import write_point_cloud as _write_point_cloud
 from cloudprox._native import write_pointcloud2 as _write_pointcloud2
 from cloudprox.exceptions import DegenerateFacesWarning, InvalidInputError
-from cloudprox.pose import from_quaternion
+from cloudprox.pose import from_quaternion, from_translation
 
 __all__ = [
     "CloudFile",
@@ -281,19 +281,16 @@ def read_pose(text: str | os.PathLike[str], what: str = "pose") -> FloatArray:
         return m.reshape(4, 4)
     parts = [p for p in text.replace(",", " ").split() if p]
     values = parse_numbers(text, len(parts), what) if parts else np.zeros(0)
-    pose = np.eye(4)
-    if len(values) == 3:
-        pose[:3, 3] = values
-    elif len(values) == 7:
-        try:
-            pose = from_quaternion(values[3:], translation=values[:3])
-        except InvalidInputError as e:
-            raise InvalidInputError(f"{what}: {e}") from None
-    elif len(values) == 16:
-        pose = values.reshape(4, 4)
-    else:
+    if len(values) == 16:
+        return values.reshape(4, 4)
+    if len(values) not in (3, 7):
         raise InvalidInputError(
             f"{what}: expected a pose file, or 3 (x,y,z), 7 (x,y,z,qw,qx,qy,qz) or 16 numbers, "
             f"got {text!r}"
         )
-    return pose
+    try:  # the core's constructors check the numbers (a zero quaternion, a huge translation)
+        if len(values) == 3:
+            return from_translation(values)
+        return from_quaternion(values[3:], translation=values[:3])
+    except InvalidInputError as e:
+        raise InvalidInputError(f"{what}: {e}") from None
