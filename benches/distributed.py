@@ -25,9 +25,9 @@ from cloudprox import distributed
 
 def scene(points: int, m: int) -> tuple[cp.PointCloud, cp.PointCloud, np.ndarray]:
     """Two spheres of radius 0.1 and ``m`` poses of the first along x and y."""
-    base = cp.sample_sphere(points, 0.1)
-    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
-    b = cp.PointCloud(cp.add_noise(base, 0.002, seed=2), sigma=0.002)
+    base = cp.synthetic.sample_sphere(points, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
+    b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
     rng = np.random.default_rng(0)
     poses = np.tile(np.eye(4), (m, 1, 1))
     poses[:, 0, 3] = rng.uniform(-0.25, -0.19, m)

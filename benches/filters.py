@@ -92,15 +92,6 @@ class Scene:
     links: list[tuple[cp.Mesh, np.ndarray]]
 
 
-def _pose(yaw: float, t: tuple[float, float, float]) -> np.ndarray:
-    """Rotation by ``yaw`` about the camera's y axis (vertical), then translation ``t``."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    m = np.eye(4)
-    m[:3, :3] = [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
-    m[:3, 3] = t
-    return m
-
-
 def _ray_box(dirs: np.ndarray, pose: np.ndarray, half: np.ndarray) -> np.ndarray:
     """Ray parameter of the first hit of rays from the origin on an oriented box, else inf."""
     r, t = pose[:3, :3], pose[:3, 3]
@@ -124,13 +115,17 @@ def make_scene(n_points: int, seed: int = 0) -> Scene:
         [(cols + 0.5 - w / 2) / f, (rows + 0.5 - h / 2) / f, np.ones((h, w))], -1
     ).reshape(-1, 3)  # z component 1: the ray parameter is the depth z
     depth = np.full(len(dirs), 3.0)  # the wall
-    table = (_pose(0.0, (0.0, 0.62, 1.6)), np.array([0.8, 0.02, 0.6]))
+    # Poses: a yaw about the camera frame's y axis (vertical), then a translation.
+    table = (cp.pose.from_rpy((0.0, 0.0, 0.0), (0.0, 0.62, 1.6)), np.array([0.8, 0.02, 0.6]))
     boxes = [
-        (_pose(0.3, (-0.4, 0.5, 1.4)), np.array([0.1, 0.1, 0.08])),
-        (_pose(-0.5, (0.1, 0.45, 1.8)), np.array([0.08, 0.15, 0.08])),
-        (_pose(0.0, (0.5, 0.54, 1.2)), np.array([0.12, 0.06, 0.1])),
+        (cp.pose.from_rpy((0.0, 0.3, 0.0), (-0.4, 0.5, 1.4)), np.array([0.1, 0.1, 0.08])),
+        (cp.pose.from_rpy((0.0, -0.5, 0.0), (0.1, 0.45, 1.8)), np.array([0.08, 0.15, 0.08])),
+        (cp.pose.from_rpy((0.0, 0.0, 0.0), (0.5, 0.54, 1.2)), np.array([0.12, 0.06, 0.1])),
     ]
-    link_poses = [_pose(0.4, (0.1, 0.1, 1.5)), _pose(0.4, (0.33, 0.26, 1.4))]
+    link_poses = [
+        cp.pose.from_rpy((0.0, 0.4, 0.0), (0.1, 0.1, 1.5)),
+        cp.pose.from_rpy((0.0, 0.4, 0.0), (0.33, 0.26, 1.4)),
+    ]
     links = [
         (cp.Mesh.cuboid(*half), pose) for half, pose in zip(LINKS_HALF, link_poses, strict=False)
     ]

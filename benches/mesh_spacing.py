@@ -35,8 +35,7 @@ def main() -> None:
         for f in FACTORS:
             ps, times = [], []
             for gap in GAPS_SIGMA:
-                pose = np.eye(4)
-                pose[2, 3] = 0.05 + gap * sigma
+                pose = cp.pose.from_translation((0.0, 0.0, 0.05 + gap * sigma))
                 start = time.perf_counter()
                 r = cp.collide(cube, cloud, pose_a=pose, mesh_spacing=f * h)
                 times.append(time.perf_counter() - start)

@@ -58,7 +58,6 @@ from tabletop import (
     fcl_object,
     log,
     motion_states,
-    rotation,
     scan,
     scene_meshes,
     voxel_boxes,
@@ -231,12 +230,13 @@ def grasps(
         obj = objects[rng.integers(len(objects))]
         lo, hi = (np.asarray(b) for b in obj.bounds())
         centre = (lo + hi) / 2
-        pose = np.eye(4)
         # approach along the hand's z, from above or from the side, yawed at random
         tilt = rng.uniform(math.pi / 2, math.pi)
         yaw = rng.uniform(-math.pi, math.pi)
-        pose[:3, :3] = (
-            rotation("z", yaw) @ rotation("y", tilt) @ rotation("z", rng.uniform(0, math.pi))
+        pose = (
+            cp.pose.from_rotation_vector((0.0, 0.0, yaw))
+            @ cp.pose.from_rotation_vector((0.0, tilt, 0.0))
+            @ cp.pose.from_rotation_vector((0.0, 0.0, rng.uniform(0, math.pi)))
         )
         approach = pose[:3, 2]
         target = rng.uniform(-0.01, 0.03)

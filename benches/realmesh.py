@@ -84,19 +84,6 @@ def fcl_times(a: cp.Mesh, b: cp.Mesh, poses: np.ndarray) -> tuple[float, float] 
     return float(np.median(dist)), float(np.median(coll))
 
 
-def random_rotation(rng: np.random.Generator) -> np.ndarray:
-    """Return a uniformly random rotation matrix (from a random unit quaternion)."""
-    q = rng.normal(size=4)
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def poses(
     a: cp.ExactShape, b: cp.ExactShape, n: int, sigma: float, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -104,8 +91,7 @@ def poses(
     out, dist = [], []
     while len(out) < n:
         target = sigma * (rng.uniform(-6.0, 10.0) if rng.random() < 0.9 else rng.uniform(10, 30))
-        pose = np.eye(4)
-        pose[:3, :3] = random_rotation(rng)
+        pose = cp.pose.random_rotations(1, seed=int(rng.integers(2**63)))[0]
         d = rng.normal(size=3)
         d /= np.linalg.norm(d)
 

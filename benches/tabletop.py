@@ -46,46 +46,22 @@ WIDTH, HEIGHT, FOCAL = 320, 240, 290.0
 REACH = 1.2
 
 
-def rotation(axis: str, angle: float) -> np.ndarray:
-    """Return the rotation matrix about the x, y or z axis."""
-    c, s = math.cos(angle), math.sin(angle)
-    m = {
-        "x": [[1, 0, 0], [0, c, -s], [0, s, c]],
-        "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
-        "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]],
-    }[axis]
-    return np.array(m, dtype=float)
-
-
 def scene_meshes() -> dict[str, cp.Mesh]:
     """Return the exact scene: the table top and the objects on it, world frame."""
     (x0, x1), (y0, y1), t = TABLE
     table = cp.Mesh.cuboid((x1 - x0) / 2, (y1 - y0) / 2, t / 2)
-    pose = np.eye(4)
-    pose[:3, 3] = ((x0 + x1) / 2, (y0 + y1) / 2, -t / 2)
+    pose = cp.pose.from_translation(((x0 + x1) / 2, (y0 + y1) / 2, -t / 2))
     out = {"table": table.transformed(pose)}
     for name, up, height, (x, y), yaw in OBJECTS:
         mesh = cp.io.read_mesh(real_file(name))
         v = np.asarray(mesh.vertices, dtype=float)
         if up == 1:  # y up -> z up
-            v = v @ rotation("x", math.pi / 2).T
+            v = v @ cp.pose.from_rpy((math.pi / 2, 0.0, 0.0))[:3, :3].T
         lo, hi = v.min(axis=0), v.max(axis=0)
         v = (v - [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]]) * (height / (hi[2] - lo[2]))
-        v = v @ rotation("z", yaw).T + [x, y, 0.0]
+        v = v @ cp.pose.from_rpy((0.0, 0.0, yaw))[:3, :3].T + [x, y, 0.0]
         out[name] = cp.Mesh(v, mesh.faces)
     return out
-
-
-def camera_pose() -> np.ndarray:
-    """Return the optical frame (x right, y down, z forward) in the world frame."""
-    z = CAMERA_LOOK - CAMERA_AT
-    z /= np.linalg.norm(z)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    pose = np.eye(4)
-    pose[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    pose[:3, 3] = CAMERA_AT
-    return pose
 
 
 def scan(meshes: dict[str, cp.Mesh], seed: int, scale: float = 1.0) -> tuple[cp.PointCloud, float]:
@@ -102,7 +78,7 @@ def scan(meshes: dict[str, cp.Mesh], seed: int, scale: float = 1.0) -> tuple[cp.
         rc.add_triangles(
             np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32)
         )
-    pose = camera_pose()
+    pose = cp.pose.look_at(CAMERA_AT, CAMERA_LOOK)  # optical frame: x right, y down, z forward
     width, height, focal = round(WIDTH * scale), round(HEIGHT * scale), FOCAL * scale
     u, v = np.meshgrid(np.arange(width), np.arange(height))
     cam = np.stack(

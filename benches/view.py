@@ -52,11 +52,10 @@ def spheres(points: int) -> view.Scene:
     """Make the view of two noisy spheres of ``points // 2`` points each, 0.5 sigma apart."""
     half = max(points // 2, 1)
     sigma = 0.002
-    base = cp.sample_sphere(half, 0.1)
-    a = cp.PointCloud(cp.add_noise(base, sigma, seed=1), sigma=sigma)
-    b = cp.PointCloud(cp.add_noise(base, sigma, seed=2), sigma=sigma)
-    pose_b = np.eye(4)
-    pose_b[0, 3] = 0.2 + 0.5 * sigma
+    base = cp.synthetic.sample_sphere(half, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(base, sigma, seed=1), sigma=sigma)
+    b = cp.PointCloud(cp.synthetic.add_noise(base, sigma, seed=2), sigma=sigma)
+    pose_b = cp.pose.from_translation((0.2 + 0.5 * sigma, 0.0, 0.0))
     return view.collision_scene(cp.collide(a, b, pose_b=pose_b))
 
 

@@ -12,8 +12,8 @@ from tests.helpers import N_POINTS, RADIUS, SIGMA
 @pytest.fixture(scope="session")
 def sphere_points() -> tuple[np.ndarray, np.ndarray]:
     """Two noisy samplings (seeds 1 and 2) of one sphere of radius 0.1 at the origin."""
-    base = cp.sample_sphere(N_POINTS, RADIUS)
-    return cp.add_noise(base, SIGMA, seed=1), cp.add_noise(base, SIGMA, seed=2)
+    base = cp.synthetic.sample_sphere(N_POINTS, RADIUS)
+    return cp.synthetic.add_noise(base, SIGMA, seed=1), cp.synthetic.add_noise(base, SIGMA, seed=2)
 
 
 @pytest.fixture(scope="session")

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cloudprox.pose import from_rpy, from_translation
 from cloudprox.reproduce.data import _write_atomically, cache_dir
 from tests.realfiles import Package, RealFileMismatch, RealFileUnavailable, fetch_archive
 
@@ -191,36 +192,22 @@ ARM_URDF = """<?xml version="1.0"?>
 """
 
 
-def _rz(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def _ry(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def _pose(r: np.ndarray, t: np.ndarray) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, :3] = r
-    m[:3, 3] = t
-    return m
-
-
 def arm_poses(q: np.ndarray) -> dict[str, np.ndarray]:
-    """Hand-computed link poses of the arm at ``q = [j1, j2, j3, j5]``, root at identity."""
+    """Hand-computed link poses of the arm at ``q = [j1, j2, j3, j5]``, root at identity.
+
+    Composed from the joints' frames by hand (yaw ``a`` then pitch ``b`` at the
+    shoulder, the prismatic ``c`` along x, the tool turned a quarter about z).
+    """
     a, b, c, w = (float(v) for v in q)
-    r2 = _rz(a) @ _ry(b)
-    o2 = np.array([0.0, 0.0, 0.3])
+    shoulder = from_rpy((0.0, b, a), (0.0, 0.0, 0.3))  # Rz(a) Ry(b), at o2
     return {
         "base": np.eye(4),
-        "link1": _pose(_rz(a), np.array([0.0, 0.0, 0.1])),
-        "link2": _pose(r2, o2),
-        "link3": _pose(r2, o2 + r2 @ np.array([0.3 + c, 0.0, 0.0])),
-        "link4": _pose(r2, o2 + r2 @ np.array([0.3, 2.0 * c + 0.01, 0.0])),
-        "tool": _pose(r2 @ _rz(math.pi / 2), o2 + r2 @ np.array([0.3, 0.0, 0.05])),
-        "wheel": _pose(_rz(w), np.array([0.0, 0.3, 0.0])),
+        "link1": from_rpy((0.0, 0.0, a), (0.0, 0.0, 0.1)),
+        "link2": shoulder,
+        "link3": shoulder @ from_translation((0.3 + c, 0.0, 0.0)),
+        "link4": shoulder @ from_translation((0.3, 2.0 * c + 0.01, 0.0)),
+        "tool": shoulder @ from_rpy((0.0, 0.0, math.pi / 2), (0.3, 0.0, 0.05)),
+        "wheel": from_rpy((0.0, 0.0, w), (0.0, 0.3, 0.0)),
     }
 
 

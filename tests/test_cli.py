@@ -7,19 +7,19 @@ import pytest
 
 import cloudprox as cp
 from cloudprox.cli import main
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 
 
 @pytest.fixture(scope="module")
 def npy_files(tmp_path_factory) -> dict[str, str]:
     d = tmp_path_factory.mktemp("npy")
-    base = cp.sample_sphere(600, 0.1)
+    base = cp.synthetic.sample_sphere(600, 0.1)
     files = {
-        "a": cp.add_noise(base, 0.002, seed=1),
-        "b_far": cp.add_noise(base, 0.002, seed=2) + np.array([0.25, 0.0, 0.0]),
-        "b_deep": cp.add_noise(base, 0.002, seed=2) + np.array([0.19, 0.0, 0.0]),
-        "b": cp.add_noise(base, 0.002, seed=2),
-        "shift": translation(0.25),
+        "a": cp.synthetic.add_noise(base, 0.002, seed=1),
+        "b_far": cp.synthetic.add_noise(base, 0.002, seed=2) + np.array([0.25, 0.0, 0.0]),
+        "b_deep": cp.synthetic.add_noise(base, 0.002, seed=2) + np.array([0.19, 0.0, 0.0]),
+        "b": cp.synthetic.add_noise(base, 0.002, seed=2),
+        "shift": from_translation((0.25, 0.0, 0.0)),
         "flat": np.zeros((5, 2)),
     }
     out = {}

@@ -8,7 +8,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cloudprox as cp
-from tests.helpers import phi, sphere_gap_pose, translation
+from cloudprox.pose import from_rotation_vector, from_translation
+from tests.helpers import phi, sphere_gap_pose
 
 GAPS = (-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0)
 
@@ -25,18 +26,6 @@ def element_sweep(spheres) -> dict[float, cp.CollisionResult]:
     """The surface-element model over the gaps."""
     a, b = spheres
     return {g: cp.collide(a, b, pose_b=sphere_gap_pose(g), model="elements") for g in GAPS}
-
-
-def rigid(rotvec: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """A (4, 4) rigid transform from a rotation vector (Rodrigues) and a translation."""
-    angle = float(np.linalg.norm(rotvec))
-    m = np.eye(4)
-    if angle > 0.0:
-        k = rotvec / angle
-        kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-        m[:3, :3] = np.eye(3) + np.sin(angle) * kx + (1.0 - np.cos(angle)) * kx @ kx
-    m[:3, 3] = t
-    return m
 
 
 def assert_non_increasing(sweep, gaps, slack: float = 1e-12) -> None:
@@ -165,7 +154,7 @@ def test_closed_form_with_anisotropic_covariances() -> None:
         plate + rng.normal(0.0, 1e-3, plate.shape), cov=np.broadcast_to(cov, (144, 3, 3))
     )
     b = cp.PointCloud(plate + rng.normal(0.0, 1e-3, plate.shape), sigma=0.002)
-    r = cp.collide(a, b, pose_b=translation(z=0.006), surface="linear")
+    r = cp.collide(a, b, pose_b=from_translation((0.0, 0.0, 0.006)), surface="linear")
     pa, pb = a.points, b.points + np.array([0.0, 0.0, 0.006])
     for region in r.regions:
         f, g = region.evaluate(pa[region.indices_a])
@@ -207,7 +196,7 @@ def test_rigid_motion_of_both_clouds_leaves_p_unchanged(spheres, rotvec, t, gap)
     a, b = spheres
     pose_b = sphere_gap_pose(gap)
     ref = cp.collide(a, b, pose_b=pose_b)
-    g = rigid(np.array(rotvec), np.array(t))
+    g = from_rotation_vector(np.array(rotvec), np.array(t))
     moved = cp.collide(a, b, pose_a=g, pose_b=g @ pose_b)
     assert moved.probability == pytest.approx(ref.probability, abs=1e-6)
     assert moved.state == ref.state
@@ -219,7 +208,7 @@ def test_rigid_motion_of_both_clouds_leaves_p_unchanged(spheres, rotvec, t, gap)
 
 def test_moving_the_cloud_or_the_pose_is_the_same(spheres) -> None:
     a, b = spheres
-    g = rigid(np.array([0.3, -0.4, 1.0]), np.array([1.0, 2.0, -0.5]))
+    g = from_rotation_vector(np.array([0.3, -0.4, 1.0]), np.array([1.0, 2.0, -0.5]))
     pose_b = sphere_gap_pose(1.0)
     by_pose = cp.collide(a, b, pose_a=g, pose_b=g @ pose_b, model="points")
     by_cloud = cp.collide(a.transformed(g), b.transformed(g @ pose_b), model="points")
@@ -236,7 +225,7 @@ def test_moving_the_cloud_or_the_pose_is_the_same(spheres) -> None:
 def test_collide_many_equals_a_loop(spheres) -> None:
     a, b = spheres
     poses = np.stack([np.linalg.inv(sphere_gap_pose(g)) for g in (-2.0, 0.0, 1.0, 5.0, 12.0)])
-    pose_b = translation(0.3, -0.1, 0.2)
+    pose_b = from_translation((0.3, -0.1, 0.2))
     poses = pose_b @ poses  # A placed relative to B at each gap
     many = cp.collide_many(a, b, poses, pose_b, aggregation="union")
     assert isinstance(many, list) and len(many) == len(poses)
@@ -328,24 +317,26 @@ def test_queries_run_in_threads_with_the_same_answers(spheres) -> None:
 
 
 def test_zero_noise_clouds_are_decided_exactly() -> None:
-    pts = cp.sample_sphere(300, 0.1)
+    pts = cp.synthetic.sample_sphere(300, 0.1)
     a = cp.PointCloud(pts)
     b = cp.PointCloud(pts)
-    far = cp.collide(a, b, pose_b=translation(0.25))
+    far = cp.collide(a, b, pose_b=from_translation((0.25, 0.0, 0.0)))
     assert far.probability == 0.0 and far.state == "free"
-    deep = cp.collide(a, b, pose_b=translation(0.1))
+    deep = cp.collide(a, b, pose_b=from_translation((0.1, 0.0, 0.0)))
     assert deep.probability == 1.0 and deep.state == "collision"
 
 
 def test_surface_aggregation_sees_deep_interpenetration() -> None:
     # Two 10 cm spheres overlapping by half, 1 mm noise: the neighbourhood means
     # cancel at the crossing; the crossing test sees the surfaces cross.
-    pts = cp.sample_sphere(2000, 0.1)
-    a = cp.PointCloud(cp.add_noise(pts, 0.001, seed=1), sigma=0.001)
-    b = cp.PointCloud(cp.add_noise(pts, 0.001, seed=2), sigma=0.001)
+    pts = cp.synthetic.sample_sphere(2000, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(pts, 0.001, seed=1), sigma=0.001)
+    b = cp.PointCloud(cp.synthetic.add_noise(pts, 0.001, seed=2), sigma=0.001)
     for options in ({"aggregation": "max"}, {"aggregation": "surface"}, {"model": "elements"}):
         model = options.get("model", "points")
-        r = cp.collide(a, b, pose_b=translation(0.1), **{"model": model, **options})
+        r = cp.collide(
+            a, b, pose_b=from_translation((0.1, 0.0, 0.0)), **{"model": model, **options}
+        )
         assert r.state == "collision", options
 
 

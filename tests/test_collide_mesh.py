@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.helpers import RADIUS, SIGMA, translation
+from cloudprox.pose import from_translation
+from tests.helpers import RADIUS, SIGMA
 
 
 @pytest.fixture(scope="module")
@@ -16,7 +17,7 @@ def sphere_cloud(sphere_points: tuple[np.ndarray, np.ndarray]) -> cp.PointCloud:
 
 def cube_pose(gap: float) -> np.ndarray:
     """A 10 cm cube whose bottom face is `gap` above the sphere's top (exact distance)."""
-    return translation(z=RADIUS + 0.05 + gap)
+    return from_translation((0.0, 0.0, RADIUS + 0.05 + gap))
 
 
 def test_mesh_against_cloud_follows_the_exact_gap(sphere_cloud: cp.PointCloud) -> None:
@@ -48,9 +49,9 @@ def test_meshes_of_other_libraries_are_accepted(sphere_cloud: cp.PointCloud) -> 
     assert got.probability == pytest.approx(ref.probability)
     o3d = pytest.importorskip("open3d")
     box = o3d.geometry.TriangleMesh.create_box(0.1, 0.1, 0.1)  # corner at the origin
-    r = cp.collide(box, sphere_cloud, pose_a=translation(-0.05, -0.05, RADIUS + 20 * SIGMA))
+    r = cp.collide(box, sphere_cloud, pose_a=from_translation((-0.05, -0.05, RADIUS + 20 * SIGMA)))
     assert r.state == "free"
-    r = cp.collide(box, sphere_cloud, pose_a=translation(-0.05, -0.05, RADIUS - 10 * SIGMA))
+    r = cp.collide(box, sphere_cloud, pose_a=from_translation((-0.05, -0.05, RADIUS - 10 * SIGMA)))
     assert r.state == "collision"
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 from tests.robots import ARM_URDF, wall
 from tests.test_pickle import assert_same_result
 
@@ -23,24 +23,24 @@ def local_ray():
 
 @pytest.fixture(scope="module")
 def clouds() -> tuple[cp.PointCloud, cp.PointCloud]:
-    base = cp.sample_sphere(600, 0.1)
+    base = cp.synthetic.sample_sphere(600, 0.1)
     return (
-        cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002, discretization=True),
-        cp.PointCloud(cp.add_noise(base, 0.002, seed=2), sigma=0.002),
+        cp.PointCloud(
+            cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002, discretization=True
+        ),
+        cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002),
     )
 
 
 def _poses(m: int) -> np.ndarray:
-    poses = np.tile(np.eye(4), (m, 1, 1))
-    poses[:, 0, 3] = np.linspace(0.18, 0.24, m)
-    poses[:, 1, 3] = np.linspace(-0.02, 0.02, m)
-    return poses
+    xs, ys = np.linspace(0.18, 0.24, m), np.linspace(-0.02, 0.02, m)
+    return np.stack([from_translation((x, y, 0.0)) for x, y in zip(xs, ys, strict=True)])
 
 
 def test_collide_many_equals_local(clouds) -> None:
     a, b = clouds
     poses = _poses(150)
-    pose_b = translation(0.0, 0.0, 0.001)
+    pose_b = from_translation((0.0, 0.0, 0.001))
     local = cp.collide_many(a, b, poses, pose_b)
     # Uneven batches (7 tasks, the last short) on 2 workers: the order is the input's.
     remote = distributed.collide_many(a, b, poses, pose_b, batch_size=22, progress=False)

@@ -7,12 +7,12 @@ import pytest
 
 import cloudprox as cp
 from cloudprox import CloudproxError, InvalidInputError, SolverError
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 
 
 @pytest.fixture(scope="module")
 def small() -> cp.PointCloud:
-    return cp.PointCloud(cp.sample_sphere(100, 0.1), sigma=0.002)
+    return cp.PointCloud(cp.synthetic.sample_sphere(100, 0.1), sigma=0.002)
 
 
 def test_hierarchy() -> None:
@@ -160,22 +160,22 @@ def test_wrong_types_raise_type_error(small: cp.PointCloud) -> None:
 
 def test_bad_sampler_input() -> None:
     with pytest.raises(InvalidInputError, match="radius must be finite and > 0"):
-        cp.sample_sphere(10, radius=-1.0)
+        cp.synthetic.sample_sphere(10, radius=-1.0)
     with pytest.raises(InvalidInputError, match="n must be in"):
-        cp.sample_sphere(-1)
+        cp.synthetic.sample_sphere(-1)
     with pytest.raises(InvalidInputError, match="spacing must be finite and > 0"):
-        cp.sample_box_surface([1.0, 1.0, 1.0], 0.0)
+        cp.synthetic.sample_box_surface([1.0, 1.0, 1.0], 0.0)
     with pytest.raises(InvalidInputError, match="more than 1e8"):
-        cp.sample_box_surface([1.0, 1.0, 1.0], 1e-6)
+        cp.synthetic.sample_box_surface([1.0, 1.0, 1.0], 1e-6)
     with pytest.raises(InvalidInputError, match=r"half_extents must have shape \(3,\)"):
-        cp.sample_box_surface([1.0, 1.0], 0.1)
+        cp.synthetic.sample_box_surface([1.0, 1.0], 0.1)
     with pytest.raises(InvalidInputError, match="sigma must be finite and >= 0"):
-        cp.add_noise(np.zeros((2, 3)), -1.0)
+        cp.synthetic.add_noise(np.zeros((2, 3)), -1.0)
 
 
 def test_evaluate_rejects_bad_points(spheres) -> None:
     a, b = spheres
-    r = cp.collide(a, b, pose_b=translation(0.2))
+    r = cp.collide(a, b, pose_b=from_translation((0.2, 0.0, 0.0)))
     region = r.regions[0]
     with pytest.raises(InvalidInputError, match=r"x must have shape \(n, 3\)"):
         region.evaluate(np.zeros((4, 2)))

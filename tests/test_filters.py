@@ -26,24 +26,12 @@ import pytest
 
 import cloudprox as cp
 from cloudprox import filters
+from cloudprox.pose import from_rotation_vector
 
 o3d = pytest.importorskip("open3d")
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def rigid(rotvec: np.ndarray | list[float], t: np.ndarray | list[float]) -> np.ndarray:
-    """A (4, 4) rigid transform from a rotation vector (Rodrigues) and a translation."""
-    rv = np.asarray(rotvec, dtype=float)
-    angle = float(np.linalg.norm(rv))
-    m = np.eye(4)
-    if angle > 0.0:
-        k = rv / angle
-        kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-        m[:3, :3] = np.eye(3) + np.sin(angle) * kx + (1.0 - np.cos(angle)) * kx @ kx
-    m[:3, 3] = t
-    return m
 
 
 def apply(pose: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -134,7 +122,7 @@ def test_crop_box_rotated_by_pose() -> None:
             shell.append(s)
     local = np.vstack([inner, *shell])
     is_inner = np.arange(len(local)) < len(inner)
-    pose = rigid([0.3, -0.5, 0.8], [2.0, -1.0, 0.5])
+    pose = from_rotation_vector([0.3, -0.5, 0.8], [2.0, -1.0, 0.5])
     pts = apply(pose, local)
     keep = filters.crop_box(pts, [-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], pose=pose)
     np.testing.assert_array_equal(keep, np.flatnonzero(is_inner))
@@ -147,11 +135,11 @@ def test_crop_box_rotated_by_pose() -> None:
 def test_crop_box_invariant_under_rigid_transform() -> None:
     rng = np.random.default_rng(11)
     pts = rng.uniform(-2.0, 2.0, size=(20_000, 3))
-    pose = rigid([0.0, 0.0, 0.7], [0.2, 0.1, -0.3])
+    pose = from_rotation_vector([0.0, 0.0, 0.7], [0.2, 0.1, -0.3])
     lo, hi = np.array([-0.8, -0.5, -1.0]), np.array([0.9, 0.6, 0.4])
     keep = filters.crop_box(pts, lo, hi, pose=pose)
     assert 0 < keep.size < len(pts)
-    t = rigid([1.1, -0.4, 2.0], [10.0, -3.0, 7.0])
+    t = from_rotation_vector([1.1, -0.4, 2.0], [10.0, -3.0, 7.0])
     keep_t = filters.crop_box(apply(t, pts), lo, hi, pose=t @ pose)
     np.testing.assert_array_equal(keep_t, keep)
 
@@ -329,6 +317,17 @@ def test_shadow_organized_removes_veil() -> None:
     assert_indices(keep, len(pts))
     kept = mask(len(pts), keep)
     assert not kept[veil].any()
+    # The defaults (None) are the core's ShadowSettings::default(): 10 degrees, 1, 8.
+    explicit = filters.shadow_filter(
+        pts,
+        np.zeros(3),
+        pixels=np.arange(len(pts)),
+        grid_shape=(H, W),
+        min_angle_deg=10.0,
+        window=1,
+        k=8,
+    )
+    np.testing.assert_array_equal(explicit, keep)
     assert kept[~veil].mean() > 0.98
     # The real points removed are the veil's immediate neighbours (as in ROS), nothing else.
     assert not (~kept & ~veil & ~near_veil(veil)).any()
@@ -354,7 +353,7 @@ def test_shadow_flat_wall_keeps_everything_and_rigid_invariance() -> None:
     assert keep.size == len(wall)
     assert filters.shadow_filter(wall, np.zeros(3)).size == len(wall)
     # Moving the sensor and the scene together changes nothing.
-    t = rigid([0.4, 1.2, -0.3], [1.0, 2.0, -4.0])
+    t = from_rotation_vector([0.4, 1.2, -0.3], [1.0, 2.0, -4.0])
     a = filters.shadow_filter(pts, np.zeros(3), pixels=np.arange(len(pts)), grid_shape=(H, W))
     b = filters.shadow_filter(
         apply(t, pts), t[:3, 3], pixels=np.arange(len(pts)), grid_shape=(H, W)
@@ -403,7 +402,7 @@ def table_and_link(pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, cp.Mesh]:
 
 def hover_pose(x: float = 0.0, y: float = 0.0) -> np.ndarray:
     # Bottom face 3 cm above the table (the pose keeps z vertical).
-    return rigid([0.0, 0.0, 0.5], [x, y, 0.03 + LINK_HALF[2]])
+    return from_rotation_vector([0.0, 0.0, 0.5], [x, y, 0.03 + LINK_HALF[2]])
 
 
 def test_self_filter_removes_link_keeps_table() -> None:
@@ -412,6 +411,7 @@ def test_self_filter_removes_link_keeps_table() -> None:
     pts = np.vstack([table, on_link])
     is_table = np.arange(len(pts)) < len(table)
     f = filters.SelfFilter([(link, pose)], padding=0.01)
+    assert filters.SelfFilter([(link, pose)]).padding == f.padding  # the core's default
     assert f.padding == 0.01
     keep = f.apply(pts)
     assert_indices(keep, len(pts))
@@ -446,7 +446,7 @@ def test_self_filter_invariant_under_rigid_transform() -> None:
     rng = np.random.default_rng(1)
     pts = np.vstack([table, on_link, rng.uniform(-0.3, 0.3, (5_000, 3))])
     keep = filters.SelfFilter([(link, pose)], padding=0.01).apply(pts)
-    t = rigid([2.0, -0.7, 0.4], [5.0, -2.0, 1.0])
+    t = from_rotation_vector([2.0, -0.7, 0.4], [5.0, -2.0, 1.0])
     keep_t = filters.SelfFilter([(link, t @ pose)], padding=0.01).apply(apply(t, pts))
     np.testing.assert_array_equal(keep_t, keep)
 

@@ -20,6 +20,7 @@ import pytest
 import cloudprox as cp
 from cloudprox import FormatError, InvalidInputError
 from cloudprox.io import DegenerateFacesWarning
+from cloudprox.pose import from_rpy
 
 # (extension, encoding) of every point-cloud format and encoding cloudprox writes.
 CLOUD_CASES: list[tuple[str, str | None]] = [
@@ -65,13 +66,6 @@ def f32(a: Any) -> np.ndarray:
     return np.asarray(a, dtype=np.float64).astype(np.float32).astype(np.float64)
 
 
-def rotation(rx: float, rz: float) -> np.ndarray:
-    cx, sx, cz, sz = np.cos(rx), np.sin(rx), np.cos(rz), np.sin(rz)
-    r_x = np.array([[1.0, 0.0, 0.0], [0.0, cx, -sx], [0.0, sx, cx]])
-    r_z = np.array([[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]])
-    return r_z @ r_x
-
-
 def points(n: int = 60, seed: int = 0) -> np.ndarray:
     """Points in front of a sensor at the origin looking along +z, non-round coordinates."""
     rng = np.random.default_rng(seed)
@@ -86,9 +80,7 @@ def noisy() -> cp.PointCloud:
 
 def mesh() -> cp.Mesh:
     """A closed 12-sided cylinder in a pose with non-round coordinates."""
-    pose = np.eye(4)
-    pose[:3, :3] = rotation(0.7, 0.3)
-    pose[:3, 3] = (0.123, -0.456, 0.789)
+    pose = from_rpy((0.7, 0.0, 0.3), (0.123, -0.456, 0.789))
     return cp.Mesh.cylinder(0.05, 0.1, 12).transformed(pose)
 
 
@@ -610,9 +602,7 @@ def test_organized_pcd_with_holes_and_viewpoint(tmp_path: Path) -> None:
 
 
 def test_cloudfile_made_for_writing(tmp_path: Path) -> None:
-    pose = np.eye(4)
-    pose[:3, :3] = rotation(0.0, np.pi / 2)
-    pose[:3, 3] = (0.1, 0.2, 0.3)
+    pose = from_rpy((0.0, 0.0, np.pi / 2), (0.1, 0.2, 0.3))
     pts = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 2.0]])
     cf = cp.io.CloudFile(pts, sensor_pose=pose, grid_shape=(2, 2), pixels=[0, 1, 3])
     assert cf.skipped == 0

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
+from cloudprox.pose import from_quaternion
 from tests.realfiles import EXPECTED, REAL_FILES, RealFileUnavailable, real_file
 
 #: Real files cloudprox reads wrongly: name -> precise description. None known.
@@ -54,21 +55,6 @@ def assert_bounds(xyz: np.ndarray, truth: dict[str, object]) -> None:
     lo, hi = np.asarray(truth["bounds"], dtype=np.float64)
     np.testing.assert_allclose(xyz.min(axis=0), lo, rtol=0.0, atol=1e-6)
     np.testing.assert_allclose(xyz.max(axis=0), hi, rtol=0.0, atol=1e-6)
-
-
-def viewpoint_pose(viewpoint: tuple[float, ...]) -> np.ndarray:
-    """The 4x4 pose of a PCD ``VIEWPOINT tx ty tz qw qx qy qz``."""
-    tx, ty, tz, w, x, y, z = viewpoint
-    n = np.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / n, x / n, y / n, z / n
-    pose = np.eye(4)
-    pose[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ]
-    pose[:3, 3] = (tx, ty, tz)
-    return pose
 
 
 def test_every_real_file_has_its_ground_truth() -> None:
@@ -125,7 +111,11 @@ def test_pcd(name: str) -> None:
     assert cf.sensor_pose is not None
     default = viewpoint is None or tuple(viewpoint) == IDENTITY_VIEWPOINT
     assert cf.sensor_pose_is_default == default
-    want = np.eye(4) if viewpoint is None else viewpoint_pose(viewpoint)
+    want = (
+        np.eye(4)
+        if viewpoint is None
+        else from_quaternion(viewpoint[3:], translation=viewpoint[:3])
+    )
     np.testing.assert_allclose(cf.sensor_pose, want, atol=1e-12)
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 from tests.robots import ARM_URDF, wall
 
 
@@ -43,12 +43,10 @@ def assert_same_cloud(c: cp.PointCloud, d: cp.PointCloud) -> None:
 
 
 def _clouds() -> dict[str, cp.PointCloud]:
-    base = cp.add_noise(cp.sample_sphere(800, 0.1), 0.002, seed=4)
+    base = cp.synthetic.add_noise(cp.synthetic.sample_sphere(800, 0.1), 0.002, seed=4)
     sensor_pose = np.eye(4)
     sensor_pose[2, 3] = -1.0
-    rot = np.eye(4)
-    rot[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
-    rot[:3, 3] = [0.01, 0.02, 0.03]
+    rot = cp.pose.from_rpy((0.0, 0.0, np.pi / 2), (0.01, 0.02, 0.03))  # a quarter turn about z
     plain = cp.PointCloud(base, sigma=0.002)
     disc = cp.PointCloud(base, sigma=0.002, discretization=True, k=8, noise_correlation=0.3)
     camera = cp.PointCloud(
@@ -58,7 +56,7 @@ def _clouds() -> dict[str, cp.PointCloud]:
         "sigma": plain,
         "discretization": disc,
         "depth camera": camera,
-        "moved twice": disc.transformed(rot).transformed(translation(0.05)),
+        "moved twice": disc.transformed(rot).transformed(from_translation((0.05, 0.0, 0.0))),
         "per-point sigma": cp.PointCloud(base, sigma=np.linspace(0.001, 0.003, len(base))),
     }
 
@@ -68,9 +66,11 @@ def test_point_cloud_roundtrip(name: str) -> None:
     cloud = _clouds()[name]
     back = roundtrip(cloud)
     assert_same_cloud(cloud, back)
-    other = cp.PointCloud(cp.add_noise(cp.sample_sphere(800, 0.1), 0.002, seed=5), sigma=0.002)
+    other = cp.PointCloud(
+        cp.synthetic.add_noise(cp.synthetic.sample_sphere(800, 0.1), 0.002, seed=5), sigma=0.002
+    )
     centre = cloud.points.mean(axis=0)
-    pose = translation(centre[0] + 0.195, centre[1], centre[2])
+    pose = from_translation((centre[0] + 0.195, centre[1], centre[2]))
     for model in ("points", "elements"):
         assert_same_result(
             cp.collide(cloud, other, pose_b=pose, model=model),
@@ -83,16 +83,16 @@ def test_mesh_roundtrip() -> None:
     back = roundtrip(mesh)
     np.testing.assert_array_equal(mesh.vertices, back.vertices)
     np.testing.assert_array_equal(mesh.faces, back.faces)
-    cloud = cp.PointCloud(cp.sample_sphere(600, 0.1), sigma=0.002)
-    pose = translation(0.14)
+    cloud = cp.PointCloud(cp.synthetic.sample_sphere(600, 0.1), sigma=0.002)
+    pose = from_translation((0.14, 0.0, 0.0))
     assert_same_result(cp.collide(mesh, cloud, pose_a=pose), cp.collide(back, cloud, pose_a=pose))
 
 
 def test_result_and_region_roundtrip() -> None:
-    base = cp.sample_sphere(800, 0.1)
-    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
-    b = cp.PointCloud(cp.add_noise(base, 0.002, seed=2), sigma=0.002)
-    result = cp.collide(a, b, pose_b=translation(0.199))
+    base = cp.synthetic.sample_sphere(800, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
+    b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
+    result = cp.collide(a, b, pose_b=from_translation((0.199, 0.0, 0.0)))
     assert result.regions
     back = roundtrip(result)
     assert_same_result(result, back)
@@ -144,10 +144,10 @@ def test_bad_states_are_refused() -> None:
 def test_request_stats_and_proximity_roundtrip() -> None:
     request = cp.CollisionRequest(surface="linear", threshold_free=0.05, decide_only=True)
     assert roundtrip(request) == request
-    base = cp.sample_sphere(400, 0.1)
-    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
-    stats = cp.collide(a, a, pose_b=translation(0.199), request=request).stats
+    base = cp.synthetic.sample_sphere(400, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
+    stats = cp.collide(a, a, pose_b=from_translation((0.199, 0.0, 0.0)), request=request).stats
     assert roundtrip(stats) == stats and roundtrip(stats).to_dict() == stats.to_dict()
     cube = cp.ExactShape([cp.Mesh.cuboid(0.1, 0.1, 0.1)])
-    near = cp.exact_proximity(cube, cube, None, translation(0.5))
+    near = cp.exact_proximity(cube, cube, None, from_translation((0.5, 0.0, 0.0)))
     assert roundtrip(near) == near and roundtrip(near).to_dict() == near.to_dict()

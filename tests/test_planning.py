@@ -52,8 +52,8 @@ def arm(tmp_path_factory: pytest.TempPathFactory) -> cp.Robot:
 @pytest.fixture(scope="module")
 def cloud() -> cp.PointCloud:
     """A scan of a thin post that the arm's straight sweep from Q0 to Q1 runs into."""
-    pts = cp.sample_box_surface(BOX_HALF, 0.005, center=BOX_CENTRE)
-    return cp.PointCloud(cp.add_noise(pts, SIGMA, seed=7), sigma=SIGMA)
+    pts = cp.synthetic.sample_box_surface(BOX_HALF, 0.005, center=BOX_CENTRE)
+    return cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=7), sigma=SIGMA)
 
 
 def exact_hits(arm: cp.Robot, path: np.ndarray, steps: int = 101) -> list[tuple[str, float]]:

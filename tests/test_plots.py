@@ -42,7 +42,7 @@ def test_plot_panels_and_bad_shapes(tmp_path, spheres, sphere_points) -> None:
 def test_plotting_leaves_pyplot_alone(tmp_path) -> None:
     code = (
         "import sys, cloudprox as cp; from cloudprox.plots import plot_collision; "
-        "a = cp.PointCloud(cp.sample_sphere(50, 0.1)); "
+        "a = cp.PointCloud(cp.synthetic.sample_sphere(50, 0.1)); "
         f"plot_collision(a.points, a.points, cp.collide(a, a), {str(tmp_path / 'x.png')!r}); "
         "print('matplotlib.pyplot' in sys.modules)"
     )
@@ -52,10 +52,8 @@ def test_plotting_leaves_pyplot_alone(tmp_path) -> None:
 
 def test_world_points() -> None:
     p = np.arange(6.0).reshape(2, 3)
-    t = np.eye(4)
-    t[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
-    t[:3, 3] = [1.0, 0.0, 0.0]
-    np.testing.assert_allclose(world_points(p, t), [[0.0, 0.0, 2.0], [-3.0, 3.0, 5.0]])
+    t = cp.pose.from_rpy((0.0, 0.0, np.pi / 2), (1.0, 0.0, 0.0))  # a quarter turn about z
+    np.testing.assert_allclose(world_points(p, t), [[0.0, 0.0, 2.0], [-3.0, 3.0, 5.0]], atol=1e-12)
     np.testing.assert_array_equal(world_points(p), p)
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 
 
 def random_points(n: int = 50, seed: int = 0) -> np.ndarray:
@@ -92,15 +92,11 @@ def test_discretization_adds_tangential_spread() -> None:
 
 
 def test_transformed_moves_points_and_rotates_covariances() -> None:
-    rng = np.random.default_rng(5)
     pts = random_points()
     cov = np.diag([1e-6, 4e-6, 9e-6])
     cloud = cp.PointCloud(pts, cov=np.broadcast_to(cov, (50, 3, 3)))
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    t = translation(0.1, -0.2, 0.3)
-    t[:3, :3] = q
+    t = from_translation((0.1, -0.2, 0.3)) @ cp.pose.random_rotations(1, seed=5)[0]
+    q = t[:3, :3]
     moved = cloud.transformed(t)
     assert isinstance(moved, cp.PointCloud) and len(moved) == 50
     np.testing.assert_allclose(moved.points, pts @ q.T + t[:3, 3], atol=1e-12)
@@ -117,16 +113,16 @@ def test_pointcloud_is_frozen() -> None:
 
 
 def test_samplers() -> None:
-    s = cp.sample_sphere(200, radius=0.5, center=[1.0, 2.0, 3.0])
+    s = cp.synthetic.sample_sphere(200, radius=0.5, center=[1.0, 2.0, 3.0])
     assert s.shape == (200, 3)
     np.testing.assert_allclose(np.linalg.norm(s - [1.0, 2.0, 3.0], axis=1), 0.5)
-    box = cp.sample_box_surface([0.1, 0.2, 0.3], 0.05)
+    box = cp.synthetic.sample_box_surface([0.1, 0.2, 0.3], 0.05)
     on_face = np.isclose(np.abs(box), [0.1, 0.2, 0.3]).any(axis=1)
     assert box.shape[1] == 3 and on_face.all()
     assert np.all(np.abs(box) <= [0.1 + 1e-12, 0.2 + 1e-12, 0.3 + 1e-12])
-    noisy = cp.add_noise(s, 0.01, seed=7)
-    np.testing.assert_array_equal(noisy, cp.add_noise(s, 0.01, seed=7))
-    assert not np.array_equal(noisy, cp.add_noise(s, 0.01, seed=8))
+    noisy = cp.synthetic.add_noise(s, 0.01, seed=7)
+    np.testing.assert_array_equal(noisy, cp.synthetic.add_noise(s, 0.01, seed=7))
+    assert not np.array_equal(noisy, cp.synthetic.add_noise(s, 0.01, seed=8))
     assert 0.005 < np.std(noisy - s) < 0.015
 
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
+from cloudprox.pose import from_translation
 from cloudprox.reproduce.realscan import (
     convex_hull,
     kinect_axial_sigma,
@@ -13,12 +14,6 @@ from cloudprox.reproduce.realscan import (
     sample_scan_poses,
 )
 from cloudprox.reproduce.reconstruct import reconstruct, surface_shape, tiles
-
-
-def _pose(t: tuple[float, float, float]) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = t
-    return m
 
 
 def test_kinect_noise_follows_nguyen_et_al() -> None:
@@ -42,7 +37,7 @@ def test_convex_hull_of_a_non_convex_mesh_is_convex_and_encloses_it() -> None:
     two = cp.Mesh.merged(
         [
             cp.Mesh.cuboid(0.1, 0.1, 0.1),
-            cp.Mesh.cuboid(0.1, 0.1, 0.1).transformed(_pose((0.5, 0, 0))),
+            cp.Mesh.cuboid(0.1, 0.1, 0.1).transformed(from_translation((0.5, 0, 0))),
         ]
     )
     hull = convex_hull(two)
@@ -55,7 +50,7 @@ def test_intersection_only_query_agrees_with_the_full_one() -> None:
     rng = np.random.default_rng(0)
     a = cp.ExactShape([cp.Mesh.cylinder(0.1, 0.2, 16)], solid=False)
     b = cp.ExactShape([cp.Mesh.cuboid(0.3, 0.2, 0.05), cp.Mesh.cuboid(0.05, 0.05, 0.3)])
-    poses = np.stack([_pose(tuple(rng.uniform(-0.5, 0.5, 3))) for _ in range(200)])
+    poses = np.stack([from_translation(rng.uniform(-0.5, 0.5, 3)) for _ in range(200)])
     full = cp.exact_proximity_many(a, b, poses)
     fast = cp.exact_intersects_many(a, b, poses)
     assert fast.dtype == bool and fast.shape == (200,)
@@ -78,7 +73,7 @@ def test_reconstruction_of_a_noisy_sphere_lies_on_it() -> None:
     probe = cp.ExactShape([cp.Mesh.cuboid(0.05, 0.05, 0.05)])
     inside = cp.exact_proximity(probe, shape)
     assert not inside.intersecting and inside.distance > 0.4
-    across = cp.exact_proximity(probe, shape, _pose((0.5, 0.0, 0.0)))
+    across = cp.exact_proximity(probe, shape, from_translation((0.5, 0.0, 0.0)))
     assert across.intersecting
 
 
@@ -111,7 +106,7 @@ def test_reconstruction_rejects_bad_input() -> None:
 def test_scan_poses_reach_their_targets_against_a_wall() -> None:
     # A wall 2 m in front of the camera (z = 2), seen through its front face; a
     # 4 cm cube as the gripper. Exact distance along the ray: the cube's face.
-    wall = cp.Mesh.cuboid(1.0, 1.0, 0.01).transformed(_pose((0.0, 0.0, 2.01)))
+    wall = cp.Mesh.cuboid(1.0, 1.0, 0.01).transformed(from_translation((0.0, 0.0, 2.01)))
     reference = cp.ExactShape([wall], solid=False)
     cube = cp.Mesh.cuboid(0.02, 0.02, 0.02)
     gripper = cp.ExactShape([cube], solid=False)

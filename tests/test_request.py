@@ -210,8 +210,8 @@ def test_collide_rejects_bad_requests_and_options(spheres) -> None:
 def test_robot_queries_take_a_request(tmp_path: Path) -> None:
     (tmp_path / "arm.urdf").write_text(ARM_URDF)
     arm = cp.Robot.from_urdf(tmp_path / "arm.urdf")
-    pts = cp.sample_box_surface((0.01, 0.01, 0.05), 0.005, center=(0.2, 0.0, 0.3))
-    cloud = cp.PointCloud(cp.add_noise(pts, 0.002, seed=7), sigma=0.002)
+    pts = cp.synthetic.sample_box_surface((0.01, 0.01, 0.05), 0.005, center=(0.2, 0.0, 0.3))
+    cloud = cp.PointCloud(cp.synthetic.add_noise(pts, 0.002, seed=7), sigma=0.002)
     q = np.zeros(arm.dof)
     request = cp.CollisionRequest(surface="linear", decide_only=True)
     by_request = cp.collide_robot(arm, q, cloud, request=request)

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
+from cloudprox.pose import from_rotation_vector
 from tests.robots import ARM_URDF, arm_poses, panda_urdf_or_skip, readme_block, wall
 
 SIGMA = 0.002
@@ -46,15 +47,6 @@ def wall_cloud(x0: float = 0.40, seed: int = 1) -> cp.PointCloud:
     return cp.PointCloud(wall(x0, 0.3, 0.1, SIGMA, seed), sigma=SIGMA)
 
 
-def rigid(rotvec: tuple[float, float, float], t: tuple[float, float, float]) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    m = np.eye(4)
-    m[:3, :3] = Rotation.from_rotvec(rotvec).as_matrix()
-    m[:3, 3] = t
-    return m
-
-
 # ------------------------------------------------------------------ the model
 
 
@@ -79,7 +71,7 @@ def test_arm_link_poses_match_hand_computed_ones(arm: cp.Robot, q: list[float]) 
     assert list(poses) == arm.link_names
     for name, m in expected.items():
         np.testing.assert_allclose(poses[name], m, atol=1e-12, err_msg=name)
-    base = rigid((0.1, -0.2, 0.3), (1.0, 2.0, -0.5))
+    base = from_rotation_vector((0.1, -0.2, 0.3), (1.0, 2.0, -0.5))
     moved = arm.link_poses(q, base_pose=base)
     for name, m in expected.items():
         np.testing.assert_allclose(moved[name], base @ m, atol=1e-12, err_msg=name)
@@ -193,7 +185,7 @@ def test_collide_robot_equals_the_per_link_collide_calls(arm: cp.Robot) -> None:
 
 def test_a_common_rigid_motion_of_base_and_cloud_changes_nothing(arm: cp.Robot) -> None:
     pts = wall(0.40, 0.3, 0.1, SIGMA, 5)
-    motion = rigid((0.3, -0.5, 0.9), (0.7, -1.2, 0.4))
+    motion = from_rotation_vector((0.3, -0.5, 0.9), (0.7, -1.2, 0.4))
     moved = pts @ motion[:3, :3].T + motion[:3, 3]
     a_cloud = cp.PointCloud(pts, sigma=SIGMA)
     b_cloud = cp.PointCloud(moved, sigma=SIGMA)
@@ -226,8 +218,8 @@ def test_collide_robot_many_equals_a_loop(arm: cp.Robot) -> None:
 
 def obstacle() -> cp.PointCloud:
     """A small noisy box surface in link2's way when j1 = 0, centred at (0.2, 0, 0.3)."""
-    pts = cp.sample_box_surface((0.01, 0.01, 0.05), 0.005, center=(0.2, 0.0, 0.3))
-    return cp.PointCloud(cp.add_noise(pts, SIGMA, seed=7), sigma=SIGMA)
+    pts = cp.synthetic.sample_box_surface((0.01, 0.01, 0.05), 0.005, center=(0.2, 0.0, 0.3))
+    return cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=7), sigma=SIGMA)
 
 
 def test_check_motion_finds_a_collision_between_two_free_waypoints(arm: cp.Robot) -> None:
@@ -278,8 +270,8 @@ def test_check_motion_misses_no_grazing_contact(arm: cp.Robot, gap_sigmas: float
     # the motion's ends, both far from it.
     half = (0.01, 0.01, 0.05)
     centre = (0.2, 0.0, 0.28 - gap_sigmas * SIGMA - half[2])
-    pts = cp.sample_box_surface(half, 0.004, center=centre)
-    cloud = cp.PointCloud(cp.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
+    pts = cp.synthetic.sample_box_surface(half, 0.004, center=centre)
+    cloud = cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
     box_pose = np.eye(4)
     box_pose[:3, 3] = centre
     q0, q1 = np.array([-0.6, 0.0, 0.0, 0.0]), np.array([0.6, 0.0, 0.0, 0.0])
@@ -305,7 +297,7 @@ def test_self_collision_on_a_folded_arm(arm: cp.Robot) -> None:
 
 def test_the_self_filter_removes_a_sampled_link(arm: cp.Robot) -> None:
     q = [0.4, -0.3, 0.05, 0.0]
-    base = rigid((0.0, 0.0, 0.2), (0.1, 0.2, 0.0))
+    base = from_rotation_vector((0.0, 0.0, 0.2), (0.1, 0.2, 0.0))
     pose = arm.link_poses(q, base_pose=base)["link2"]
     mesh = arm.link_mesh("link2")
     assert mesh is not None
@@ -322,7 +314,7 @@ def test_panda_against_a_table(panda: tuple[cp.Robot, Path]) -> None:
     gx, gy = np.arange(0.35, 0.95, 0.01), np.arange(-0.3, 0.3, 0.01)
     xx, yy = np.meshgrid(gx, gy, indexing="ij")
     table = np.column_stack([xx.ravel(), yy.ravel(), np.full(xx.size, 0.25)])
-    cloud = cp.PointCloud(cp.add_noise(table, SIGMA, seed=9), sigma=SIGMA)
+    cloud = cp.PointCloud(cp.synthetic.add_noise(table, SIGMA, seed=9), sigma=SIGMA)
     # The hand 23 cm above the table, and the fingers 8 cm into it.
     up = np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8, 0.02, 0.02])
     down = np.array([0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.8, 0.02, 0.02])

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import cloudprox
-from cloudprox.scenes import build_scene, make_pose, piano, room
+from cloudprox.pose import from_translation
+from cloudprox.scenes import build_scene, piano, room
 
 
 def test_meshes_and_exact_queries_from_python() -> None:
@@ -21,7 +22,7 @@ def test_meshes_and_exact_queries_from_python() -> None:
     assert np.allclose(np.max(np.abs(pts), axis=1), 0.1)
     shape = cloudprox.ExactShape([cube])
     assert shape.part_kinds == ["convex"]
-    r = cloudprox.exact_proximity(shape, shape, None, make_pose((0.5, 0.0, 0.0)))
+    r = cloudprox.exact_proximity(shape, shape, None, from_translation((0.5, 0.0, 0.0)))
     assert isinstance(r, cloudprox.Proximity)
     assert not r.intersecting and r.distance == pytest.approx(0.3)
     assert r.penetration_depth is None and r.signed_distance == r.distance
@@ -34,7 +35,7 @@ def test_meshes_and_exact_queries_from_python() -> None:
     # (Offset sideways a little: EPA misjudges the depth of two boxes whose faces
     # are exactly coplanar.)
     many = cloudprox.exact_proximity_many(
-        shape, shape, np.stack([make_pose((x, 0.001, 0.002)) for x in (0.15, 0.25)])
+        shape, shape, np.stack([from_translation((x, 0.001, 0.002)) for x in (0.15, 0.25)])
     )
     assert list(many["intersecting"]) == [True, False]
     assert many["signed_distance"] == pytest.approx([-0.05, 0.05])
@@ -48,14 +49,6 @@ def test_meshes_and_exact_queries_from_python() -> None:
         cube.sample()
 
 
-def test_make_pose_is_rigid_and_composes_rpy() -> None:
-    t = make_pose((1.0, 2.0, 3.0), (0.3, -0.2, 1.1))
-    assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3))
-    assert np.linalg.det(t[:3, :3]) == pytest.approx(1.0)
-    yaw = make_pose((0, 0, 0), (0, 0, np.pi / 2))
-    assert np.allclose(yaw[:3, :3] @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-
-
 def test_union_sampling_stays_on_the_union_surface() -> None:
     p = piano()
     pts, normals = p.sample(2000.0, seed=4)
@@ -64,7 +57,7 @@ def test_union_sampling_stays_on_the_union_surface() -> None:
         assert not part.contains(pts, margin=1e-6).any(), part.name
     # ... and every sample lies on some part's surface: a tiny probe at it touches the piano.
     probe = cloudprox.ExactShape([cloudprox.Mesh.cuboid(1e-4, 1e-4, 1e-4)])
-    poses = np.stack([make_pose(x) for x in pts[::50]])
+    poses = np.stack([from_translation(x) for x in pts[::50]])
     assert cloudprox.exact_proximity_many(probe, p.exact, poses)["intersecting"].all()
     assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
     with pytest.raises(ValueError, match="density"):

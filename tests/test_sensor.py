@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.helpers import translation
+from cloudprox.pose import from_translation
 
 
 def test_depth_camera_default_is_khoshelham_on_the_axis() -> None:
@@ -18,6 +18,23 @@ def test_depth_camera_default_is_khoshelham_on_the_axis() -> None:
     cov = cam.covariances(pts, sensor_pose=np.eye(4))
     np.testing.assert_allclose(cov[:, 2, 2], (1.425e-3 * z**2) ** 2, rtol=1e-12)
     np.testing.assert_allclose(cov[:, 0, 0], (0.8 * z / 580.0) ** 2, rtol=1e-12)
+
+
+def test_unset_parameters_are_the_cores_defaults() -> None:
+    # None (the signature's default) is the Rust Default, written once there.
+    kh, cam = cp.DepthCamera.khoshelham_2012(), cp.DepthCamera(focal_px=600.0)
+    for name in ("axial_offset", "axial_quadratic", "axial_depth0", "sigma_px", "baseline_m"):
+        assert getattr(cam, name) == getattr(kh, name), name
+    assert cam.disparity_step_px == kh.disparity_step_px == 0.125 and cam.focal_px == 600.0
+    st = cp.StereoCamera(sigma_px=None)
+    assert (st.focal_px, st.baseline, st.sigma_disparity_px, st.sigma_px) == (
+        430.0,
+        0.05,
+        0.08,
+        0.5,
+    )
+    assert cp.Lidar().sigma_range == 0.01
+    assert cp.Lidar(sigma_range=0.02).sigma_angle == cp.Lidar().sigma_angle
 
 
 def test_presets_and_stereo_and_lidar_formulas() -> None:
@@ -36,7 +53,7 @@ def test_point_cloud_from_a_sensor_uses_the_model() -> None:
     rng = np.random.default_rng(0)
     pts = rng.uniform(-1.0, 1.0, (200, 3)) + np.array([0.0, 0.0, 3.0])
     cam = cp.DepthCamera.nguyen_2012()
-    pose = translation(0.1, 0.0, -0.2)
+    pose = from_translation((0.1, 0.0, -0.2))
     cloud = cp.PointCloud(pts, sensor=cam, sensor_pose=pose)
     np.testing.assert_allclose(cloud.covariances, cam.covariances(pts, sensor_pose=pose))
     # Covariances are stretched along the viewing ray: the largest axis is the ray.
@@ -57,7 +74,7 @@ def test_point_cloud_from_a_sensor_uses_the_model() -> None:
             {"sensor": cp.Lidar(), "origin": [0, 0, 0], "sensor_pose": np.eye(4)},
             "either origin or sensor_pose",
         ),
-        ({"sensor": cp.DepthCamera(), "sensor_pose": translation(0, 0, 5)}, "not in front"),
+        ({"sensor": cp.DepthCamera(), "sensor_pose": from_translation((0, 0, 5))}, "not in front"),
     ],
 )
 def test_bad_sensor_arguments_are_named(kwargs: dict[str, object], match: str) -> None:

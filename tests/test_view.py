@@ -15,8 +15,8 @@ import pytest
 import cloudprox as cp
 from cloudprox import view
 from cloudprox.cli import main
+from cloudprox.pose import from_translation
 from tests.chromium import Chromium, find_chromium
-from tests.helpers import translation
 from tests.robots import ARM_URDF, wall
 
 
@@ -110,10 +110,10 @@ def _k3d_objects(text: str) -> list[dict[str, object]]:
 
 @pytest.fixture(scope="module")
 def spheres_near() -> tuple[cp.PointCloud, cp.PointCloud, np.ndarray]:
-    base = cp.sample_sphere(1500, 0.1)
-    a = cp.PointCloud(cp.add_noise(base, 0.002, seed=1), sigma=0.002)
-    b = cp.PointCloud(cp.add_noise(base, 0.002, seed=2), sigma=0.002)
-    return a, b, translation(0.19)
+    base = cp.synthetic.sample_sphere(1500, 0.1)
+    a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
+    b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
+    return a, b, from_translation((0.19, 0.0, 0.0))
 
 
 def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None:
@@ -147,7 +147,7 @@ def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None
     assert np.ptp(cols) > 0.05 * w, np.ptp(cols)
 
     # The same spheres far apart: no hot pixel at all, the colour bar aside.
-    far = cp.collide(a, b, pose_b=translation(0.3))
+    far = cp.collide(a, b, pose_b=from_translation((0.3, 0.0, 0.0)))
     assert far.state == "free"
     html = view.write_html(view.collision_scene(far), tmp_path / "far.html")
     pixels = screenshot(html, tmp_path / "far.png")
@@ -333,7 +333,7 @@ def test_scene_of_a_result(spheres_near) -> None:
 def test_mesh_side_is_drawn_with_its_samples(tmp_path, spheres_near) -> None:
     a, _, _ = spheres_near
     box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
-    pose = translation(0.14)
+    pose = from_translation((0.14, 0.0, 0.0))
     result = cp.collide(box, a, pose_a=pose)
     assert result.points_a.shape == (len(result.probabilities_a), 3)
     assert np.all(np.abs(result.points_a[:, 0] - 0.14) <= 0.05 + 1e-12)
@@ -354,7 +354,7 @@ def test_bad_inputs_give_clear_errors(spheres_near, monkeypatch) -> None:
     with pytest.raises(ValueError, match="half_size must be finite and > 0"):
         view.separating_surface(result.regions[0], 0.0)
     box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
-    with_mesh = cp.collide(box, a, pose_a=translation(0.14))
+    with_mesh = cp.collide(box, a, pose_a=from_translation((0.14, 0.0, 0.0)))
     with pytest.raises(ValueError, match=r"a pose must have shape \(4, 4\)"):
         view.collision_scene(with_mesh, box, a, np.eye(3))
     monkeypatch.setitem(sys.modules, "plotly", None)
@@ -531,7 +531,7 @@ def test_cli_collide_and_robot_write_views(capsys, tmp_path, arm_files) -> None:
 )
 def test_cli_view_errors(capsys, tmp_path, arm_files, extra, message) -> None:
     a = tmp_path / "a.npy"
-    np.save(a, cp.sample_sphere(200, 0.1))
+    np.save(a, cp.synthetic.sample_sphere(200, 0.1))
     code, _, err = run(capsys, "collide", str(a), str(a), "--sigma", "0.002", *extra)
     assert code == 2 and message in err and err.count("\n") == 1, err
 

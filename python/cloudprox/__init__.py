@@ -8,18 +8,17 @@ the pair gets an aggregated probability ``P`` and a state (``"free"``,
 
 Examples
 --------
->>> import numpy as np
 >>> import cloudprox
->>> pts = cloudprox.sample_sphere(500, radius=0.1)
->>> a = cloudprox.PointCloud(cloudprox.add_noise(pts, 0.002, seed=1), sigma=0.002)
->>> b = cloudprox.PointCloud(cloudprox.add_noise(pts, 0.002, seed=2), sigma=0.002)
->>> pose_b = np.eye(4)
->>> pose_b[0, 3] = 0.25  # 5 cm (25 sigma) between the two spheres
+>>> from cloudprox import pose, synthetic
+>>> pts = synthetic.sample_sphere(500, radius=0.1)
+>>> a = cloudprox.PointCloud(synthetic.add_noise(pts, 0.002, seed=1), sigma=0.002)
+>>> b = cloudprox.PointCloud(synthetic.add_noise(pts, 0.002, seed=2), sigma=0.002)
+>>> pose_b = pose.from_translation((0.25, 0.0, 0.0))  # 5 cm (25 sigma) apart
 >>> cloudprox.collide(a, b, pose_b=pose_b).state
 'free'
 """
 
-from cloudprox import filters, io
+from cloudprox import filters, io, pose, synthetic
 from cloudprox._native import (
     CollisionRequest,
     CollisionResult,
@@ -41,7 +40,6 @@ from cloudprox._native import (
     StereoCamera,
     Voxels,
     __version__,
-    add_noise,
     check_motion,
     collide,
     collide_many,
@@ -50,8 +48,6 @@ from cloudprox._native import (
     exact_intersects_many,
     exact_proximity,
     exact_proximity_many,
-    sample_box_surface,
-    sample_sphere,
 )
 from cloudprox.exceptions import (
     CloudproxError,
@@ -87,7 +83,6 @@ __all__ = [
     "StereoCamera",
     "Voxels",
     "__version__",
-    "add_noise",
     "check_motion",
     "collide",
     "collide_many",
@@ -98,6 +93,6 @@ __all__ = [
     "exact_proximity_many",
     "filters",
     "io",
-    "sample_box_surface",
-    "sample_sphere",
+    "pose",
+    "synthetic",
 ]

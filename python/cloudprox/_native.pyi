@@ -18,6 +18,8 @@ import numpy.typing as npt
 
 __version__: Final[str]
 __all__ = [
+    "SOR_DEFAULT_K",
+    "SOR_DEFAULT_STD_RATIO",
     "CloudFile",
     "CloudproxError",
     "CollisionRequest",
@@ -56,6 +58,12 @@ __all__ = [
     "exact_proximity",
     "exact_proximity_many",
     "parse_mesh",
+    "pose_from_quaternion",
+    "pose_from_rotation_vector",
+    "pose_from_rpy",
+    "pose_from_translation",
+    "pose_look_at",
+    "random_rotations",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
@@ -70,6 +78,11 @@ __all__ = [
 ]
 
 _FloatArray = npt.NDArray[np.float64]
+
+#: Default number of neighbours of :func:`statistical_outlier_removal` (the core's).
+SOR_DEFAULT_K: Final[int]
+#: Default standard-deviation multiplier of :func:`statistical_outlier_removal` (the core's).
+SOR_DEFAULT_STD_RATIO: Final[float]
 _IntArray = npt.NDArray[np.int64]
 _SurfaceName = Literal["linear", "quadric"]
 _AggregationName = Literal["surface", "max", "union", "independent"]
@@ -791,6 +804,147 @@ def collide_many(
         :func:`collide` in a loop.
     """
 
+def pose_from_translation(translation: npt.ArrayLike) -> _FloatArray:
+    """Make the pure translation by ``translation``.
+
+    Parameters
+    ----------
+    translation : array_like, shape (3,)
+        Translation (metres).
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        The homogeneous matrix, float64.
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming ``translation`` if its shape is wrong or an entry is NaN, infinite
+        or beyond 1e9 m.
+    """
+
+def pose_from_quaternion(
+    quaternion: npt.ArrayLike, translation: npt.ArrayLike | None = None
+) -> _FloatArray:
+    """Make a pose from a quaternion ``(w, x, y, z)`` and a translation.
+
+    Parameters
+    ----------
+    quaternion : array_like, shape (4,)
+        ``(w, x, y, z)``, scalar first; normalised here (need not be unit).
+    translation : array_like, shape (3,), optional
+        Translation (metres) applied after the rotation; zero by default.
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        The homogeneous matrix, float64.
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming ``quaternion`` if it is zero, not finite or not of shape (4,), or
+        ``translation``.
+    """
+
+def pose_from_rpy(rpy: npt.ArrayLike, translation: npt.ArrayLike | None = None) -> _FloatArray:
+    """Make a pose from roll-pitch-yaw angles and a translation.
+
+    The convention is ROS/URDF's: roll about the fixed x axis, then pitch about
+    the fixed y axis, then yaw about the fixed z axis,
+    ``R = Rz(yaw) Ry(pitch) Rx(roll)``.
+
+    Parameters
+    ----------
+    rpy : array_like, shape (3,)
+        Roll, pitch, yaw (radians).
+    translation : array_like, shape (3,), optional
+        Translation (metres) applied after the rotation; zero by default.
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        The homogeneous matrix, float64.
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming ``rpy`` or ``translation`` (wrong shape, NaN or infinite).
+    """
+
+def pose_from_rotation_vector(
+    rotation_vector: npt.ArrayLike, translation: npt.ArrayLike | None = None
+) -> _FloatArray:
+    """Make a pose from a rotation vector and a translation.
+
+    Parameters
+    ----------
+    rotation_vector : array_like, shape (3,)
+        The rotation axis times the angle (radians), right-handed.
+    translation : array_like, shape (3,), optional
+        Translation (metres) applied after the rotation; zero by default.
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        The homogeneous matrix, float64.
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming ``rotation_vector`` or ``translation`` (wrong shape, NaN or infinite).
+    """
+
+def pose_look_at(
+    eye: npt.ArrayLike, target: npt.ArrayLike, up: npt.ArrayLike | None = None
+) -> _FloatArray:
+    """Make the pose of a camera at ``eye`` looking at ``target``.
+
+    The result is the camera's optical frame in the world (ROS
+    ``*_optical_frame``, OpenCV, :class:`DepthCamera`): z forward, from ``eye``
+    towards ``target``; x to the image's right (``z x up``); y down in the image.
+
+    Parameters
+    ----------
+    eye : array_like, shape (3,)
+        The camera's position (metres).
+    target : array_like, shape (3,)
+        The point on the optical axis.
+    up : array_like, shape (3,), optional
+        The world's up direction; ``(0, 0, 1)`` by default.
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        The homogeneous matrix, float64.
+
+    Raises
+    ------
+    cloudprox.InvalidInputError
+        Naming the argument: a wrong shape, NaN, ``target`` equal to ``eye``, a
+        zero ``up`` or one parallel to the viewing direction.
+    """
+
+def random_rotations(n: int, seed: int = 0) -> npt.NDArray[np.float64]:
+    """Draw ``n`` uniformly random rotations (seeded, deterministic).
+
+    Unit quaternions of four standard normals from the core's generator: the same
+    ``seed`` gives the same rotations on every platform.
+
+    Parameters
+    ----------
+    n : int
+        Number of rotations, in ``[0, 1e8]``.
+    seed : int, default 0
+        Seed of the generator.
+
+    Returns
+    -------
+    ndarray, shape (n, 4, 4)
+        Poses with the rotations and zero translation, float64.
+    """
+
 def sample_sphere(n: int, radius: float = 1.0, center: npt.ArrayLike | None = None) -> _FloatArray:
     """Spread points evenly over a sphere (Fibonacci lattice).
 
@@ -857,9 +1011,12 @@ class DepthCamera:
     (Sensors 2012): ``sigma_z = 1.425e-3 z^2`` (1.4 mm at 1 m, 3.6 cm at 5 m),
     focal length 580 px, lateral 0.8 px (Nguyen et al. 2012).
 
+    Every parameter left ``None`` takes the core's default (``DepthCamera::default()``
+    in Rust, the Khoshelham values: 0, 1.425e-3, 0, 580 px, 0.8 px, 0.075 m, 1/8 px).
+
     Parameters
     ----------
-    axial_offset, axial_quadratic, axial_depth0 : float
+    axial_offset, axial_quadratic, axial_depth0 : float, optional
         Coefficients of the axial law (metres, 1/metre, metres; ``>= 0``).
     focal_px : float
         Focal length in pixels (``> 0``).
@@ -879,13 +1036,13 @@ class DepthCamera:
     def __new__(
         cls,
         *,
-        axial_offset: float = 0.0,
-        axial_quadratic: float = 1.425e-3,
-        axial_depth0: float = 0.0,
-        focal_px: float = 580.0,
-        sigma_px: float = 0.8,
-        baseline_m: float = 0.075,
-        disparity_step_px: float = 0.125,
+        axial_offset: float | None = None,
+        axial_quadratic: float | None = None,
+        axial_depth0: float | None = None,
+        focal_px: float | None = None,
+        sigma_px: float | None = None,
+        baseline_m: float | None = None,
+        disparity_step_px: float | None = None,
     ) -> DepthCamera: ...
     @staticmethod
     def nguyen_2012() -> DepthCamera:
@@ -930,16 +1087,17 @@ class StereoCamera:
     Depth standard deviation ``z^2 sigma_disparity_px / (focal_px baseline)``
     (first-order propagation of ``z = f B / d``), stretched along the ray;
     lateral ``sigma_px z / focal_px``. Defaults: a RealSense D435-like camera
-    (430 px, 50 mm, 0.08 px subpixel disparity noise, 0.5 px lateral).
+    (430 px, 50 mm, 0.08 px subpixel disparity noise, 0.5 px lateral): every
+    parameter left ``None`` takes the core's ``StereoCamera::default()``.
     """
 
     def __new__(
         cls,
         *,
-        focal_px: float = 430.0,
-        baseline: float = 0.05,
-        sigma_disparity_px: float = 0.08,
-        sigma_px: float = 0.5,
+        focal_px: float | None = None,
+        baseline: float | None = None,
+        sigma_disparity_px: float | None = None,
+        sigma_px: float | None = None,
     ) -> StereoCamera: ...
     @property
     def focal_px(self) -> float: ...
@@ -967,10 +1125,13 @@ class Lidar:
 
     ``sigma_range`` along the ray, ``range * sigma_angle`` across it. Defaults:
     Hokuyo UTM-30LX (accuracy +-30 mm taken as 3 sigma: 10 mm; angular resolution
-    0.25 deg, quantization standard deviation 0.25 deg / sqrt(12)).
+    0.25 deg, quantization standard deviation 0.25 deg / sqrt(12)): a parameter
+    left ``None`` takes the core's ``Lidar::default()``.
     """
 
-    def __new__(cls, *, sigma_range: float = 0.01, sigma_angle: float | None = None) -> Lidar: ...
+    def __new__(
+        cls, *, sigma_range: float | None = None, sigma_angle: float | None = None
+    ) -> Lidar: ...
     @property
     def sigma_range(self) -> float: ...
     @property
@@ -1155,7 +1316,7 @@ class Voxels:
     def __len__(self) -> int: ...
 
 def statistical_outlier_removal(
-    points: npt.ArrayLike, k: int | None = None, std_ratio: float = ...
+    points: npt.ArrayLike, k: int | None = None, std_ratio: float | None = None
 ) -> _IntArray:
     """Return the indices (ascending) of the points kept (see :mod:`cloudprox.filters`)."""
 
@@ -1165,9 +1326,9 @@ def shadow_filter(
     *,
     pixels: npt.ArrayLike | None = None,
     grid_shape: tuple[int, int] | None = None,
-    min_angle_deg: float = 10.0,
-    window: int = 1,
-    k: int = 8,
+    min_angle_deg: float | None = None,
+    window: int | None = None,
+    k: int | None = None,
 ) -> _IntArray:
     """Return the indices of the points kept by the veil filter (see :mod:`cloudprox.filters`)."""
 
@@ -1175,7 +1336,7 @@ def shadow_filter(
 class SelfFilter:
     """Removes the points on the robot (see :mod:`cloudprox.filters`)."""
 
-    def __new__(cls, links: object, padding: float = 0.01) -> SelfFilter: ...
+    def __new__(cls, links: object, padding: float | None = None) -> SelfFilter: ...
     def set_poses(self, poses: npt.ArrayLike) -> None:
         """Move the links: ``(m, 4, 4)``, one pose per link."""
     @property
@@ -1254,9 +1415,15 @@ class Robot:
     def self_collisions(self, q: npt.ArrayLike) -> list[tuple[str, str]]:
         """Return the pairs of non-adjacent links whose exact meshes intersect at ``q``."""
     def self_filter(
-        self, q: npt.ArrayLike, padding: float = 0.01, base_pose: npt.ArrayLike | None = None
+        self,
+        q: npt.ArrayLike,
+        padding: float | None = None,
+        base_pose: npt.ArrayLike | None = None,
     ) -> SelfFilter:
-        """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame)."""
+        """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame).
+
+        ``padding=None`` is the core's ``SELF_FILTER_DEFAULT_PADDING`` (0.01 m).
+        """
 
 @final
 class LinkCollision:

@@ -26,7 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudprox._native import PointCloud, add_noise, collide, sample_sphere
+from cloudprox._native import PointCloud, collide
+from cloudprox.pose import from_translation
+from cloudprox.synthetic import add_noise, sample_sphere
 
 __all__ = ["CONFIGS", "BenchRow", "make_spheres", "run_bench"]
 
@@ -81,10 +83,10 @@ class _Cloudprox:
     def __init__(self, pa: np.ndarray, pb: np.ndarray, sigma: float) -> None:
         self.a = PointCloud(pa, sigma=sigma)
         self.b = PointCloud(pb, sigma=sigma)
-        collide(self.a, self.b, pose_b=_translation(1.0))  # builds both hierarchies
+        collide(self.a, self.b, pose_b=from_translation((1.0, 0.0, 0.0)))  # builds both hierarchies
 
     def query(self, offset: float) -> str:
-        r = collide(self.a, self.b, pose_b=_translation(offset))
+        r = collide(self.a, self.b, pose_b=from_translation((offset, 0.0, 0.0)))
         return f"P={r.probability:.3g} {r.state}"
 
 
@@ -153,12 +155,6 @@ def _cubes_model(fcl: object, points: np.ndarray, half: float) -> object:
     model.addSubModel(verts, tris)
     model.endModel()
     return model
-
-
-def _translation(x: float) -> np.ndarray:
-    t = np.eye(4)
-    t[0, 3] = x
-    return t
 
 
 def run_bench(

@@ -17,7 +17,7 @@ Examples
 >>> import numpy as np, ray, cloudprox as cp
 >>> from cloudprox import distributed
 >>> _ = ray.init(num_cpus=2, include_dashboard=False)  # doctest: +SKIP
->>> a = cp.PointCloud(cp.sample_sphere(500, 0.1), sigma=0.002)
+>>> a = cp.PointCloud(cp.synthetic.sample_sphere(500, 0.1), sigma=0.002)
 >>> poses = np.tile(np.eye(4), (100, 1, 1)); poses[:, 0, 3] = np.linspace(0.18, 0.3, 100)
 >>> results = distributed.collide_many(a, a, poses)  # doctest: +SKIP
 """

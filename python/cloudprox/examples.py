@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from cloudprox import io
 from cloudprox._native import DepthCamera, Mesh
+from cloudprox.pose import from_translation, look_at
 
 __all__ = ["BOX_CENTRE", "BOX_HALF", "TABLE_TOP", "gripper_mesh", "write_example_files"]
 
@@ -41,23 +42,11 @@ BOX_CENTRE = np.array([0.1, 0.3])
 BOX_HALF = np.array([0.04, 0.04, 0.075])
 #: The mug: centre of its footprint, radius and height (m).
 MUG = (np.array([-0.2, 0.35]), 0.04, 0.1)
-#: Camera: position, point looked at, image size and focal length (px).
+#: Camera: position, point looked at (its optical frame is :func:`cloudprox.pose.look_at`'s),
+#: image size and focal length (px).
 CAMERA_AT = np.array([0.0, -0.55, 1.55])
 CAMERA_LOOK = np.array([0.0, 0.3, 0.8])
 WIDTH, HEIGHT, FOCAL = 320, 240, 290.0
-
-
-def _camera_pose() -> FloatArray:
-    """Optical frame (x right, y down, z forward) in the world frame."""
-    z = CAMERA_LOOK - CAMERA_AT
-    z /= np.linalg.norm(z)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    pose = np.eye(4)
-    pose[:3, :3] = np.column_stack([x, y, z])
-    pose[:3, 3] = CAMERA_AT
-    return pose
 
 
 def _boxes() -> list[tuple[FloatArray, FloatArray]]:
@@ -108,7 +97,7 @@ def _ray_mug(o: FloatArray, d: FloatArray) -> FloatArray:
 
 def _render(rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
     """Depth image ``(HEIGHT, WIDTH)`` (NaN where nothing is seen) and the rays."""
-    pose = _camera_pose()
+    pose = look_at(CAMERA_AT, CAMERA_LOOK)
     u, v = np.meshgrid(np.arange(WIDTH), np.arange(HEIGHT))
     rays_cam = np.stack(
         [(u - (WIDTH - 1) / 2) / FOCAL, (v - (HEIGHT - 1) / 2) / FOCAL, np.ones_like(u, float)],
@@ -147,23 +136,17 @@ def _mixed_pixels(depth: FloatArray, rng: np.random.Generator) -> FloatArray:
 
 def gripper_mesh() -> Mesh:
     """Return the example gripper: fingertips at ``z = 0``, palm above (approach ``-z``)."""
-    palm = Mesh.cuboid(0.03, 0.09, 0.02).transformed(_translation(0.0, 0.0, 0.07))
+    palm = Mesh.cuboid(0.03, 0.09, 0.02).transformed(from_translation((0.0, 0.0, 0.07)))
     fingers = [
-        Mesh.cuboid(0.01, 0.01, 0.025).transformed(_translation(0.0, s * 0.06, 0.025))
+        Mesh.cuboid(0.01, 0.01, 0.025).transformed(from_translation((0.0, s * 0.06, 0.025)))
         for s in (-1.0, 1.0)
     ]
     return Mesh.merged([palm, *fingers])
 
 
-def _translation(x: float, y: float, z: float) -> FloatArray:
-    t = np.eye(4)
-    t[:3, 3] = (x, y, z)
-    return t
-
-
 def _grasp(offset: float, tip_height: float) -> FloatArray:
     """Gripper pose: fingertips at ``tip_height``, ``offset`` from the box's centre along y."""
-    return _translation(BOX_CENTRE[0], BOX_CENTRE[1] + offset, tip_height)
+    return from_translation((BOX_CENTRE[0], BOX_CENTRE[1] + offset, tip_height))
 
 
 def write_example_files(folder: str | Path, seed: int = 0) -> dict[str, Path]:
@@ -180,7 +163,7 @@ def write_example_files(folder: str | Path, seed: int = 0) -> dict[str, Path]:
     )
     noisy = _mixed_pixels(noisy, rng)
     noisy[rng.random(noisy.shape) < 0.01] = np.nan  # dropouts
-    pose = _camera_pose()
+    pose = look_at(CAMERA_AT, CAMERA_LOOK)
     pts_cam = rays * noisy[..., None]
     pts = pts_cam.reshape(-1, 3) @ pose[:3, :3].T + pose[:3, 3]
     keep = np.flatnonzero(np.isfinite(pts).all(axis=1))

@@ -21,12 +21,18 @@ ascending), so that points, covariances and pixels can be subset alike::
                                            grid_shape=scan.grid_shape)
     points, covs = points[keep], covs[keep]
 
-Bad parameters raise :class:`cloudprox.InvalidInputError` naming them.
+Parameters left ``None`` take the Rust core's defaults (written once, there):
+``SOR_DEFAULT_K`` (20) and ``SOR_DEFAULT_STD_RATIO`` (2.0) for the outlier filter,
+a 10 degree angle, a window of 1 and ``k = 8`` for the shadow filter, a 1 cm
+padding for the self filter. Bad parameters raise
+:class:`cloudprox.InvalidInputError` naming them.
 """
 
 from __future__ import annotations
 
 from cloudprox._native import (
+    SOR_DEFAULT_K,
+    SOR_DEFAULT_STD_RATIO,
     SelfFilter,
     crop_box,
     shadow_filter,
@@ -43,8 +49,3 @@ __all__ = [
     "statistical_outlier_removal",
     "voxel_downsample",
 ]
-
-#: Default number of neighbours of :func:`statistical_outlier_removal`.
-SOR_DEFAULT_K = 20
-#: Default standard-deviation multiplier of :func:`statistical_outlier_removal`.
-SOR_DEFAULT_STD_RATIO = 2.0

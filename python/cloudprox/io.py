@@ -22,7 +22,6 @@ Examples
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -38,6 +37,7 @@ from cloudprox._native import write_mesh as _write_mesh
 from cloudprox._native import write_point_cloud as _write_point_cloud
 from cloudprox._native import write_pointcloud2 as _write_pointcloud2
 from cloudprox.exceptions import DegenerateFacesWarning, InvalidInputError
+from cloudprox.pose import from_quaternion, from_translation
 
 __all__ = [
     "CloudFile",
@@ -242,20 +242,6 @@ def parse_numbers(text: str, n: int, what: str = "numbers") -> FloatArray:
     return values
 
 
-def _quaternion_matrix(w: float, x: float, y: float, z: float, what: str) -> FloatArray:
-    norm = math.sqrt(w * w + x * x + y * y + z * z)
-    if not norm > 0.0:
-        raise InvalidInputError(f"{what}: the quaternion (w x y z) is zero")
-    w, x, y, z = w / norm, x / norm, y / norm, z / norm
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def read_pose(text: str | os.PathLike[str], what: str = "pose") -> FloatArray:
     """Read a ``(4, 4)`` pose from a file, or parse it from inline numbers.
 
@@ -295,17 +281,16 @@ def read_pose(text: str | os.PathLike[str], what: str = "pose") -> FloatArray:
         return m.reshape(4, 4)
     parts = [p for p in text.replace(",", " ").split() if p]
     values = parse_numbers(text, len(parts), what) if parts else np.zeros(0)
-    pose = np.eye(4)
-    if len(values) == 3:
-        pose[:3, 3] = values
-    elif len(values) == 7:
-        pose[:3, 3] = values[:3]
-        pose[:3, :3] = _quaternion_matrix(*values[3:], what=what)
-    elif len(values) == 16:
-        pose = values.reshape(4, 4)
-    else:
+    if len(values) == 16:
+        return values.reshape(4, 4)
+    if len(values) not in (3, 7):
         raise InvalidInputError(
             f"{what}: expected a pose file, or 3 (x,y,z), 7 (x,y,z,qw,qx,qy,qz) or 16 numbers, "
             f"got {text!r}"
         )
-    return pose
+    try:  # the core's constructors check the numbers (a zero quaternion, a huge translation)
+        if len(values) == 3:
+            return from_translation(values)
+        return from_quaternion(values[3:], translation=values[:3])
+    except InvalidInputError as e:
+        raise InvalidInputError(f"{what}: {e}") from None

@@ -256,11 +256,10 @@ def _apply_filter(
         new_points, new_covs = voxels.points, voxels.covariances
         return new_points, new_covs, None
     elif step.name == "outliers":
-        k = _int(step.args[0], "outliers K") if step.args else filters.SOR_DEFAULT_K
+        # Arguments left out are None: the core's defaults.
+        k = _int(step.args[0], "outliers K") if step.args else None
         std = _float(step.args[1], "outliers STD") if len(step.args) > 1 else None
-        keep = filters.statistical_outlier_removal(
-            points, k=k, std_ratio=filters.SOR_DEFAULT_STD_RATIO if std is None else std
-        )
+        keep = filters.statistical_outlier_removal(points, k=k, std_ratio=std)
     elif step.name == "shadow":
         origin = sensor.sensor_origin(scan)
         if origin is None:
@@ -268,14 +267,14 @@ def _apply_filter(
                 f"shadow filter on {scan.path}: the sensor origin is unknown (the file has no "
                 "VIEWPOINT): give --origin or --sensor-pose"
             )
-        angle = _float(step.args[0], "shadow angle") if step.args else 10.0
+        angle = _float(step.args[0], "shadow angle") if step.args else None
         grid = scan.grid_shape if pixels is not None else None
         keep = filters.shadow_filter(
             points, origin, pixels=pixels, grid_shape=grid, min_angle_deg=angle
         )
     else:  # self
         mesh, _ = read_mesh_file(step.args[0])
-        padding = _float(step.args[1], "self padding") if len(step.args) > 1 else 0.01
+        padding = _float(step.args[1], "self padding") if len(step.args) > 1 else None
         pose = parse_pose(step.args[2], "self pose") if len(step.args) > 2 else np.eye(4)
         keep = filters.SelfFilter([(mesh, pose)], padding).apply(points)
     return (

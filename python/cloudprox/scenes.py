@@ -22,13 +22,13 @@ import numpy as np
 import numpy.typing as npt
 
 from cloudprox._native import ExactShape, Mesh, exact_proximity
+from cloudprox.pose import from_rpy, from_translation
 
 __all__ = [
     "Part",
     "Scene",
     "SceneObject",
     "build_scene",
-    "make_pose",
     "piano",
     "room",
 ]
@@ -37,45 +37,6 @@ FloatArray = npt.NDArray[np.float64]
 
 #: Sides of the prisms that stand for cylinders.
 CYLINDER_SEGMENTS = 48
-
-
-def make_pose(
-    translation: npt.ArrayLike = (0.0, 0.0, 0.0),
-    rpy: npt.ArrayLike = (0.0, 0.0, 0.0),
-) -> FloatArray:
-    """Make a ``(4, 4)`` rigid transform from a translation and roll-pitch-yaw angles.
-
-    Parameters
-    ----------
-    translation : array_like, shape (3,)
-        Translation (metres).
-    rpy : array_like, shape (3,)
-        Rotations about x, then y, then z (radians): ``R = Rz(yaw) Ry(pitch) Rx(roll)``.
-
-    Returns
-    -------
-    ndarray, shape (4, 4)
-    """
-    r, p, y = (float(v) for v in np.asarray(rpy, dtype=float))
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(y),
-        math.sin(y),
-    )
-    rot = np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-    pose = np.eye(4)
-    pose[:3, :3] = rot
-    pose[:3, 3] = np.asarray(translation, dtype=float)
-    return pose
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,14 +79,14 @@ def _box(
     rpy: npt.ArrayLike = (0.0, 0.0, 0.0),
 ) -> Part:
     h = [float(x) for x in np.asarray(half, dtype=float)]
-    return Part(name, group, Mesh.cuboid(*h).transformed(make_pose(center, rpy)))
+    return Part(name, group, Mesh.cuboid(*h).transformed(from_rpy(rpy, center)))
 
 
 def _cylinder(
     name: str, group: str, center: npt.ArrayLike, radius: float, half_height: float
 ) -> Part:
     mesh = Mesh.cylinder(radius, half_height, CYLINDER_SEGMENTS)
-    return Part(name, group, mesh.transformed(make_pose(center)))
+    return Part(name, group, mesh.transformed(from_translation(center)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -341,7 +302,7 @@ class Scene:
         ndarray, shape (4, 4)
         """
         lo, hi = self.table_top().mesh.bounds()
-        return make_pose(((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, hi[2] + gap))
+        return from_translation(((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, hi[2] + gap))
 
     def gaps(self, pose: npt.ArrayLike) -> dict[str, float]:
         """Exact signed distance between the piano at ``pose`` and each room group."""

@@ -18,7 +18,7 @@ Examples
 --------
 >>> import cloudprox as cp
 >>> from cloudprox import view
->>> a = cp.PointCloud(cp.sample_sphere(300, radius=0.1), sigma=0.002)
+>>> a = cp.PointCloud(cp.synthetic.sample_sphere(300, radius=0.1), sigma=0.002)
 >>> result = cp.collide(a, a, pose_b=[[1, 0, 0, 0.19], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
 >>> scene = view.collision_scene(result, labels=("left", "right"))
 >>> [layer.name for layer in scene.points]

@@ -241,3 +241,37 @@ pub fn matrices3_to_py<'py>(py: Python<'py>, m: &[Matrix3]) -> PyResult<Bound<'p
     }
     PyArray1::from_vec(py, flat).reshape([m.len(), 3, 3])
 }
+
+/// A `(4,)` array-like as four numbers.
+pub fn array4_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 4]> {
+    let arr = to_f64_array(obj, what)?;
+    check_shape(&arr, &[Some(4)], what, "(4,)")?;
+    let d = data(&arr, what)?;
+    Ok([d[0], d[1], d[2], d[3]])
+}
+
+/// The row-major entries of a pose's 4x4 homogeneous matrix.
+fn pose_entries(pose: &Pose, out: &mut Vec<f64>) {
+    let m = pose.to_homogeneous();
+    for r in 0..4 {
+        for c in 0..4 {
+            out.push(m[(r, c)]);
+        }
+    }
+}
+
+/// A float64 array of shape `(4, 4)`: the pose's homogeneous matrix.
+pub fn pose_to_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let mut flat = Vec::with_capacity(16);
+    pose_entries(pose, &mut flat);
+    PyArray1::from_vec(py, flat).reshape([4, 4])
+}
+
+/// A float64 array of shape `(n, 4, 4)`: the poses' homogeneous matrices.
+pub fn poses_to_py<'py>(py: Python<'py>, poses: &[Pose]) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let mut flat = Vec::with_capacity(16 * poses.len());
+    for p in poses {
+        pose_entries(p, &mut flat);
+    }
+    PyArray1::from_vec(py, flat).reshape([poses.len(), 4, 4])
+}

@@ -4,7 +4,8 @@
 use std::sync::RwLock;
 
 use cloudprox::filter::{
-    self, CovarianceMerge, SelfFilter, ShadowSettings, SOR_DEFAULT_K, SOR_DEFAULT_STD_RATIO,
+    self, CovarianceMerge, SelfFilter, ShadowSettings, SELF_FILTER_DEFAULT_PADDING, SOR_DEFAULT_K,
+    SOR_DEFAULT_STD_RATIO,
 };
 use cloudprox::io::Grid;
 use cloudprox::math::{Point3, Pose};
@@ -171,14 +172,17 @@ pub fn voxel_downsample<'py>(
 /// Indices (ascending) of the points kept by statistical outlier removal (PCL's
 /// rule: mean distance to the `k` nearest neighbours above the global mean plus
 /// `std_ratio` standard deviations removes a point).
+/// `k` and `std_ratio` left `None` are the core's `SOR_DEFAULT_K` and
+/// `SOR_DEFAULT_STD_RATIO`.
 #[pyfunction]
-#[pyo3(signature = (points, k=None, std_ratio=SOR_DEFAULT_STD_RATIO))]
+#[pyo3(signature = (points, k=None, std_ratio=None))]
 pub fn statistical_outlier_removal<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
     k: Option<i64>,
-    std_ratio: f64,
+    std_ratio: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let std_ratio = std_ratio.unwrap_or(SOR_DEFAULT_STD_RATIO);
     let points = points_from(points, "points")?;
     let k = match k {
         Some(k) => usize_arg(py, k, "k", 1)?,
@@ -190,18 +194,20 @@ pub fn statistical_outlier_removal<'py>(
     Ok(indices_to_py(py, &keep))
 }
 
-/// Indices (ascending) of the points kept by the shadow (veil) filter.
+/// Indices (ascending) of the points kept by the shadow (veil) filter;
+/// `min_angle_deg`, `window` and `k` left `None` are the core's
+/// `ShadowSettings::default()`.
 #[pyfunction]
-#[pyo3(signature = (points, origin, *, pixels=None, grid_shape=None, min_angle_deg=10.0, window=1, k=8))]
+#[pyo3(signature = (points, origin, *, pixels=None, grid_shape=None, min_angle_deg=None, window=None, k=None))]
 pub fn shadow_filter<'py>(
     py: Python<'py>,
     points: &Bound<'py, PyAny>,
     origin: &Bound<'py, PyAny>,
     pixels: Option<&Bound<'py, PyAny>>,
     grid_shape: Option<(i64, i64)>,
-    min_angle_deg: f64,
-    window: i64,
-    k: i64,
+    min_angle_deg: Option<f64>,
+    window: Option<i64>,
+    k: Option<i64>,
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let points = points_from(points, "points")?;
     let origin = point3_from(origin, "origin")?;
@@ -248,10 +254,11 @@ pub fn shadow_filter<'py>(
             ))
         }
     };
+    let default = ShadowSettings::default();
     let settings = ShadowSettings {
-        min_angle: min_angle_deg.to_radians(),
-        window: usize_arg(py, window, "window", 1)?,
-        k: usize_arg(py, k, "k", 1)?,
+        min_angle: min_angle_deg.map_or(default.min_angle, f64::to_radians),
+        window: window.map_or(Ok(default.window), |w| usize_arg(py, w, "window", 1))?,
+        k: k.map_or(Ok(default.k), |k| usize_arg(py, k, "k", 1))?,
     };
     let keep = run_detached(py, move || {
         filter::shadow_filter(&points, &origin, grid.as_ref(), &settings)
@@ -279,8 +286,9 @@ impl PySelfFilter {
 #[pymethods]
 impl PySelfFilter {
     #[new]
-    #[pyo3(signature = (links, padding=0.01))]
-    fn new(py: Python<'_>, links: &Bound<'_, PyAny>, padding: f64) -> PyResult<Self> {
+    #[pyo3(signature = (links, padding=None))]
+    fn new(py: Python<'_>, links: &Bound<'_, PyAny>, padding: Option<f64>) -> PyResult<Self> {
+        let padding = padding.unwrap_or(SELF_FILTER_DEFAULT_PADDING);
         let mut parsed: Vec<(cloudprox::shape::Mesh, Pose)> = Vec::new();
         for (i, item) in links.try_iter()?.enumerate() {
             let item = item?;

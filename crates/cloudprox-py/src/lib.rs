@@ -13,12 +13,15 @@
 //! | `filter.rs` | sensor-cloud filters: crop box, voxel, outliers, shadow, self |
 //! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
+//! | `pose.rs` | pose constructors (translation, quaternion, rpy, rotation vector, look-at, random) |
 //! | `sample.rs` | seeded synthetic shapes |
 //! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
 //! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
 //! | `robot.rs` | `Robot`, `collide_robot`, `collide_robot_many`, `check_motion` |
 //!
-//! The Python package `cloudprox` re-exports everything; `_native.pyi` is the stub.
+//! The Python package `cloudprox` re-exports everything (the filters, pose
+//! constructors and synthetic samplers through its `filters`, `pose` and
+//! `synthetic` modules); `_native.pyi` is the stub.
 #![deny(unused_qualifications)]
 
 use pyo3::prelude::*;
@@ -30,6 +33,7 @@ mod error;
 mod filter;
 mod io;
 mod mesh;
+mod pose;
 mod request;
 mod result;
 mod robot;
@@ -57,6 +61,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(filter::crop_box, m)?)?;
     m.add_function(wrap_pyfunction!(filter::voxel_downsample, m)?)?;
     m.add_function(wrap_pyfunction!(filter::statistical_outlier_removal, m)?)?;
+    m.add("SOR_DEFAULT_K", cloudprox::filter::SOR_DEFAULT_K)?;
+    m.add(
+        "SOR_DEFAULT_STD_RATIO",
+        cloudprox::filter::SOR_DEFAULT_STD_RATIO,
+    )?;
     m.add_function(wrap_pyfunction!(filter::shadow_filter, m)?)?;
     m.add_class::<io::PyCloudFile>()?;
     m.add_function(wrap_pyfunction!(io::read_point_cloud, m)?)?;
@@ -74,6 +83,12 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::exact_proximity, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity_many_py, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_intersects_many_py, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::pose_from_translation, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::pose_from_quaternion, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::pose_from_rpy, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::pose_from_rotation_vector, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::pose_look_at, m)?)?;
+    m.add_function(wrap_pyfunction!(pose::random_rotations, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_sphere, m)?)?;
     m.add_function(wrap_pyfunction!(sample::sample_box_surface, m)?)?;
     m.add_function(wrap_pyfunction!(sample::add_noise, m)?)?;

@@ -342,15 +342,17 @@ impl PyRobot {
     }
 
     /// The self-filter of the robot at `q` (root at `base_pose`, in the cloud's
-    /// frame): removes the points within `padding` of a link, or inside a closed link.
-    #[pyo3(signature = (q, padding=0.01, base_pose=None))]
+    /// frame): removes the points within `padding` of a link, or inside a closed link
+    /// (`None`: the core's `SELF_FILTER_DEFAULT_PADDING`).
+    #[pyo3(signature = (q, padding=None, base_pose=None))]
     fn self_filter(
         &self,
         py: Python<'_>,
         q: &Bound<'_, PyAny>,
-        padding: f64,
+        padding: Option<f64>,
         base_pose: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PySelfFilter> {
+        let padding = padding.unwrap_or(cloudprox::filter::SELF_FILTER_DEFAULT_PADDING);
         let q = config_from(q, "q")?;
         let base = pose_from(py, base_pose, "base_pose")?;
         let robot = Arc::clone(&self.inner);

@@ -1,7 +1,6 @@
 //! Sensor noise models: `DepthCamera`, `StereoCamera`, `Lidar`.
 
 use cloudprox::math::Point3;
-use cloudprox::uncertainty::sensor::{KINECT_BASELINE_M, KINECT_DISPARITY_STEP_PX};
 use cloudprox::uncertainty::{DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray3};
@@ -87,35 +86,34 @@ pub struct PyDepthCamera {
     inner: DepthCamera,
 }
 
-// The signature below spells the Kinect defaults as literals (Python shows them);
-// they must stay the core's constants.
-const _: () = assert!(KINECT_BASELINE_M == 0.075 && KINECT_DISPARITY_STEP_PX == 0.125);
-
 #[pymethods]
 impl PyDepthCamera {
     #[new]
+    // Every parameter left `None` is the core's `DepthCamera::default()`'s.
     #[pyo3(signature = (
-        *, axial_offset=0.0, axial_quadratic=1.425e-3, axial_depth0=0.0, focal_px=580.0,
-        sigma_px=0.8, baseline_m=0.075, disparity_step_px=0.125
+        *, axial_offset=None, axial_quadratic=None, axial_depth0=None, focal_px=None,
+        sigma_px=None, baseline_m=None, disparity_step_px=None
     ))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
-        axial_offset: f64,
-        axial_quadratic: f64,
-        axial_depth0: f64,
-        focal_px: f64,
-        sigma_px: f64,
-        baseline_m: f64,
-        disparity_step_px: f64,
+        axial_offset: Option<f64>,
+        axial_quadratic: Option<f64>,
+        axial_depth0: Option<f64>,
+        focal_px: Option<f64>,
+        sigma_px: Option<f64>,
+        baseline_m: Option<f64>,
+        disparity_step_px: Option<f64>,
     ) -> PyResult<Self> {
+        let d = DepthCamera::default();
         let inner = DepthCamera {
-            axial_offset,
-            axial_quadratic,
-            axial_depth0,
-            focal_px,
-            sigma_px,
-            baseline_m,
-            disparity_step_px,
+            axial_offset: axial_offset.unwrap_or(d.axial_offset),
+            axial_quadratic: axial_quadratic.unwrap_or(d.axial_quadratic),
+            axial_depth0: axial_depth0.unwrap_or(d.axial_depth0),
+            focal_px: focal_px.unwrap_or(d.focal_px),
+            sigma_px: sigma_px.unwrap_or(d.sigma_px),
+            baseline_m: baseline_m.unwrap_or(d.baseline_m),
+            disparity_step_px: disparity_step_px.unwrap_or(d.disparity_step_px),
         };
         inner.validate().or_py(py)?;
         Ok(Self { inner })
@@ -239,19 +237,21 @@ pub struct PyStereoCamera {
 #[pymethods]
 impl PyStereoCamera {
     #[new]
-    #[pyo3(signature = (*, focal_px=430.0, baseline=0.05, sigma_disparity_px=0.08, sigma_px=0.5))]
+    // Every parameter left `None` is the core's `StereoCamera::default()`'s.
+    #[pyo3(signature = (*, focal_px=None, baseline=None, sigma_disparity_px=None, sigma_px=None))]
     fn new(
         py: Python<'_>,
-        focal_px: f64,
-        baseline: f64,
-        sigma_disparity_px: f64,
-        sigma_px: f64,
+        focal_px: Option<f64>,
+        baseline: Option<f64>,
+        sigma_disparity_px: Option<f64>,
+        sigma_px: Option<f64>,
     ) -> PyResult<Self> {
+        let d = StereoCamera::default();
         let inner = StereoCamera {
-            focal_px,
-            baseline,
-            sigma_disparity_px,
-            sigma_px,
+            focal_px: focal_px.unwrap_or(d.focal_px),
+            baseline: baseline.unwrap_or(d.baseline),
+            sigma_disparity_px: sigma_disparity_px.unwrap_or(d.sigma_disparity_px),
+            sigma_px: sigma_px.unwrap_or(d.sigma_px),
         };
         inner.validate().or_py(py)?;
         Ok(Self { inner })
@@ -330,11 +330,13 @@ pub struct PyLidar {
 #[pymethods]
 impl PyLidar {
     #[new]
-    #[pyo3(signature = (*, sigma_range=0.01, sigma_angle=None))]
-    fn new(py: Python<'_>, sigma_range: f64, sigma_angle: Option<f64>) -> PyResult<Self> {
+    // Every parameter left `None` is the core's `Lidar::default()`'s.
+    #[pyo3(signature = (*, sigma_range=None, sigma_angle=None))]
+    fn new(py: Python<'_>, sigma_range: Option<f64>, sigma_angle: Option<f64>) -> PyResult<Self> {
+        let d = Lidar::default();
         let inner = Lidar {
-            sigma_range,
-            sigma_angle: sigma_angle.unwrap_or(Lidar::default().sigma_angle),
+            sigma_range: sigma_range.unwrap_or(d.sigma_range),
+            sigma_angle: sigma_angle.unwrap_or(d.sigma_angle),
         };
         inner.validate().or_py(py)?;
         Ok(Self { inner })

@@ -64,6 +64,7 @@ import numpy.typing as npt
 from cloudprox._native import Mesh
 from cloudprox.exceptions import DegenerateFacesWarning
 from cloudprox.io import parse_mesh, read_mesh
+from cloudprox.pose import from_translation
 
 __all__ = [
     "PANDA_FINGER_MOUNT",
@@ -712,12 +713,6 @@ def _panda_meshes(wheel: Path) -> tuple[Mesh, Mesh]:
     return meshes[0], meshes[1]
 
 
-def _translation(x: float, y: float, z: float) -> FloatArray:
-    t = np.eye(4)
-    t[:3, 3] = (x, y, z)
-    return t
-
-
 def panda_gripper_parts(opening: float = PANDA_MAX_OPENING) -> list[Mesh]:
     """Franka Panda hand and fingers in the hand frame: ``[hand, left, right]``.
 
@@ -745,8 +740,8 @@ def panda_gripper_parts(opening: float = PANDA_MAX_OPENING) -> list[Mesh]:
         )
     hand, finger = _panda_meshes(fetch_panda_wheel())
     half_turn = np.diag([-1.0, -1.0, 1.0, 1.0])
-    left = finger.transformed(_translation(0.0, -opening, PANDA_FINGER_MOUNT) @ half_turn)
-    right = finger.transformed(_translation(0.0, opening, PANDA_FINGER_MOUNT))
+    left = finger.transformed(from_translation((0.0, -opening, PANDA_FINGER_MOUNT)) @ half_turn)
+    right = finger.transformed(from_translation((0.0, opening, PANDA_FINGER_MOUNT)))
     return [hand, left, right]
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from cloudprox.reproduce.methods import THRESHOLD_COLLISION, THRESHOLD_FREE
 from cloudprox.reproduce.metrics import NEAR_SIGMA, Metrics, roc_curve
 
 __all__ = [
@@ -46,7 +47,8 @@ def plot_probability_vs_distance(
             x = np.broadcast_to(dist / sigma, s.shape).ravel()
             ax.scatter(x, s.ravel(), s=7, alpha=0.5, color=c, label=name, linewidths=0)
         ax.axvline(0.0, color="k", lw=0.8)
-        ax.axhspan(0.1, 0.9, color="0.9", zorder=0, label="contact band (0.1-0.9)")
+        lo, hi = THRESHOLD_FREE, THRESHOLD_COLLISION
+        ax.axhspan(lo, hi, color="0.9", zorder=0, label=f"contact band ({lo:g}-{hi:g})")
         ax.set_xlabel("exact signed distance / sigma (negative: penetration)")
         ax.set_ylabel("collision probability P")
         ax.set_title(title)

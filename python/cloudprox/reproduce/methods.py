@@ -67,8 +67,10 @@ __all__ = [
 
 FloatArray = npt.NDArray[np.float64]
 
-#: cloudprox's default thresholds (P >= A: collision, P <= B: free).
-THRESHOLD_COLLISION, THRESHOLD_FREE = 0.9, 0.1
+#: cloudprox's default thresholds (P >= A: collision, P <= B: free), read from the
+#: core's defaults (``CollisionRequest()``).
+THRESHOLD_COLLISION = CollisionRequest().threshold_collision
+THRESHOLD_FREE = CollisionRequest().threshold_free
 #: Queries of the reconstruction baseline timed one by one.
 TIMED_QUERIES = 30
 #: The points model's aggregations: the surface one and the paper's three.

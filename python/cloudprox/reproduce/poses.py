@@ -23,7 +23,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cloudprox._native import exact_proximity_many
-from cloudprox.scenes import SceneObject, make_pose
+from cloudprox.pose import from_rpy
+from cloudprox.scenes import SceneObject
 
 __all__ = ["QueryPoses", "draw_target_units", "sample_poses"]
 
@@ -141,13 +142,14 @@ def sample_poses(
         tg = target[pending]
         starts = np.stack(
             [
-                make_pose(
-                    (
+                # Keywords in this order keep the draws' order (translation first).
+                from_rpy(
+                    translation=(
                         rng.uniform(lo[0] + 0.5, hi[0] - 0.5),
                         rng.uniform(lo[1] + 0.5, hi[1] - 0.5),
                         rng.uniform(0.65, 2.4),
                     ),
-                    (
+                    rpy=(
                         rng.uniform(-tilt, tilt),
                         rng.uniform(-tilt, tilt),
                         rng.uniform(0, 2 * math.pi),

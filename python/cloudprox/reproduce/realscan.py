@@ -57,6 +57,7 @@ from cloudprox._native import (
     exact_intersects_many,
     exact_proximity_many,
 )
+from cloudprox.pose import random_rotations
 from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.data import (
     DepthFrame,
@@ -158,21 +159,6 @@ class ScanPoses:
     sigma: FloatArray
 
 
-def _random_rotations(n: int, rng: np.random.Generator) -> FloatArray:
-    """Uniformly random rotation matrices (from unit quaternions)."""
-    q = rng.standard_normal((n, 4))
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        1,
-    )
-
-
 def sample_scan_poses(
     gripper: ExactShape,
     bound: ExactShape,
@@ -216,7 +202,7 @@ def sample_scan_poses(
         a, s = anchors[pick], anchor_sigma[pick]
         target = unit[pending] * s
         ray = a / np.linalg.norm(a, axis=1, keepdims=True)
-        rot = _random_rotations(k, rng)
+        rot = random_rotations(k, seed=int(rng.integers(2**63)))[:, :3, :3]
         start = np.zeros((k, 4, 4))
         start[:, :3, :3] = rot
         start[:, 3, 3] = 1.0

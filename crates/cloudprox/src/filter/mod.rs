@@ -33,7 +33,7 @@ mod voxel;
 
 pub use crop_box::crop_box;
 pub use outlier::{statistical_outlier_removal, SOR_DEFAULT_K, SOR_DEFAULT_STD_RATIO};
-pub use self_filter::SelfFilter;
+pub use self_filter::{SelfFilter, SELF_FILTER_DEFAULT_PADDING};
 pub use shadow::{shadow_filter, ShadowSettings};
 pub use voxel::{voxel_downsample, voxel_downsample_with, CovarianceMerge, Voxelized};
 

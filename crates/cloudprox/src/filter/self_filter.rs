@@ -37,6 +37,11 @@ impl std::fmt::Debug for Link {
     }
 }
 
+/// The default padding of a self-filter (metres): 1 cm, the low end of the PR2
+/// pipeline's 1-3 cm (the Python bindings' `padding=None`, the command line's
+/// `self:MESH` without a padding).
+pub const SELF_FILTER_DEFAULT_PADDING: f64 = 0.01;
+
 /// Removes the points of a cloud that lie on the robot, given the meshes of its
 /// links and their poses. Built once (acceleration structures per link), then
 /// applied to every frame; [`SelfFilter::set_poses`] moves the links.
@@ -49,9 +54,10 @@ impl std::fmt::Debug for Link {
 /// pseudo-normal test (meshes wound inward are flipped first). Meshes from files
 /// are often open (holes, duplicated seams, inconsistent winding): for those only
 /// the distance to the surface counts, so a point deep inside an open link
-/// further than `padding` from every face is kept. Padding has no default: the
-/// PR2 pipeline uses 1 to 3 cm; use at least 2-3 sensor sigmas plus the error of
-/// the link poses.
+/// further than `padding` from every face is kept. [`SelfFilter::new`] takes the
+/// padding explicitly; [`SELF_FILTER_DEFAULT_PADDING`] (1 cm) is what callers that
+/// leave it out get. The PR2 pipeline uses 1 to 3 cm; use at least 2-3 sensor
+/// sigmas plus the error of the link poses.
 ///
 /// Each point is first rejected by each link's padded bounding box (in the cloud
 /// frame, then in the link's frame), so points far from the robot cost a few
