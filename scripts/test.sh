@@ -36,5 +36,8 @@ python3 -m mypy.stubtest cloudprox._native
 step "documentation site (mkdocs build --strict, API reference from the installed package)"
 NO_MKDOCS_2_WARNING=1 python3 -m mkdocs build --strict --site-dir "${TMPDIR:-/tmp}/cloudprox-site"
 
-step "pytest (two workers, one file each)"
-python3 -m pytest -q -n 2 --dist loadfile
+step "pytest: the fast suite (two workers, one file each)"
+python3 -m pytest -q -n 2 --dist loadfile -m "not network and not slow"
+
+step "pytest: real files from the registries, and the quick reproduction"
+python3 -m pytest -q -n 2 --dist loadfile -m "network or slow"

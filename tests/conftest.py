@@ -1,4 +1,11 @@
-"""Shared fixtures: two noisy spheres with fixed noise."""
+"""Shared fixtures (two noisy spheres with fixed noise) and the suite's marks.
+
+Two marks split the suite (``pyproject.toml`` declares them): ``network``, the
+tests that read real files fetched into the cache from package registries
+(crates.io, PyPI, Debian), and ``slow``, the full quick reproduction. A
+developer's fast run is ``python3 -m pytest -m "not network and not slow"``;
+``scripts/test.sh`` (and so CI) runs the fast suite, then the marked tests.
+"""
 
 from __future__ import annotations
 
@@ -20,3 +27,28 @@ def sphere_points() -> tuple[np.ndarray, np.ndarray]:
 def spheres(sphere_points: tuple[np.ndarray, np.ndarray]) -> tuple[cp.PointCloud, cp.PointCloud]:
     pa, pb = sphere_points
     return cp.PointCloud(pa, sigma=SIGMA), cp.PointCloud(pb, sigma=SIGMA)
+
+
+#: Modules whose every test reads real files from the cache.
+NETWORK_MODULES = {"test_io_real", "test_reproduce_data"}
+#: Fixtures that fetch real files (the Panda URDF and its meshes).
+NETWORK_FIXTURES = {"panda", "readme_folder"}
+#: Tests that fetch real files themselves.
+NETWORK_TESTS = {"test_readme_robot_planning"}
+#: Fixtures that run the full quick reproduction.
+SLOW_FIXTURES = {"quick_run"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark the tests that need the network or the full reproduction."""
+    for item in items:
+        fixtures = set(getattr(item, "fixturenames", ()))
+        module = item.module.__name__.rsplit(".", 1)[-1] if item.module else ""
+        if (
+            module in NETWORK_MODULES
+            or fixtures & NETWORK_FIXTURES
+            or item.originalname in NETWORK_TESTS
+        ):
+            item.add_marker(pytest.mark.network)
+        if fixtures & SLOW_FIXTURES:
+            item.add_marker(pytest.mark.slow)

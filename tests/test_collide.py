@@ -99,7 +99,8 @@ def test_result_fields(sweep, spheres) -> None:
         assert region.normal[0] > 0.5  # from A (at the origin) towards B (along +x)
         assert region.surface == "quadric"
         assert region.status in ("solved", "almost_solved", "fallback")
-        assert region.iterations >= 0
+        # The barrier method takes at least one step to a solution.
+        assert region.iterations >= 1 or region.status == "fallback"
         assert 0.0 <= region.probability <= 1.0
         assert isinstance(region.separation, float) and isinstance(region.component, int)
         assert "ContactRegion(" in repr(region)

@@ -128,8 +128,10 @@ pub fn invalid_input(py: Python<'_>, msg: impl Into<String>) -> PyErr {
 }
 
 /// The Python exception for a core error: `InvalidInput` and `Shape` become
-/// `InvalidInputError` with the core's message. The match is exhaustive on
-/// purpose: a variant added to the core must be mapped here.
+/// `InvalidInputError` with the core's message, `Format` a `FormatError`, `Io`
+/// the matching `OSError`. The core's `Error` is `#[non_exhaustive]`: a
+/// variant added later is a `CloudproxError` with its message until it is
+/// mapped here.
 pub fn core_error(py: Python<'_>, err: cloudprox::Error) -> PyErr {
     match err {
         cloudprox::Error::InvalidInput(msg) => invalid_input(py, msg),
@@ -143,6 +145,7 @@ pub fn core_error(py: Python<'_>, err: cloudprox::Error) -> PyErr {
             kind,
             message,
         } => os_error(kind, format!("{path}: {message}")),
+        e => CloudproxError::new_err(e.to_string()),
     }
 }
 

@@ -4,6 +4,7 @@ use thiserror::Error as ThisError;
 
 /// Everything that can go wrong in cloudprox because of what the caller passed in.
 #[derive(Debug, Clone, PartialEq, ThisError)]
+#[non_exhaustive]
 pub enum Error {
     /// An input value is out of its domain (NaN coordinates, negative sigma, empty
     /// cloud, non-PSD covariance, thresholds out of order, ...). The message names it.

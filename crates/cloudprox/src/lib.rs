@@ -68,8 +68,7 @@ pub mod uncertainty;
 
 pub use error::{Error, Result};
 
-/// The scalar type of every coordinate, covariance and probability.
-pub type Real = f64;
+pub use math::Real;
 
 /// The names most programs need, in one import.
 pub mod prelude {
@@ -85,7 +84,7 @@ pub mod prelude {
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{
-        DepthCamera, DiscretizationSettings, Lidar, RobustModel, SensorModel, StereoCamera,
-        Viewpoint,
+        DepthCamera, DiscretizationSettings, Lidar, NoiseModel, RobustModel, SensorModel,
+        StereoCamera, Viewpoint,
     };
 }

@@ -1,6 +1,7 @@
 //! Point, vector, matrix and pose aliases used throughout the crate.
 
-use crate::Real;
+/// The scalar type of every coordinate, covariance and probability.
+pub type Real = f64;
 
 /// A point in 3D space (metres).
 pub type Point3 = nalgebra::Point3<Real>;

@@ -14,12 +14,15 @@ pub struct ByteCursor<'a> {
 }
 
 macro_rules! read_num {
-    ($le:ident, $be:ident, $t:ty, $n:expr) => {
+    ($le:ident, $t:ty, $n:expr) => {
         /// Reads one little-endian value.
         pub fn $le(&mut self) -> Result<$t> {
             let b = self.take($n)?;
             Ok(<$t>::from_le_bytes(b.try_into().expect("length checked")))
         }
+    };
+    ($le:ident, $be:ident, $t:ty, $n:expr) => {
+        read_num!($le, $t, $n);
         /// Reads one big-endian value.
         pub fn $be(&mut self) -> Result<$t> {
             let b = self.take($n)?;
@@ -103,7 +106,8 @@ impl<'a> ByteCursor<'a> {
     read_num!(i16_le, i16_be, i16, 2);
     read_num!(u32_le, u32_be, u32, 4);
     read_num!(i32_le, i32_be, i32, 4);
-    read_num!(u64_le, u64_be, u64, 8);
+    // (No reader needs a big-endian u64.)
+    read_num!(u64_le, u64, 8);
     read_num!(f32_le, f32_be, f32, 4);
     read_num!(f64_le, f64_be, f64, 8);
 

@@ -41,7 +41,7 @@ mod text;
 pub mod xyz;
 
 pub use cloud_data::{CloudData, CloudDataBuilder, Grid, MeshData, COV_FIELDS};
-pub use cursor::ByteCursor;
+pub(crate) use cursor::ByteCursor;
 pub use format::{
     read_mesh, read_mesh_bytes, read_point_cloud, read_point_cloud_bytes, write_mesh,
     write_mesh_bytes, write_point_cloud, write_point_cloud_bytes, CloudFormat, Encoding,

@@ -93,8 +93,9 @@ pub struct SelfCollision {
     pub link_b: usize,
 }
 
-/// Counters and timings of one robot query.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// Counters and timings of one robot query. Equality compares the counters,
+/// not the wall time.
+#[derive(Debug, Clone, Default)]
 pub struct RobotStats {
     /// Links with geometry.
     pub links_with_geometry: usize,
@@ -112,6 +113,36 @@ pub struct RobotStats {
     pub node_pairs_visited: usize,
     /// Wall time (seconds).
     pub time_seconds: Real,
+}
+
+impl PartialEq for RobotStats {
+    fn eq(&self, o: &Self) -> bool {
+        // Every field named, so that a new one is not left out by accident.
+        let Self {
+            links_with_geometry,
+            links_queried,
+            links_after_decision,
+            broad_phase_nodes,
+            self_pairs_checked,
+            node_pairs_visited,
+            time_seconds: _,
+        } = self;
+        (
+            links_with_geometry,
+            links_queried,
+            links_after_decision,
+            broad_phase_nodes,
+            self_pairs_checked,
+            node_pairs_visited,
+        ) == (
+            &o.links_with_geometry,
+            &o.links_queried,
+            &o.links_after_decision,
+            &o.broad_phase_nodes,
+            &o.self_pairs_checked,
+            &o.node_pairs_visited,
+        )
+    }
 }
 
 /// The answer of [`collide_robot`].

@@ -10,7 +10,7 @@
 //!    ([`crate::bvh`]), and keep the samples within the noise's reach of the
 //!    other cloud, with context around them (`near.rs`);
 //! 2. merge them into connected near regions, and split large regions into
-//!    patches along the contact ([`region`]);
+//!    patches along the contact (`region.rs`);
 //! 3. train a robust separating surface per patch ([`crate::classify`]), and
 //!    estimate the contact point, normal and separation (`contact.rs`);
 //! 4. with surface elements, whether a patch's element surfaces can reach each
@@ -29,7 +29,7 @@ mod contact;
 mod elements;
 mod near;
 mod probabilities;
-pub mod region;
+pub(crate) mod region;
 mod request;
 mod result;
 

@@ -38,8 +38,9 @@ pub struct ContactRegion {
     pub iterations: u32,
 }
 
-/// Counters and timings of one query.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// Counters and timings of one query. Equality compares the counters, not
+/// the wall time (two runs of one query differ in it).
+#[derive(Debug, Clone, Default)]
 pub struct QueryStats {
     /// Node pairs tested during the traversal.
     pub node_pairs_visited: usize,
@@ -71,6 +72,51 @@ pub struct QueryStats {
     pub pruned_bound: Real,
     /// Wall time of the query (seconds).
     pub time_seconds: Real,
+}
+
+impl PartialEq for QueryStats {
+    fn eq(&self, o: &Self) -> bool {
+        // Every field named, so that a new one is not left out by accident.
+        let Self {
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+            time_seconds: _,
+        } = self;
+        (
+            node_pairs_visited,
+            leaf_pairs,
+            near_regions,
+            patches,
+            misfit_cuts,
+            patches_beyond_reach,
+            points_classified,
+            solver_iterations,
+            barrier_fallbacks,
+            solver_fallbacks,
+            pruned_bound,
+        ) == (
+            &o.node_pairs_visited,
+            &o.leaf_pairs,
+            &o.near_regions,
+            &o.patches,
+            &o.misfit_cuts,
+            &o.patches_beyond_reach,
+            &o.points_classified,
+            &o.solver_iterations,
+            &o.barrier_fallbacks,
+            &o.solver_fallbacks,
+            &o.pruned_bound,
+        )
+    }
 }
 
 /// The answer of [`crate::query::collide()`].
