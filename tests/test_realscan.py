@@ -54,7 +54,7 @@ def test_intersection_only_query_agrees_with_the_full_one() -> None:
     full = cp.exact_proximity_many(a, b, poses)
     fast = cp.exact_intersects_many(a, b, poses)
     assert fast.dtype == bool and fast.shape == (200,)
-    assert np.array_equal(fast, full["intersecting"])
+    assert np.array_equal(fast, full.intersecting)
     assert 20 < fast.sum() < 180
 
 
@@ -122,6 +122,6 @@ def test_scan_poses_reach_their_targets_against_a_wall() -> None:
     assert (unit < -3.0).any() and (unit > 10.0).any()
     full = cp.exact_proximity_many(gripper, reference, q.poses)
     apart = q.signed_distance > 0.0
-    assert np.allclose(full["distance"][apart], q.signed_distance[apart], atol=1e-9)
+    assert np.allclose(full.distance[apart], q.signed_distance[apart], atol=1e-9)
     # Past contact: the cube's front (nearest-the-wall) corner is |d| beyond the face.
-    assert np.all(full["intersecting"][~apart])
+    assert np.all(full.intersecting[~apart])

@@ -259,7 +259,7 @@ def exact_clearance_along(
             continue
         poses = np.stack([arm.link_poses(q)[name] for q in qs])
         d = cp.exact_proximity_many(cp.ExactShape([mesh]), box, poses, box_pose)
-        best = min(best, float(np.min(np.where(d["intersecting"], 0.0, d["distance"]))))
+        best = min(best, float(np.min(np.where(d.intersecting, 0.0, d.distance))))
     return best
 
 

@@ -37,8 +37,15 @@ def test_meshes_and_exact_queries_from_python() -> None:
     many = cloudprox.exact_proximity_many(
         shape, shape, np.stack([from_translation((x, 0.001, 0.002)) for x in (0.15, 0.25)])
     )
-    assert list(many["intersecting"]) == [True, False]
-    assert many["signed_distance"] == pytest.approx([-0.05, 0.05])
+    assert list(many.intersecting) == [True, False]
+    assert many.signed_distance == pytest.approx([-0.05, 0.05])
+    assert isinstance(many, cloudprox.ProximityBatch) and len(many) == 2
+    assert many.distance.dtype == np.float64 and many.intersecting.dtype == np.bool_
+    assert many[1].distance == pytest.approx(0.05) and not many[-1].intersecting
+    keys = {"intersecting", "distance", "penetration_depth", "signed_distance"}
+    assert set(many.to_dict()) == keys
+    with pytest.raises(IndexError, match="out of range for 2 poses"):
+        many[2]
     with pytest.raises(cloudprox.InvalidInputError, match="refers to vertex 5"):
         cloudprox.Mesh(np.eye(3), [[0, 1, 5]])
     with pytest.raises(cloudprox.InvalidInputError, match="faces must be integers"):
@@ -58,7 +65,7 @@ def test_union_sampling_stays_on_the_union_surface() -> None:
     # ... and every sample lies on some part's surface: a tiny probe at it touches the piano.
     probe = cloudprox.ExactShape([cloudprox.Mesh.cuboid(1e-4, 1e-4, 1e-4)])
     poses = np.stack([from_translation(x) for x in pts[::50]])
-    assert cloudprox.exact_proximity_many(probe, p.exact, poses)["intersecting"].all()
+    assert cloudprox.exact_proximity_many(probe, p.exact, poses).intersecting.all()
     assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
     with pytest.raises(ValueError, match="density"):
         p.sample(0.0)

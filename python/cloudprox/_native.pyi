@@ -36,6 +36,7 @@ __all__ = [
     "MotionResult",
     "PointCloud",
     "Proximity",
+    "ProximityBatch",
     "QueryStats",
     "Robot",
     "RobotBatchResult",
@@ -557,15 +558,39 @@ def exact_proximity_many(
     b: ExactShape,
     poses_a: npt.ArrayLike,
     pose_b: npt.ArrayLike | None = None,
-) -> dict[str, npt.NDArray[np.float64] | npt.NDArray[np.bool_]]:
+) -> ProximityBatch:
     """:func:`exact_proximity` for poses ``(m, 4, 4)`` of ``a``, in parallel.
 
     Returns
     -------
-    dict
-        Arrays of shape ``(m,)``: ``intersecting`` (bool), ``distance``,
-        ``penetration_depth`` (NaN when unknown) and ``signed_distance``.
+    ProximityBatch
+        One :class:`Proximity` per pose, read as arrays of shape ``(m,)``
+        (``intersecting``, ``distance``, ``penetration_depth`` (NaN when
+        unknown), ``signed_distance``) or pose by pose (``batch[i]``).
     """
+
+@final
+class ProximityBatch:
+    """What :func:`exact_proximity_many` returns: one :class:`Proximity` per pose."""
+
+    @property
+    def intersecting(self) -> npt.NDArray[np.bool_]:
+        """Whether the shapes intersect at each pose, bool ``(m,)``."""
+    @property
+    def distance(self) -> npt.NDArray[np.float64]:
+        """Distance between the shapes (0 where they intersect), ``(m,)``."""
+    @property
+    def penetration_depth(self) -> npt.NDArray[np.float64]:
+        """The penetration depth where the shapes intersect (NaN where unknown or apart), ``(m,)``."""
+    @property
+    def signed_distance(self) -> npt.NDArray[np.float64]:
+        """``distance``, or minus the depth where intersecting, ``(m,)``."""
+    def to_dict(self) -> dict[str, npt.NDArray[np.float64] | npt.NDArray[np.bool_]]:
+        """Return the four arrays as a dict (``tolist()`` them for JSON)."""
+    def __len__(self) -> int:
+        """Return the number of poses."""
+    def __getitem__(self, index: int, /) -> Proximity:
+        """Return the :class:`Proximity` at pose ``index`` (negative counts from the end)."""
 
 @final
 class CollisionRequest:

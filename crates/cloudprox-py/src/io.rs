@@ -5,19 +5,18 @@ use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use cloudprox::cloud::{pose_to_matrix, PointCloud};
+use cloudprox::cloud::PointCloud;
 use cloudprox::io::pointcloud2::{
     read_pointcloud2 as read_pc2, write_pointcloud2 as write_pc2, PointCloud2Layout, PointField,
 };
 use cloudprox::io::{self, CloudData, CloudFormat, Encoding, Grid, MeshFormat};
-use cloudprox::math::{Matrix3, Pose};
-use numpy::prelude::*;
+use cloudprox::math::Matrix3;
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
 use crate::cloud::{noise_from, PyPointCloud};
-use crate::convert::{matrices3_to_py, points_from, points_to_py, rows3_to_py};
+use crate::convert::{matrices3_to_py, points_from, points_to_py, pose_to_py, rows3_to_py};
 use crate::error::{invalid_input, run_detached};
 use crate::mesh::PyMesh;
 
@@ -309,7 +308,7 @@ impl PyCloudFile {
         self.data
             .sensor
             .as_ref()
-            .map(|p| pose_py(py, p))
+            .map(|p| pose_to_py(py, p))
             .transpose()
     }
 
@@ -373,7 +372,7 @@ impl PyCloudFile {
     ) -> PyResult<PyPointCloud> {
         let file_pose = if sensor.is_some() && origin.is_none() && sensor_pose.is_none() {
             match self.data.sensor.as_ref() {
-                Some(p) => Some(pose_py(py, p)?.into_any()),
+                Some(p) => Some(pose_to_py(py, p)?.into_any()),
                 None => {
                     return Err(invalid_input(
                         py,
@@ -431,14 +430,6 @@ impl PyCloudFile {
             self.data.fields
         )
     }
-}
-
-fn pose_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let m = pose_to_matrix(pose);
-    let flat: Vec<f64> = (0..4)
-        .flat_map(|r| (0..4).map(move |c| m[(r, c)]))
-        .collect();
-    PyArray1::from_vec(py, flat).reshape([4, 4])
 }
 
 /// Reads a point-cloud file (PLY, PCD, XYZ/CSV, NPY, LAS/LAZ; the format from the

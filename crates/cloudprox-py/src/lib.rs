@@ -56,6 +56,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::PyMesh>()?;
     m.add_class::<mesh::PyMeshSample>()?;
     m.add_class::<mesh::PyProximity>()?;
+    m.add_class::<mesh::PyProximityBatch>()?;
     m.add_class::<filter::PyVoxels>()?;
     m.add_class::<filter::PySelfFilter>()?;
     m.add_function(wrap_pyfunction!(filter::crop_box, m)?)?;

@@ -487,36 +487,107 @@ pub fn exact_proximity<'py>(
     Ok(PyProximity { inner })
 }
 
-/// [`exact_proximity`] for poses `(m, 4, 4)` of `a`, in parallel: a dict of arrays
-/// `intersecting` (bool), `distance`, `penetration_depth` (NaN if unknown) and
-/// `signed_distance`, each of shape `(m,)`.
+/// What ``exact_proximity_many`` returns: one ``Proximity`` per pose, read as
+/// arrays of shape ``(m,)`` (``batch.distance``) or one pose at a time
+/// (``batch[i]``).
+#[pyclass(name = "ProximityBatch", frozen, module = "cloudprox._native")]
+pub struct PyProximityBatch {
+    inner: Vec<ExactProximity>,
+}
+
+impl PyProximityBatch {
+    fn column<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&ExactProximity) -> f64,
+    ) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.iter().map(f).collect())
+    }
+}
+
+#[pymethods]
+impl PyProximityBatch {
+    /// Whether the shapes intersect at each pose, bool ``(m,)``.
+    #[getter]
+    fn intersecting<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        PyArray1::from_vec(py, self.inner.iter().map(|r| r.intersecting).collect())
+    }
+
+    /// Distance between the shapes (0 where they intersect), ``(m,)``.
+    #[getter]
+    fn distance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |r| r.distance)
+    }
+
+    /// The penetration depth where the shapes intersect (NaN where unknown or
+    /// apart), ``(m,)``.
+    #[getter]
+    fn penetration_depth<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |r| r.penetration_depth.unwrap_or(f64::NAN))
+    }
+
+    /// ``distance``, or minus the depth where intersecting, ``(m,)``.
+    #[getter]
+    fn signed_distance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, ExactProximity::signed_distance)
+    }
+
+    /// The four arrays as a dict (``tolist()`` them for JSON).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("intersecting", self.intersecting(py))?;
+        d.set_item("distance", self.distance(py))?;
+        d.set_item("penetration_depth", self.penetration_depth(py))?;
+        d.set_item("signed_distance", self.signed_distance(py))?;
+        Ok(d)
+    }
+
+    /// The number of poses.
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// The ``Proximity`` at pose ``index`` (negative counts from the end).
+    fn __getitem__(&self, index: isize) -> PyResult<PyProximity> {
+        let n = self.inner.len();
+        let i = if index < 0 {
+            n.checked_sub(index.unsigned_abs())
+        } else {
+            Some(index.unsigned_abs())
+        };
+        match i.and_then(|i| self.inner.get(i)) {
+            Some(&inner) => Ok(PyProximity { inner }),
+            None => Err(pyo3::exceptions::PyIndexError::new_err(format!(
+                "pose index {index} out of range for {n} poses"
+            ))),
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        let hits = self.inner.iter().filter(|r| r.intersecting).count();
+        format!(
+            "ProximityBatch(poses={}, intersecting={hits})",
+            self.inner.len()
+        )
+    }
+}
+
+/// [`exact_proximity`] for poses `(m, 4, 4)` of `a`, in parallel, as a
+/// `ProximityBatch`. The GIL is released during the queries.
 #[pyfunction]
 #[pyo3(name = "exact_proximity_many", signature = (a, b, poses_a, pose_b=None))]
-pub fn exact_proximity_many_py<'py>(
-    py: Python<'py>,
-    a: &Bound<'py, PyExactShape>,
-    b: &Bound<'py, PyExactShape>,
-    poses_a: &Bound<'py, PyAny>,
-    pose_b: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+pub fn exact_proximity_many_py(
+    py: Python<'_>,
+    a: &Bound<'_, PyExactShape>,
+    b: &Bound<'_, PyExactShape>,
+    poses_a: &Bound<'_, PyAny>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyProximityBatch> {
     let poses = poses_from(poses_a, "poses_a")?;
     let pb = pose_from(py, pose_b, "pose_b")?;
     let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
-    let rs = run_detached(py, move || Ok(exact_proximity_many(&poses, &sa, &pb, &sb)))?;
-    let d = PyDict::new(py);
-    let inter: Vec<bool> = rs.iter().map(|r| r.intersecting).collect();
-    d.set_item("intersecting", PyArray1::from_vec(py, inter))?;
-    let col = |f: &dyn Fn(&ExactProximity) -> f64| -> Vec<f64> { rs.iter().map(f).collect() };
-    d.set_item("distance", vec_to_py(py, &col(&|r| r.distance)))?;
-    d.set_item(
-        "penetration_depth",
-        vec_to_py(py, &col(&|r| r.penetration_depth.unwrap_or(f64::NAN))),
-    )?;
-    d.set_item(
-        "signed_distance",
-        vec_to_py(py, &col(&ExactProximity::signed_distance)),
-    )?;
-    Ok(d)
+    let inner = run_detached(py, move || Ok(exact_proximity_many(&poses, &sa, &pb, &sb)))?;
+    Ok(PyProximityBatch { inner })
 }
 
 /// Whether `a` at each of the poses `(m, 4, 4)` intersects `b`, in parallel: a

@@ -3,8 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use cloudprox::cloud::{pose_to_matrix, PointCloud};
-use cloudprox::math::Pose;
+use cloudprox::cloud::PointCloud;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
     collide_robot_many as core_collide_robot_many, LinkCollision, MotionRequest, Robot,
@@ -15,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
 use crate::cloud::PyPointCloud;
-use crate::convert::{check_shape, pose_from, to_f64_array, vec_to_py};
+use crate::convert::{check_shape, pose_from, pose_to_py, to_f64_array, vec_to_py};
 use crate::error::{invalid_input, run_detached, CoreResultExt};
 use crate::filter::PySelfFilter;
 use crate::mesh::PyMesh;
@@ -101,14 +100,6 @@ fn cloud_from(obj: &Bound<'_, PyAny>) -> PyResult<Arc<PointCloud>> {
     Err(pyo3::exceptions::PyTypeError::new_err(format!(
         "cloud must be a PointCloud, got {ty}; wrap arrays in PointCloud(points, sigma=...)"
     )))
-}
-
-fn matrix_to_py<'py>(py: Python<'py>, pose: &Pose) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let m = pose_to_matrix(pose);
-    let rows: Vec<Vec<f64>> = (0..4)
-        .map(|i| (0..4).map(|j| m[(i, j)]).collect())
-        .collect();
-    Ok(PyArray2::from_vec2(py, &rows)?)
 }
 
 /// A robot loaded from a URDF file: links, joints, limits and collision
@@ -292,7 +283,7 @@ impl PyRobot {
         let poses = self.inner.link_poses(&q, &base).or_py(py)?;
         let d = PyDict::new(py);
         for (name, pose) in self.inner.link_names().into_iter().zip(&poses) {
-            d.set_item(name, matrix_to_py(py, pose)?)?;
+            d.set_item(name, pose_to_py(py, pose)?)?;
         }
         Ok(d)
     }

@@ -179,8 +179,8 @@ def reconstruct_answer(
         shapes = draw._cache["meshes"]  # type: ignore[assignment]
     piano, room = shapes
     r = exact_proximity_many(piano, room, poses)
-    hit = np.asarray(r["intersecting"], dtype=bool)
-    scores = np.where(hit, 1.0, -np.asarray(r["distance"], dtype=float))
+    hit = np.asarray(r.intersecting, dtype=bool)
+    scores = np.where(hit, 1.0, -np.asarray(r.distance, dtype=float))
     timed = []
     for pose in poses[:: max(1, len(poses) // TIMED_QUERIES)][:TIMED_QUERIES]:
         t0 = time.perf_counter()

@@ -67,7 +67,7 @@ def _translated(poses: FloatArray, dirs: FloatArray, t: FloatArray) -> FloatArra
 
 def _signed(piano: SceneObject, room: SceneObject, poses: FloatArray) -> FloatArray:
     r = exact_proximity_many(piano.exact, room.exact, poses)
-    return np.asarray(r["signed_distance"], dtype=float)
+    return np.asarray(r.signed_distance, dtype=float)
 
 
 def draw_target_units(
@@ -199,7 +199,7 @@ def sample_poses(
     r = exact_proximity_many(piano.exact, room.exact, poses)
     return QueryPoses(
         poses=poses,
-        signed_distance=np.asarray(r["signed_distance"], dtype=float),
-        intersecting=np.asarray(r["intersecting"], dtype=bool),
+        signed_distance=np.asarray(r.signed_distance, dtype=float),
+        intersecting=np.asarray(r.intersecting, dtype=bool),
         far=far,
     )

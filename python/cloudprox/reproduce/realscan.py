@@ -217,7 +217,7 @@ def sample_scan_poses(
 
         def gap(t: FloatArray, idx: npt.NDArray[np.intp]) -> FloatArray:
             r = exact_proximity_many(bound, reference, at(t, idx))
-            return np.where(np.asarray(r["intersecting"]), -1.0, np.asarray(r["distance"]))
+            return np.where(np.asarray(r.intersecting), -1.0, np.asarray(r.distance))
 
         def hits(t: FloatArray, idx: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
             return np.asarray(exact_intersects_many(gripper, reference, at(t, idx)))
@@ -259,10 +259,10 @@ def sample_scan_poses(
         tg = target[ok]
         final = at(np.where(tg < 0.0, b_ - tg, a_ - tg), ok)
         r = exact_proximity_many(gripper, reference, final)
-        apart = ~np.asarray(r["intersecting"])
+        apart = ~np.asarray(r.intersecting)
         # Past contact the gripper must still cross the surface; backed off, clear.
         keep = np.where(tg < 0.0, ~apart, apart)
-        signed_ok = np.where(tg < 0.0, tg, np.asarray(r["distance"]))
+        signed_ok = np.where(tg < 0.0, tg, np.asarray(r.distance))
         placed = ok[keep]
         poses[pending[placed]] = final[keep]
         signed[pending[placed]] = signed_ok[keep]
