@@ -228,6 +228,9 @@ def test_robot_queries_take_a_request(tmp_path: Path) -> None:
     assert isinstance(stats, cp.RobotStats) and stats.links_with_geometry > 0
     assert json.loads(json.dumps(stats.to_dict())) == stats.to_dict()
     assert stats.time_seconds > 0.0
+    again = pickle.loads(pickle.dumps(stats))
+    assert again == stats and again.to_dict() == stats.to_dict()
+    assert repr(stats).startswith("RobotStats(links_with_geometry=")
 
 
 def test_query_stats_are_typed(spheres) -> None:
@@ -241,3 +244,5 @@ def test_query_stats_are_typed(spheres) -> None:
     assert json.loads(json.dumps(d)) == d
     assert all(d[name] == getattr(stats, name) for name in d)
     assert repr(stats).startswith("QueryStats(near_regions=")
+    again = pickle.loads(pickle.dumps(stats))
+    assert again == stats and again.to_dict() == d

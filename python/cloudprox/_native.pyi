@@ -1521,6 +1521,9 @@ class RobotStats:
     def to_dict(self) -> dict[str, int | float]:
         """Return the statistics as a dict of ``int`` and ``float``, ready for JSON."""
     def __eq__(self, value: object, /) -> bool: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    @staticmethod
+    def _from_state(state: tuple[int, ...]) -> RobotStats: ...
 
 @final
 class RobotBatchResult:

@@ -4,6 +4,7 @@
 //!
 //! | file | what |
 //! |---|---|
+//! | `macros.rs` | `stats_class!`: a statistics class from one list of its counters |
 //! | `error.rs` | exception hierarchy, core error and panic mapping |
 //! | `convert.rs` | numpy <-> nalgebra conversion and shape checks |
 //! | `cloud.rs` | `PointCloud` |
@@ -26,6 +27,8 @@
 
 use pyo3::prelude::*;
 
+#[macro_use]
+mod macros;
 mod cloud;
 mod collide;
 mod convert;

@@ -1,4 +1,5 @@
-//! `CollisionResult` and `ContactRegion`: the answer of a query, as plain data.
+//! `CollisionResult`, `ContactRegion` and `QueryStats`: the answer of a query,
+//! as plain data.
 
 use std::sync::Arc;
 
@@ -6,7 +7,7 @@ use cloudprox::classify::{Separator, SolveStatus, Surface};
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
 use cloudprox::math::{Point3, Vector3};
-use cloudprox::query::{CollisionResult, ContactRegion, QueryStats};
+use cloudprox::query::{CollisionResult, ContactRegion, QueryCounters, QueryStats};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -20,7 +21,7 @@ use crate::error::guard;
 type Evaluation<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// `x` with about 6 significant digits, like Python's `%.6g`.
-fn fmt_g(x: f64) -> String {
+pub(crate) fn fmt_g(x: f64) -> String {
     let a = x.abs();
     if x == 0.0 || !x.is_finite() {
         format!("{x}")
@@ -66,22 +67,6 @@ type RegionState = (
     SeparatorState,
     String,
     u32,
-);
-
-/// The pickled form of query statistics (the fields of `QueryStats`, in order).
-type StatsState = (
-    usize,
-    usize,
-    usize,
-    usize,
-    usize,
-    usize,
-    usize,
-    u64,
-    usize,
-    usize,
-    f64,
-    f64,
 );
 
 /// The pickled form of a `CollisionResult` (without the clouds it was computed on).
@@ -171,218 +156,38 @@ fn region_from_state(py: Python<'_>, s: RegionState) -> PyResult<ContactRegion> 
     })
 }
 
-/// The pickled form of query statistics, field by field (without `..`: a new
-/// core field must be added here).
-fn stats_to_state(s: &QueryStats) -> StatsState {
-    let QueryStats {
-        node_pairs_visited,
-        leaf_pairs,
-        near_regions,
-        patches,
-        misfit_cuts,
-        patches_beyond_reach,
-        points_classified,
-        solver_iterations,
-        barrier_fallbacks,
-        solver_fallbacks,
-        pruned_bound,
-        time_seconds,
-    } = s.clone();
-    (
-        node_pairs_visited,
-        leaf_pairs,
-        near_regions,
-        patches,
-        misfit_cuts,
-        patches_beyond_reach,
-        points_classified,
-        solver_iterations,
-        barrier_fallbacks,
-        solver_fallbacks,
-        pruned_bound,
-        time_seconds,
-    )
-}
-
-/// Query statistics from their pickled form.
-fn stats_from_state(s: StatsState) -> QueryStats {
-    let (
-        node_pairs_visited,
-        leaf_pairs,
-        near_regions,
-        patches,
-        misfit_cuts,
-        patches_beyond_reach,
-        points_classified,
-        solver_iterations,
-        barrier_fallbacks,
-        solver_fallbacks,
-        pruned_bound,
-        time_seconds,
-    ) = s;
-    QueryStats {
-        node_pairs_visited,
-        leaf_pairs,
-        near_regions,
-        patches,
-        misfit_cuts,
-        patches_beyond_reach,
-        points_classified,
-        solver_iterations,
-        barrier_fallbacks,
-        solver_fallbacks,
-        pruned_bound,
-        time_seconds,
-    }
-}
-
-/// Counters and timings of one ``collide`` query (``CollisionResult.stats``).
-#[pyclass(name = "QueryStats", frozen, module = "cloudprox._native")]
-pub struct PyQueryStats {
-    inner: QueryStats,
-}
-
-#[pymethods]
-impl PyQueryStats {
-    /// Node pairs of the two hierarchies tested during the traversal.
-    #[getter]
-    fn node_pairs_visited(&self) -> usize {
-        self.inner.node_pairs_visited
-    }
-
-    /// Leaf pairs kept (not pruned).
-    #[getter]
-    fn leaf_pairs(&self) -> usize {
-        self.inner.leaf_pairs
-    }
-
-    /// Connected near regions.
-    #[getter]
-    fn near_regions(&self) -> usize {
-        self.inner.near_regions
-    }
-
-    /// Patches classified (``len(result.regions)``).
-    #[getter]
-    fn patches(&self) -> usize {
-        self.inner.patches
-    }
-
-    /// Patches cut in two because their surface put a point beyond the noise's
-    /// reach of the other cloud on the wrong side.
-    #[getter]
-    fn misfit_cuts(&self) -> usize {
-        self.inner.misfit_cuts
-    }
-
-    /// Patches of the elements model pruned without a classifier (no element
-    /// faces the other side within the noise's reach).
-    #[getter]
-    fn patches_beyond_reach(&self) -> usize {
-        self.inner.patches_beyond_reach
-    }
-
-    /// Points of both clouds that went into a classifier.
-    #[getter]
-    fn points_classified(&self) -> usize {
-        self.inner.points_classified
-    }
-
-    /// Interior-point iterations over all patches.
-    #[getter]
-    fn solver_iterations(&self) -> u64 {
-        self.inner.solver_iterations
-    }
-
-    /// Patches where the barrier method did not converge and Clarabel was used.
-    #[getter]
-    fn barrier_fallbacks(&self) -> usize {
-        self.inner.barrier_fallbacks
-    }
-
-    /// Patches whose solve fell back to the mean-difference plane
-    /// (``ContactRegion.status == "fallback"``).
-    #[getter]
-    fn solver_fallbacks(&self) -> usize {
-        self.inner.solver_fallbacks
-    }
-
-    /// Upper bound on the probability that any pruned point is on the wrong
-    /// side (pruned points get ``p_i = 0``); below ``prune_epsilon`` per pair.
-    #[getter]
-    fn pruned_bound(&self) -> f64 {
-        self.inner.pruned_bound
-    }
-
-    /// Wall time of the query, in seconds.
-    #[getter]
-    fn time_seconds(&self) -> f64 {
-        self.inner.time_seconds
-    }
-
-    /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (
-            node_pairs_visited,
-            leaf_pairs,
-            near_regions,
-            patches,
-            misfit_cuts,
-            patches_beyond_reach,
-            points_classified,
-            solver_iterations,
-            barrier_fallbacks,
-            solver_fallbacks,
-            pruned_bound,
-            time_seconds,
-        ) = stats_to_state(&self.inner);
-        let d = PyDict::new(py);
-        d.set_item("node_pairs_visited", node_pairs_visited)?;
-        d.set_item("leaf_pairs", leaf_pairs)?;
-        d.set_item("near_regions", near_regions)?;
-        d.set_item("patches", patches)?;
-        d.set_item("misfit_cuts", misfit_cuts)?;
-        d.set_item("patches_beyond_reach", patches_beyond_reach)?;
-        d.set_item("points_classified", points_classified)?;
-        d.set_item("solver_iterations", solver_iterations)?;
-        d.set_item("barrier_fallbacks", barrier_fallbacks)?;
-        d.set_item("solver_fallbacks", solver_fallbacks)?;
-        d.set_item("pruned_bound", pruned_bound)?;
-        d.set_item("time_seconds", time_seconds)?;
-        Ok(d)
-    }
-
-    fn __eq__(&self, other: &Self) -> bool {
-        self.inner == other.inner
-    }
-
-    /// Pickle support: every counter.
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (StatsState,))> {
-        Ok((
-            slf.getattr("_from_state")?,
-            (stats_to_state(&slf.get().inner),),
-        ))
-    }
-
-    /// Rebuilds pickled statistics (see `__reduce__`).
-    #[staticmethod]
-    fn _from_state(state: StatsState) -> Self {
-        Self {
-            inner: stats_from_state(state),
-        }
-    }
-
-    fn __repr__(&self) -> String {
-        let s = &self.inner;
-        format!(
-            "QueryStats(near_regions={}, patches={}, points_classified={}, \
-             solver_iterations={}, time_seconds={})",
-            s.near_regions,
-            s.patches,
-            s.points_classified,
-            s.solver_iterations,
-            fmt_g(s.time_seconds)
-        )
+stats_class! {
+    /// Counters and timings of one ``collide`` query (``CollisionResult.stats``).
+    "QueryStats": PyQueryStats(QueryStats { counters: QueryCounters }),
+    state: StatsState,
+    repr: [near_regions, patches, points_classified, solver_iterations],
+    counters: {
+        /// Node pairs of the two hierarchies tested during the traversal.
+        node_pairs_visited: usize,
+        /// Leaf pairs kept (not pruned).
+        leaf_pairs: usize,
+        /// Connected near regions.
+        near_regions: usize,
+        /// Patches classified (``len(result.regions)``).
+        patches: usize,
+        /// Patches cut in two because their surface put a point beyond the noise's
+        /// reach of the other cloud on the wrong side.
+        misfit_cuts: usize,
+        /// Patches of the elements model pruned without a classifier (no element
+        /// faces the other side within the noise's reach).
+        patches_beyond_reach: usize,
+        /// Points of both clouds that went into a classifier.
+        points_classified: usize,
+        /// Interior-point iterations over all patches.
+        solver_iterations: u64,
+        /// Patches where the barrier method did not converge and Clarabel was used.
+        barrier_fallbacks: usize,
+        /// Patches whose solve fell back to the mean-difference plane
+        /// (``ContactRegion.status == "fallback"``).
+        solver_fallbacks: usize,
+        /// Upper bound on the probability that any pruned point is on the wrong
+        /// side (pruned points get ``p_i = 0``); below ``prune_epsilon`` per pair.
+        pruned_bound: f64,
     }
 }
 
@@ -648,7 +453,7 @@ impl PyCollisionResult {
             me.probabilities_a.clone(),
             me.probabilities_b.clone(),
             regions,
-            stats_to_state(&me.stats),
+            PyQueryStats::state_of(&me.stats),
         );
         Ok((slf.getattr("_from_state")?, (state,)))
     }
@@ -667,7 +472,7 @@ impl PyCollisionResult {
             probabilities_a,
             probabilities_b,
             regions,
-            stats: stats_from_state(stats),
+            stats: PyQueryStats::from_state(stats),
             sides: None,
         })
     }
@@ -681,9 +486,7 @@ impl PyCollisionResult {
     /// Counters and timings of the query (a new `QueryStats` each time).
     #[getter]
     fn stats(&self) -> PyQueryStats {
-        PyQueryStats {
-            inner: self.stats.clone(),
-        }
+        PyQueryStats::wrap(self.stats.clone())
     }
 
     fn __repr__(&self) -> String {

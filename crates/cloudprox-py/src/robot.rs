@@ -7,7 +7,7 @@ use cloudprox::cloud::PointCloud;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
     collide_robot_many as core_collide_robot_many, LinkCollision, MotionRequest, Robot,
-    RobotCollisionResult, RobotStats,
+    RobotCollisionResult, RobotCounters, RobotStats,
 };
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -423,92 +423,27 @@ impl PyLinkCollision {
     }
 }
 
-/// Counters and timings of one ``collide_robot`` query
-/// (``RobotCollisionResult.stats``).
-#[pyclass(name = "RobotStats", frozen, module = "cloudprox._native")]
-pub struct PyRobotStats {
-    inner: RobotStats,
-}
-
-#[pymethods]
-impl PyRobotStats {
-    /// Links with geometry.
-    #[getter]
-    fn links_with_geometry(&self) -> usize {
-        self.inner.links_with_geometry
-    }
-
-    /// Links queried against the cloud (the others were skipped by the broad
-    /// phase, or left once the query was decided).
-    #[getter]
-    fn links_queried(&self) -> usize {
-        self.inner.links_queried
-    }
-
-    /// Links left unqueried because an earlier link's probability had reached
-    /// the collision threshold (``decide_only`` only).
-    #[getter]
-    fn links_after_decision(&self) -> usize {
-        self.inner.links_after_decision
-    }
-
-    /// Hierarchy nodes of the cloud visited by the broad phase.
-    #[getter]
-    fn broad_phase_nodes(&self) -> usize {
-        self.inner.broad_phase_nodes
-    }
-
-    /// Link pairs tested for self-collision.
-    #[getter]
-    fn self_pairs_checked(&self) -> usize {
-        self.inner.self_pairs_checked
-    }
-
-    /// Node pairs visited by the per-link queries, summed.
-    #[getter]
-    fn node_pairs_visited(&self) -> usize {
-        self.inner.node_pairs_visited
-    }
-
-    /// Wall time of the query, in seconds.
-    #[getter]
-    fn time_seconds(&self) -> f64 {
-        self.inner.time_seconds
-    }
-
-    /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        // Destructured without `..`: a new core field must be added here.
-        let RobotStats {
-            links_with_geometry,
-            links_queried,
-            links_after_decision,
-            broad_phase_nodes,
-            self_pairs_checked,
-            node_pairs_visited,
-            time_seconds,
-        } = &self.inner;
-        let d = PyDict::new(py);
-        d.set_item("links_with_geometry", links_with_geometry)?;
-        d.set_item("links_queried", links_queried)?;
-        d.set_item("links_after_decision", links_after_decision)?;
-        d.set_item("broad_phase_nodes", broad_phase_nodes)?;
-        d.set_item("self_pairs_checked", self_pairs_checked)?;
-        d.set_item("node_pairs_visited", node_pairs_visited)?;
-        d.set_item("time_seconds", time_seconds)?;
-        Ok(d)
-    }
-
-    fn __eq__(&self, other: &Self) -> bool {
-        self.inner == other.inner
-    }
-
-    fn __repr__(&self) -> String {
-        let s = &self.inner;
-        format!(
-            "RobotStats(links_with_geometry={}, links_queried={}, time_seconds={})",
-            s.links_with_geometry, s.links_queried, s.time_seconds
-        )
+stats_class! {
+    /// Counters and timings of one ``collide_robot`` query
+    /// (``RobotCollisionResult.stats``).
+    "RobotStats": PyRobotStats(RobotStats { counters: RobotCounters }),
+    state: RobotStatsState,
+    repr: [links_with_geometry, links_queried],
+    counters: {
+        /// Links with geometry.
+        links_with_geometry: usize,
+        /// Links queried against the cloud (the others were skipped by the broad
+        /// phase, or left once the query was decided).
+        links_queried: usize,
+        /// Links left unqueried because an earlier link's probability had reached
+        /// the collision threshold (``decide_only`` only).
+        links_after_decision: usize,
+        /// Hierarchy nodes of the cloud visited by the broad phase.
+        broad_phase_nodes: usize,
+        /// Link pairs tested for self-collision.
+        self_pairs_checked: usize,
+        /// Node pairs visited by the per-link queries, summed.
+        node_pairs_visited: usize,
     }
 }
 
@@ -609,9 +544,7 @@ impl PyRobotCollisionResult {
     /// Counters and timings (a new `RobotStats` each time).
     #[getter]
     fn stats(&self) -> PyRobotStats {
-        PyRobotStats {
-            inner: self.stats.clone(),
-        }
+        PyRobotStats::wrap(self.stats.clone())
     }
 
     fn __repr__(&self) -> String {

@@ -73,15 +73,15 @@ fn main() {
             "{k:>6.1} {:>10.4} {:>10} {:>8} {:>8} {:>9.2}   sep {:+.4} it {}",
             res.probability,
             res.state.name(),
-            res.stats.patches,
-            res.stats.points_classified,
+            res.stats.counters.patches,
+            res.stats.counters.points_classified,
             res.stats.time_seconds * 1e3,
             res.regions
                 .iter()
                 .map(|r| r.separation)
                 .fold(f64::INFINITY, f64::min)
                 / sigma,
-            res.stats.solver_iterations
+            res.stats.counters.solver_iterations
         );
     }
     // Plates: a 20 cm x 20 cm x 2 cm slab under a 10 cm x 10 cm x 2 cm slab.
@@ -109,8 +109,8 @@ fn main() {
             "{k:>6.1} {:>10.4} {:>10} {:>8} {:>8} {:>9.2}",
             res.probability,
             res.state.name(),
-            res.stats.patches,
-            res.stats.points_classified,
+            res.stats.counters.patches,
+            res.stats.counters.points_classified,
             res.stats.time_seconds * 1e3
         );
     }

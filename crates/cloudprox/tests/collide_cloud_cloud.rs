@@ -104,7 +104,7 @@ fn states_follow_thresholds() {
     assert_eq!(far.state, CollisionState::Free);
     assert_eq!(far.probability, 0.0);
     assert!(far.regions.is_empty(), "{:?}", far.stats);
-    assert!(far.stats.pruned_bound < 1e-2, "{:?}", far.stats);
+    assert!(far.stats.counters.pruned_bound < 1e-2, "{:?}", far.stats);
 }
 
 #[test]
@@ -121,7 +121,7 @@ fn expressing_the_clouds_in_another_frame_changes_nothing() {
         let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
         let r1 = collide_moved_data(&a, &b, &t, &pb, &req);
         assert_eq!(
-            r0.stats.points_classified, r1.stats.points_classified,
+            r0.stats.counters.points_classified, r1.stats.counters.points_classified,
             "gap {gap}"
         );
         assert!(

@@ -233,7 +233,7 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
         assert!((p - r.probabilities_b[i as usize]).abs() < 1e-9);
     }
     // The region holds tens of samples, not thousands of points.
-    assert!(r.stats.points_classified < 400, "{:?}", r.stats);
+    assert!(r.stats.counters.points_classified < 400, "{:?}", r.stats);
     let _ = normal_cdf(0.0);
 }
 
@@ -269,11 +269,11 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
     for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
         let pose = sphere_pose(gap * SIGMA);
         let r = collide(&Pose::identity(), &a, &pose, &b, &elements()).unwrap();
-        if r.stats.points_classified > 0 {
+        if r.stats.counters.points_classified > 0 {
             continue;
         }
         let p = collide(&Pose::identity(), &a, &pose, &b, &points).unwrap();
-        if p.stats.points_classified == 0 {
+        if p.stats.counters.points_classified == 0 {
             continue;
         }
         pruned += 1;
@@ -288,7 +288,11 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
     }
     assert!(pruned >= 1, "no gap between 3 and 7 sigma was pruned");
     let near = collide(&Pose::identity(), &a, &sphere_pose(SIGMA), &b, &elements()).unwrap();
-    assert_eq!(near.stats.patches_beyond_reach, 0, "{:?}", near.stats);
+    assert_eq!(
+        near.stats.counters.patches_beyond_reach, 0,
+        "{:?}",
+        near.stats
+    );
     assert!(!near.regions.is_empty());
 }
 
@@ -363,7 +367,7 @@ proptest! {
         let h = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose_b, &b, &brute).unwrap();
         let (ph, pb) = (h.probability, bf.probability);
-        if h.stats.near_regions == 0 {
+        if h.stats.counters.near_regions == 0 {
             prop_assert_eq!(ph, 0.0);
             prop_assert!(pb < 1e-9, "hulls apart at gap {} sigma, brute force P = {}", gap, pb);
         }

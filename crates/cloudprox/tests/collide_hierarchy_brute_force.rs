@@ -84,9 +84,9 @@ proptest! {
         let h = collide(&Pose::identity(), &a, &pose_b, &b, &req(true, surface, model)).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose_b, &b, &req(false, surface, model)).unwrap();
         let (ph, pb) = (h.probability, bf.probability);
-        let classified = |r: &CollisionResult| r.stats.points_classified;
+        let classified = |r: &CollisionResult| r.stats.counters.points_classified;
         prop_assert_eq!(classified(&h), classified(&bf), "the same near points");
-        if h.stats.near_regions <= 1 {
+        if h.stats.counters.near_regions <= 1 {
             // Same points, listed in another order: equal up to the solver's tolerance.
             prop_assert!((ph - pb).abs() < 1e-6, "one region: hierarchy {ph} vs brute force {pb}");
         }

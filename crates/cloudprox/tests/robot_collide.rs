@@ -71,10 +71,10 @@ fn a_robot_far_from_the_cloud_costs_no_link_query() {
     .unwrap();
     assert_eq!(r.probability, 0.0);
     assert_eq!(r.state, CollisionState::Free);
-    assert_eq!(r.stats.links_with_geometry, 6);
-    assert_eq!(r.stats.links_queried, 0);
+    assert_eq!(r.stats.counters.links_with_geometry, 6);
+    assert_eq!(r.stats.counters.links_queried, 0);
     // The broad phase stops at the root of the cloud's hierarchy.
-    assert_eq!(r.stats.broad_phase_nodes, 6);
+    assert_eq!(r.stats.counters.broad_phase_nodes, 6);
 }
 
 #[test]
@@ -100,8 +100,8 @@ fn broad_phase_changes_the_cost_not_the_answer() {
         ] {
             let a = collide_robot(&robot, &q, &Pose::identity(), &cloud, &with).unwrap();
             let b = collide_robot(&robot, &q, &Pose::identity(), &cloud, &without).unwrap();
-            assert_eq!(b.stats.links_queried, 6);
-            skipped += 6 - a.stats.links_queried;
+            assert_eq!(b.stats.counters.links_queried, 6);
+            skipped += 6 - a.stats.counters.links_queried;
             assert_eq!(a.probability, b.probability, "{model:?} {q:?}");
             for (x, y) in a.links.iter().zip(&b.links) {
                 assert_eq!(
@@ -471,8 +471,8 @@ fn a_decide_only_query_leaves_the_links_after_one_that_collides() {
     assert!(after
         .iter()
         .all(|l| l.probability.is_nan() && !l.queried && l.result.is_none()));
-    assert_eq!(fast.stats.links_after_decision, after.len());
-    assert_eq!(full.stats.links_after_decision, 0);
+    assert_eq!(fast.stats.counters.links_after_decision, after.len());
+    assert_eq!(full.stats.counters.links_after_decision, 0);
     // The full query did query some of them (they are within reach).
     assert!(full.links.iter().any(|l| l.link > 2 && l.queried));
     // Links before the decision read as in the full query.
@@ -489,6 +489,6 @@ fn a_decide_only_query_leaves_the_links_after_one_that_collides() {
     // A free configuration is answered in full.
     let away = [1.5, 0.0, 0.0, 0.0];
     let f = collide_robot(&robot, &away, &Pose::identity(), &cloud, &req).unwrap();
-    assert_eq!(f.stats.links_after_decision, 0);
+    assert_eq!(f.stats.counters.links_after_decision, 0);
     assert!(f.links.iter().all(|l| !l.probability.is_nan()));
 }

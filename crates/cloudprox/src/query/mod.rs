@@ -10,5 +10,5 @@ pub mod exact;
 
 pub use collide::{
     collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
-    CollisionResult, ContactRegion, MeshSampling, QueryModel, QueryStats,
+    CollisionResult, ContactRegion, MeshSampling, QueryCounters, QueryModel, QueryStats,
 };

@@ -27,6 +27,6 @@ pub use geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS, LIN
 pub use model::{Joint, JointKind, Link, Mimic, Robot};
 pub use motion::{check_motion, MotionRequest, MotionResult};
 pub use query::{
-    collide_robot, collide_robot_many, LinkCollision, RobotCollisionResult, RobotRequest,
-    RobotStats, SelfCollision,
+    collide_robot, collide_robot_many, LinkCollision, RobotCollisionResult, RobotCounters,
+    RobotRequest, RobotStats, SelfCollision,
 };

@@ -93,10 +93,10 @@ pub struct SelfCollision {
     pub link_b: usize,
 }
 
-/// Counters and timings of one robot query. Equality compares the counters,
-/// not the wall time.
-#[derive(Debug, Clone, Default)]
-pub struct RobotStats {
+/// The counters of one robot query: everything in [`RobotStats`] but the
+/// wall time, so that two runs of one query compare equal.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct RobotCounters {
     /// Links with geometry.
     pub links_with_geometry: usize,
     /// Links queried against the cloud (the others were skipped by the broad
@@ -111,37 +111,21 @@ pub struct RobotStats {
     pub self_pairs_checked: usize,
     /// Node pairs visited by the per-link queries, summed.
     pub node_pairs_visited: usize,
+}
+
+/// Counters and timings of one robot query. Equality compares the counters,
+/// not the wall time.
+#[derive(Debug, Clone, Default)]
+pub struct RobotStats {
+    /// The counters.
+    pub counters: RobotCounters,
     /// Wall time (seconds).
     pub time_seconds: Real,
 }
 
 impl PartialEq for RobotStats {
     fn eq(&self, o: &Self) -> bool {
-        // Every field named, so that a new one is not left out by accident.
-        let Self {
-            links_with_geometry,
-            links_queried,
-            links_after_decision,
-            broad_phase_nodes,
-            self_pairs_checked,
-            node_pairs_visited,
-            time_seconds: _,
-        } = self;
-        (
-            links_with_geometry,
-            links_queried,
-            links_after_decision,
-            broad_phase_nodes,
-            self_pairs_checked,
-            node_pairs_visited,
-        ) == (
-            &o.links_with_geometry,
-            &o.links_queried,
-            &o.links_after_decision,
-            &o.broad_phase_nodes,
-            &o.self_pairs_checked,
-            &o.node_pairs_visited,
-        )
+        self.counters == o.counters
     }
 }
 
@@ -286,9 +270,9 @@ pub(crate) fn collide_robot_prepared(
         let Some(link_cloud) = link_cloud else {
             continue;
         };
-        stats.links_with_geometry += 1;
+        stats.counters.links_with_geometry += 1;
         if decided {
-            stats.links_after_decision += 1;
+            stats.counters.links_after_decision += 1;
             links.push(after_decision(l));
             continue;
         }
@@ -304,7 +288,7 @@ pub(crate) fn collide_robot_prepared(
                         k,
                         &mut ws.bvh,
                     );
-                    stats.broad_phase_nodes += visited;
+                    stats.counters.broad_phase_nodes += visited;
                     may
                 }
                 QueryModel::Points => {
@@ -318,7 +302,7 @@ pub(crate) fn collide_robot_prepared(
                         samples.spacing_max[l],
                         cloud,
                         k,
-                        &mut stats.broad_phase_nodes,
+                        &mut stats.counters.broad_phase_nodes,
                         &mut ws.stack,
                     )
                 }
@@ -333,7 +317,7 @@ pub(crate) fn collide_robot_prepared(
             });
             continue;
         }
-        stats.links_queried += 1;
+        stats.counters.links_queried += 1;
         // The request was validated by the caller; a query error cannot occur.
         match collide_with_workspace(
             &poses[l],
@@ -344,7 +328,7 @@ pub(crate) fn collide_robot_prepared(
             &mut ws.bvh,
         ) {
             Ok(r) => {
-                stats.node_pairs_visited += r.stats.node_pairs_visited;
+                stats.counters.node_pairs_visited += r.stats.counters.node_pairs_visited;
                 decided = request.collide.decide_only
                     && r.probability >= request.collide.thresholds.collision;
                 links.push(LinkCollision {
@@ -371,7 +355,7 @@ pub(crate) fn collide_robot_prepared(
         .collect();
     let probability = aggregate(request.collide.aggregation, &p);
     let self_collisions = if request.self_collision {
-        stats.self_pairs_checked = robot.self_pairs.len();
+        stats.counters.self_pairs_checked = robot.self_pairs.len();
         self_collisions(robot, &poses)
     } else {
         Vec::new()

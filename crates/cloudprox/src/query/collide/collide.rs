@@ -97,7 +97,7 @@ pub(crate) fn collide_with_workspace(
     let beyond_reach = match elements {
         Some((ea, eb)) if request.use_hierarchy => {
             let (may, visited) = element_surfaces_may_reach(ea, &rel, eb, reach, workspace);
-            stats.node_pairs_visited += visited;
+            stats.counters.node_pairs_visited += visited;
             !may
         }
         _ => false,
@@ -108,7 +108,7 @@ pub(crate) fn collide_with_workspace(
         near_set(&rel, sa, sb, request, workspace, &mut stats)
     };
     let core = &near.core;
-    stats.near_regions = near.regions.len();
+    stats.counters.near_regions = near.regions.len();
 
     let mut probabilities_a = vec![0.0; a.len()];
     let mut probabilities_b = vec![0.0; b.len()];
@@ -154,7 +154,7 @@ pub(crate) fn collide_with_workspace(
                 .filter(|&(ea, eb)| has_surface_element(ea, &ia) || has_surface_element(eb, &ib));
             if let Some((ea, eb)) = surfaces {
                 if !element_sides_within_reach(ea, &ia, &rel, eb, &ib, reach) {
-                    stats.patches_beyond_reach += 1;
+                    stats.counters.patches_beyond_reach += 1;
                     continue;
                 }
             }
@@ -182,7 +182,7 @@ pub(crate) fn collide_with_workspace(
                     .then(|| cut(&patch, &pa, &pb))
                     .flatten();
                 if let Some((l, r)) = halves {
-                    stats.misfit_cuts += 1;
+                    stats.counters.misfit_cuts += 1;
                     todo.push(r);
                     todo.push(l);
                     return true;
@@ -243,13 +243,13 @@ pub(crate) fn collide_with_workspace(
                 core_values(indexed(&ia, &qa), &core.0)
                     .chain(core_values(indexed(&ib, &qb), &core.1)),
             );
-            stats.points_classified += pts.len();
-            stats.solver_iterations += u64::from(fit.classification.iterations);
-            stats.barrier_fallbacks += usize::from(
+            stats.counters.points_classified += pts.len();
+            stats.counters.solver_iterations += u64::from(fit.classification.iterations);
+            stats.counters.barrier_fallbacks += usize::from(
                 request.classify.solver == SocpSolver::Barrier
                     && fit.classification.solver != SocpSolver::Barrier,
             );
-            stats.solver_fallbacks +=
+            stats.counters.solver_fallbacks +=
                 usize::from(fit.classification.status == SolveStatus::Fallback);
             // The patch's points: the samples themselves, or the points of the
             // elements they stand for; each with its Eq. 3 probability against
@@ -296,7 +296,7 @@ pub(crate) fn collide_with_workspace(
             }
         }
     }
-    stats.patches = regions.len();
+    stats.counters.patches = regions.len();
     let probability = request.aggregation.aggregate(
         core_values(inputs_a.iter().copied().enumerate(), &core.0)
             .chain(core_values(inputs_b.iter().copied().enumerate(), &core.1)),

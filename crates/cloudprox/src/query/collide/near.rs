@@ -63,9 +63,9 @@ pub(crate) fn near_set(
                 .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
             keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx);
         }
-        stats.node_pairs_visited += t.node_pairs_visited;
-        stats.leaf_pairs = t.leaf_pairs.len();
-        stats.pruned_bound = t.pruned_bound;
+        stats.counters.node_pairs_visited += t.node_pairs_visited;
+        stats.counters.leaf_pairs = t.leaf_pairs.len();
+        stats.counters.pruned_bound = t.pruned_bound;
         if !any_near {
             t.leaf_pairs.clear();
         }

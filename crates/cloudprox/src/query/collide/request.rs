@@ -43,7 +43,7 @@ pub struct CollisionRequest {
     pub thresholds: Thresholds,
     /// A node pair is pruned when its crossing bound is below this (default 1e-3).
     /// The sum of the bounds of what was pruned is reported in
-    /// [`crate::query::QueryStats::pruned_bound`].
+    /// [`crate::query::QueryCounters::pruned_bound`].
     pub prune_epsilon: Real,
     /// Context kept around the near region, in sampling spacings (each point's
     /// distance to its 6th nearest neighbour) (default 2, at least 0.5). A pair
@@ -55,7 +55,7 @@ pub struct CollisionRequest {
     /// Near regions with more points than this are split into patches along the
     /// contact, each with its own surface (default 2000): a bound on the cost of
     /// one solve. Smaller patches are also cut where one surface misfits (see
-    /// [`QueryStats::misfit_cuts`](crate::query::QueryStats::misfit_cuts)).
+    /// [`QueryCounters::misfit_cuts`](crate::query::QueryCounters::misfit_cuts)).
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into

@@ -38,10 +38,10 @@ pub struct ContactRegion {
     pub iterations: u32,
 }
 
-/// Counters and timings of one query. Equality compares the counters, not
-/// the wall time (two runs of one query differ in it).
-#[derive(Debug, Clone, Default)]
-pub struct QueryStats {
+/// The counters of one query: everything in [`QueryStats`] but the wall
+/// time, so that two runs of one query compare equal.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct QueryCounters {
     /// Node pairs tested during the traversal.
     pub node_pairs_visited: usize,
     /// Leaf pairs kept (not pruned).
@@ -70,52 +70,21 @@ pub struct QueryStats {
     /// of a plane separating its node from the other cloud's (see
     /// [`crate::bvh::prune_bound`]); pruned points get `p_i = 0`.
     pub pruned_bound: Real,
+}
+
+/// Counters and timings of one query. Equality compares the counters, not
+/// the wall time (two runs of one query differ in it).
+#[derive(Debug, Clone, Default)]
+pub struct QueryStats {
+    /// The counters.
+    pub counters: QueryCounters,
     /// Wall time of the query (seconds).
     pub time_seconds: Real,
 }
 
 impl PartialEq for QueryStats {
     fn eq(&self, o: &Self) -> bool {
-        // Every field named, so that a new one is not left out by accident.
-        let Self {
-            node_pairs_visited,
-            leaf_pairs,
-            near_regions,
-            patches,
-            misfit_cuts,
-            patches_beyond_reach,
-            points_classified,
-            solver_iterations,
-            barrier_fallbacks,
-            solver_fallbacks,
-            pruned_bound,
-            time_seconds: _,
-        } = self;
-        (
-            node_pairs_visited,
-            leaf_pairs,
-            near_regions,
-            patches,
-            misfit_cuts,
-            patches_beyond_reach,
-            points_classified,
-            solver_iterations,
-            barrier_fallbacks,
-            solver_fallbacks,
-            pruned_bound,
-        ) == (
-            &o.node_pairs_visited,
-            &o.leaf_pairs,
-            &o.near_regions,
-            &o.patches,
-            &o.misfit_cuts,
-            &o.patches_beyond_reach,
-            &o.points_classified,
-            &o.solver_iterations,
-            &o.barrier_fallbacks,
-            &o.solver_fallbacks,
-            &o.pruned_bound,
-        )
+        self.counters == o.counters
     }
 }
 

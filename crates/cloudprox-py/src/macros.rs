@@ -1,0 +1,107 @@
+//! Macros that write a Python class from one list of its fields.
+
+/// A frozen Python class over a core statistics struct `$core` made of
+/// `counters: $counters` and `time_seconds`. The one list of counters given
+/// here makes the getters, `to_dict` (the counters, then `time_seconds`),
+/// pickling (a tuple of the same, in that order) and `__repr__` (the fields
+/// named after `repr:`, then `time_seconds`); equality is the core's, which
+/// compares the counters. The counters are destructured without `..`, so a
+/// counter added in the core must be added to the list.
+macro_rules! stats_class {
+    (
+        $(#[doc = $doc:literal])*
+        $py_name:literal: $class:ident($core:ident { counters: $counters:ident }),
+        state: $state:ident,
+        repr: [$($repr:ident),+],
+        counters: {
+            $( $(#[doc = $field_doc:literal])* $field:ident: $ty:ty, )+
+        }
+    ) => {
+        /// The pickled form of the statistics: the counters in order, then the
+        /// wall time.
+        type $state = ($($ty,)+ f64);
+
+        $(#[doc = $doc])*
+        #[pyclass(name = $py_name, frozen, module = "cloudprox._native")]
+        pub struct $class {
+            inner: $core,
+        }
+
+        impl $class {
+            /// Wraps core statistics.
+            pub(crate) fn wrap(inner: $core) -> Self {
+                Self { inner }
+            }
+
+            /// The pickled form of `s`.
+            pub(crate) fn state_of(s: &$core) -> $state {
+                let $counters { $($field),+ } = &s.counters;
+                ($(*$field,)+ s.time_seconds)
+            }
+
+            /// Statistics from their pickled form.
+            pub(crate) fn from_state(state: $state) -> $core {
+                let ($($field,)+ time_seconds) = state;
+                $core {
+                    counters: $counters { $($field),+ },
+                    time_seconds,
+                }
+            }
+        }
+
+        #[pymethods]
+        impl $class {
+            $(
+                $(#[doc = $field_doc])*
+                #[getter]
+                fn $field(&self) -> $ty {
+                    self.inner.counters.$field
+                }
+            )+
+
+            /// Wall time of the query, in seconds.
+            #[getter]
+            fn time_seconds(&self) -> f64 {
+                self.inner.time_seconds
+            }
+
+            /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
+            fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+                let ($($field,)+ time_seconds) = Self::state_of(&self.inner);
+                let d = PyDict::new(py);
+                $( d.set_item(stringify!($field), $field)?; )+
+                d.set_item("time_seconds", time_seconds)?;
+                Ok(d)
+            }
+
+            fn __eq__(&self, other: &Self) -> bool {
+                self.inner == other.inner
+            }
+
+            /// Pickle support: every counter and the wall time.
+            fn __reduce__<'py>(
+                slf: &Bound<'py, Self>,
+            ) -> PyResult<(Bound<'py, PyAny>, ($state,))> {
+                Ok((
+                    slf.getattr("_from_state")?,
+                    (Self::state_of(&slf.get().inner),),
+                ))
+            }
+
+            /// Rebuilds pickled statistics (see `__reduce__`).
+            #[staticmethod]
+            fn _from_state(state: $state) -> Self {
+                Self::wrap(Self::from_state(state))
+            }
+
+            fn __repr__(&self) -> String {
+                let c = &self.inner.counters;
+                format!(
+                    concat!($py_name, "(", $(stringify!($repr), "={}, ",)+ "time_seconds={})"),
+                    $(c.$repr,)+
+                    $crate::result::fmt_g(self.inner.time_seconds)
+                )
+            }
+        }
+    };
+}
