@@ -30,7 +30,7 @@ def spheres(sphere_points: tuple[np.ndarray, np.ndarray]) -> tuple[cp.PointCloud
 
 
 #: Modules whose every test reads real files from the cache.
-NETWORK_MODULES = {"test_io_real", "test_reproduce_data"}
+NETWORK_MODULES = {"test_io_real", "test_datasets"}
 #: Fixtures that fetch real files (the Panda URDF and its meshes).
 NETWORK_FIXTURES = {"panda", "readme_folder"}
 #: Tests that fetch real files themselves.

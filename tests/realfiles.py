@@ -2,7 +2,7 @@
 
 None of these files is stored in the repository. Each one is carried by a pinned
 package of a registry that CI reaches (crates.io, PyPI, Debian): the package is
-downloaded into the cache (:func:`cloudprox.reproduce.data.cache_dir`, i.e.
+downloaded into the cache (:func:`cloudprox.datasets.cache_dir`, i.e.
 ``$CLOUDPROX_CACHE`` or ``~/.cache/cloudprox``) on first use, its SHA-256 is
 checked, the one file is extracted, and the SHA-256 of the file is checked too.
 
@@ -11,11 +11,11 @@ checked, the one file is extracted, and the SHA-256 of the file is checked too.
 * PyPI: ``<cache>/pypi/<file>``, fetched with ``python -m pip download --no-deps``
   (an sdist when the files are only in the sdist: pip then prepares its metadata,
   which installs the package's build backend from PyPI in an isolated
-  environment); the folder is the one :mod:`cloudprox.reproduce.data` keeps the
+  environment); the folder is the one :mod:`cloudprox.datasets` keeps the
   Panda wheel in, so that wheel is downloaded once for both;
 * Debian: ``<cache>/deb/<file>``, fetched with ``apt-get download NAME=VERSION``
   (needs the apt lists: ``apt-get update``), read with the ``.deb`` reader of
-  :mod:`cloudprox.reproduce.data`.
+  :mod:`cloudprox.datasets`.
 
 Extracted files go to ``<cache>/realfiles/<registry>/<name>-<version>/<member>``.
 
@@ -91,7 +91,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from cloudprox.reproduce.data import _extract_from_deb, _write_atomically, cache_dir
+from cloudprox.datasets import cache_dir, extract_from_deb, write_atomically
 
 __all__ = [
     "EXPECTED",
@@ -894,7 +894,7 @@ def _read_member(package: Package, archive: Path, member: str) -> bytes:
     name = package.root + member
     try:
         if package.archive.endswith(".deb"):
-            return _extract_from_deb(archive, name)
+            return extract_from_deb(archive, name)
         if package.archive.endswith(".whl"):
             with zipfile.ZipFile(archive) as wheel:
                 return wheel.read(name)
@@ -952,7 +952,7 @@ def real_file(name: str) -> Path:
             f"{package.archive}!{spec.member}: SHA-256 {digest} ({len(content)} bytes), "
             f"expected {spec.sha256} ({spec.size} bytes)"
         )
-    _write_atomically(dest, content)
+    write_atomically(dest, content)
     return dest
 
 

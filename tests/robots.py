@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cloudprox.datasets import cache_dir, write_atomically
 from cloudprox.pose import from_rpy, from_translation
-from cloudprox.reproduce.data import _write_atomically, cache_dir
 from tests.realfiles import Package, RealFileMismatch, RealFileUnavailable, fetch_archive
 
 GYM_IGNITION_MODELS = Package(
@@ -109,7 +109,7 @@ def panda_urdf() -> Path:
                     f"{wheel}!panda/{rel}: SHA-256 {digest} ({len(content)} bytes), "
                     f"expected {sha} ({size} bytes)"
                 )
-            _write_atomically(root / rel, content)
+            write_atomically(root / rel, content)
     return root / "panda.urdf"
 
 

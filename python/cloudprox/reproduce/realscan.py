@@ -1,6 +1,6 @@
 """The paper's Kinect experiment on a real depth frame: a robot gripper near a scanned shelf.
 
-Data (fetched into the cache by :mod:`cloudprox.reproduce.data`, never committed):
+Data (fetched into the cache by :mod:`cloudprox.datasets`, never committed):
 the one real Kinect v1 frame that Debian's ``mrpt-common`` ships (273,225 points of
 a bookshelf with objects in front of a wall, 1.6 m to 2.6 m away) and the Franka
 Emika Panda hand with its two fingers (``dm-robotics-panda`` on PyPI), opened 4 cm
@@ -57,14 +57,14 @@ from cloudprox._native import (
     exact_intersects_many,
     exact_proximity_many,
 )
-from cloudprox.pose import random_rotations
-from cloudprox.reproduce import methods as m
-from cloudprox.reproduce.data import (
+from cloudprox.datasets import (
     DepthFrame,
     load_kinect_frame,
     panda_gripper,
     panda_gripper_parts,
 )
+from cloudprox.pose import random_rotations
+from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.metrics import Metrics, compute_metrics
 from cloudprox.reproduce.poses import draw_target_units
 from cloudprox.reproduce.reconstruct import available as reconstruction_available

@@ -1,8 +1,19 @@
-"""Real data of the Kinect experiment: one depth frame and the Franka Panda gripper.
+"""Real data fetched from package registries: a Kinect depth frame, the Panda gripper.
 
-Nothing here is stored in the repository. Both files come from package
-registries and are kept in a local cache (:func:`cache_dir`: ``$CLOUDPROX_CACHE``,
-else ``~/.cache/cloudprox``), fetched on first use.
+Shared by the reproduction (:mod:`cloudprox.reproduce`), the tests and the
+benchmarks. Nothing here is stored in the repository: the files come from
+package registries and are kept in a local cache (:func:`cache_dir`:
+``$CLOUDPROX_CACHE``, else ``~/.cache/cloudprox``), fetched on first use.
+
+Public API:
+
+- :func:`cache_dir`: the cache folder; :func:`write_atomically` puts a file in it.
+- :func:`extract_from_deb`: one file of a Debian package (``ar`` archive holding
+  a ``data.tar``, plain or compressed with xz, gzip or Zstandard), read in Python.
+- :func:`fetch_kinect_rawlog`, :func:`kinect_rawlog_path`,
+  :func:`load_kinect_frame` and :class:`DepthFrame`: the Kinect v1 frame below.
+- :func:`fetch_panda_wheel`, :func:`load_obj`, :func:`panda_gripper_parts`,
+  :func:`panda_gripper` and the ``PANDA_*`` constants: the gripper below.
 
 Depth frame
     ``tests_rgbd.rawlog`` of the Debian package ``mrpt-common`` (MRPT, the Mobile
@@ -73,6 +84,7 @@ __all__ = [
     "DegenerateFacesWarning",
     "DepthFrame",
     "cache_dir",
+    "extract_from_deb",
     "fetch_kinect_rawlog",
     "fetch_panda_wheel",
     "kinect_rawlog_path",
@@ -80,6 +92,7 @@ __all__ = [
     "load_obj",
     "panda_gripper",
     "panda_gripper_parts",
+    "write_atomically",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -224,7 +237,7 @@ def _tar_name(name: str) -> str:
     return name[2:] if name.startswith("./") else name.lstrip("/")
 
 
-def _extract_from_deb(deb: Path, member: str) -> bytes:
+def extract_from_deb(deb: Path, member: str) -> bytes:
     """Contents of the regular file ``member`` (e.g. ``usr/share/...``) of the package ``deb``."""
     tar_bytes = _data_tar(deb)
     wanted = _tar_name(member)
@@ -246,7 +259,12 @@ def _extract_from_deb(deb: Path, member: str) -> bytes:
     raise ValueError(f"{deb}: the package has no file {member}")
 
 
-def _write_atomically(path: Path, content: bytes) -> None:
+def write_atomically(path: Path, content: bytes) -> None:
+    """Write ``content`` to ``path`` (parents created) through a temporary file.
+
+    The temporary file is in the same folder and replaces ``path`` at once, so
+    that a reader never sees a partial file.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     try:
@@ -291,10 +309,10 @@ def fetch_kinect_rawlog() -> Path:
                 f"found {[deb.name for deb in debs]}"
             )
         try:
-            content = _extract_from_deb(debs[0], _MRPT_DEB_MEMBER)
+            content = extract_from_deb(debs[0], _MRPT_DEB_MEMBER)
         except ValueError as exc:
             raise ValueError(f"{what}: {exc}; {_MRPT_HOWTO}") from exc
-    _write_atomically(dest, content)
+    write_atomically(dest, content)
     return dest
 
 

@@ -1,4 +1,4 @@
-"""Real data of the Kinect experiment: MRPT frame, Panda gripper, fetching.
+"""cloudprox.datasets: the MRPT Kinect frame, the Panda gripper, fetching, .deb reading.
 
 The Kinect frame and the gripper wheel are fetched into the cache
 (``$CLOUDPROX_CACHE`` or ``~/.cache/cloudprox``) on the first run.
@@ -21,22 +21,22 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from cloudprox.reproduce import data
+from cloudprox import datasets
 
 # ------------------------------------------------------------------------- cache
 
 
 def test_cache_dir_from_env(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CLOUDPROX_CACHE", str(tmp_path / "c" / "d"))
-    assert data.cache_dir() == tmp_path / "c" / "d"
+    assert datasets.cache_dir() == tmp_path / "c" / "d"
     assert (tmp_path / "c" / "d").is_dir()
 
 
 def test_cache_dir_default(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("CLOUDPROX_CACHE", raising=False)
     monkeypatch.setenv("HOME", str(tmp_path))
-    assert data.cache_dir() == tmp_path / ".cache" / "cloudprox"
-    assert data.cache_dir().is_dir()
+    assert datasets.cache_dir() == tmp_path / ".cache" / "cloudprox"
+    assert datasets.cache_dir().is_dir()
 
 
 # ------------------------------------------------------------------ Kinect frame
@@ -45,17 +45,17 @@ N_KINECT_POINTS = 273_225
 
 
 @pytest.fixture(scope="module")
-def frame() -> data.DepthFrame:
-    return data.load_kinect_frame()
+def frame() -> datasets.DepthFrame:
+    return datasets.load_kinect_frame()
 
 
 @pytest.fixture(scope="module")
 def raw_archive() -> bytes:
     """The uncompressed MRPT archive of the frame."""
-    return gzip.decompress(data.kinect_rawlog_path().read_bytes())
+    return gzip.decompress(datasets.kinect_rawlog_path().read_bytes())
 
 
-def test_kinect_frame_points(frame: data.DepthFrame) -> None:
+def test_kinect_frame_points(frame: datasets.DepthFrame) -> None:
     assert frame.points.shape == (N_KINECT_POINTS, 3)
     assert frame.points.dtype == np.float64
     assert np.all(np.isfinite(frame.points))
@@ -67,7 +67,7 @@ def test_kinect_frame_points(frame: data.DepthFrame) -> None:
     assert not frame.points.flags.writeable
 
 
-def test_kinect_intrinsics_reproject_pixels(frame: data.DepthFrame) -> None:
+def test_kinect_intrinsics_reproject_pixels(frame: datasets.DepthFrame) -> None:
     # agree with the depth camera calibration stored in the file
     np.testing.assert_allclose(
         [frame.fx, frame.fy, frame.cx, frame.cy], [572.883, 542.740, 314.649, 240.160], atol=1e-3
@@ -81,7 +81,7 @@ def test_kinect_intrinsics_reproject_pixels(frame: data.DepthFrame) -> None:
     np.testing.assert_allclose(frame.project(p), frame.pixels, atol=0.01)
 
 
-def test_kinect_depth_image_matches_points(frame: data.DepthFrame) -> None:
+def test_kinect_depth_image_matches_points(frame: datasets.DepthFrame) -> None:
     assert frame.depth.shape == (480, 640)
     assert frame.rgb.shape == (480, 640, 3)
     assert frame.rgb.dtype == np.uint8
@@ -93,12 +93,12 @@ def test_kinect_depth_image_matches_points(frame: data.DepthFrame) -> None:
     assert frame.depth.min() == 0.0
 
 
-def test_kinect_fetch_into_cache(frame: data.DepthFrame) -> None:
-    path = data.fetch_kinect_rawlog()  # apt-get download mrpt-common, once
-    assert path == data.cache_dir() / "mrpt" / "tests_rgbd.rawlog"
+def test_kinect_fetch_into_cache(frame: datasets.DepthFrame) -> None:
+    path = datasets.fetch_kinect_rawlog()  # apt-get download mrpt-common, once
+    assert path == datasets.cache_dir() / "mrpt" / "tests_rgbd.rawlog"
     if Path(frame.source) != path:
         assert path.read_bytes() == Path(frame.source).read_bytes()
-    assert data.load_kinect_frame(path).points.shape == (N_KINECT_POINTS, 3)
+    assert datasets.load_kinect_frame(path).points.shape == (N_KINECT_POINTS, 3)
 
 
 def _points_offset(raw: bytes) -> tuple[int, int]:
@@ -115,15 +115,15 @@ def _corrupt(raw: bytes, at: int, new: bytes) -> bytes:
 def test_kinect_uncompressed_archive_loads(tmp_path: Path, raw_archive: bytes) -> None:
     path = tmp_path / "plain.rawlog"
     path.write_bytes(raw_archive)
-    assert data.load_kinect_frame(path).points.shape == (N_KINECT_POINTS, 3)
+    assert datasets.load_kinect_frame(path).points.shape == (N_KINECT_POINTS, 3)
 
 
 def test_kinect_truncated_gzip(tmp_path: Path) -> None:
-    blob = data.kinect_rawlog_path().read_bytes()
+    blob = datasets.kinect_rawlog_path().read_bytes()
     path = tmp_path / "cut.rawlog"
     path.write_bytes(blob[: len(blob) // 2])
     with pytest.raises(ValueError, match=re.escape(str(path)) + ".*corrupt or truncated gzip"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 @pytest.mark.parametrize(
@@ -147,7 +147,7 @@ def test_kinect_truncated_archive(
         gzip.compress(raw_archive[: cut.get(where, len(raw_archive) - 2)], compresslevel=1)
     )
     with pytest.raises(ValueError, match=re.escape(str(path)) + ": " + problem):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_wrong_class(tmp_path: Path, raw_archive: bytes) -> None:
@@ -158,14 +158,14 @@ def test_kinect_wrong_class(tmp_path: Path, raw_archive: bytes) -> None:
         match=r"expected an object of class mrpt::obs::CObservation3DRangeScan, "
         r"found 'mrpt::obs::CObservation2DRangeScan'",
     ):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_not_an_archive(tmp_path: Path) -> None:
     path = tmp_path / "text.rawlog"
     path.write_bytes(b"hello world\n")
     with pytest.raises(ValueError, match=r"expected an object of class .*, found 'byte 0x68'"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_wrong_version(tmp_path: Path, raw_archive: bytes) -> None:
@@ -174,7 +174,7 @@ def test_kinect_wrong_version(tmp_path: Path, raw_archive: bytes) -> None:
     path = tmp_path / "v7.rawlog"
     path.write_bytes(_corrupt(raw_archive, version_at, b"\x07"))
     with pytest.raises(ValueError, match=r"unsupported serialization version 7 of mrpt::obs::CObs"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_bad_flag_and_end_marker(tmp_path: Path, raw_archive: bytes) -> None:
@@ -182,10 +182,10 @@ def test_kinect_bad_flag_and_end_marker(tmp_path: Path, raw_archive: bytes) -> N
     path = tmp_path / "flag.rawlog"
     path.write_bytes(_corrupt(raw_archive, at - 5, b"\x07"))
     with pytest.raises(ValueError, match=r"has-points flag should be a boolean"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
     path.write_bytes(_corrupt(raw_archive, len(raw_archive) - 1, b"\x00"))
     with pytest.raises(ValueError, match=r"missing end-of-object marker"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_points_must_match_depth_and_pinhole(tmp_path: Path, raw_archive: bytes) -> None:
@@ -195,15 +195,15 @@ def test_kinect_points_must_match_depth_and_pinhole(tmp_path: Path, raw_archive:
     path = tmp_path / "moved.rawlog"
     path.write_bytes(_corrupt(raw_archive, at, struct.pack("<f", x0 + 0.01)))
     with pytest.raises(ValueError, match=r"points differ from the depth image by up to 0.01 m"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
     path.write_bytes(_corrupt(raw_archive, at + 4 * n, struct.pack("<f", y0 + 0.01)))
     with pytest.raises(ValueError, match=r"not a pinhole projection"):
-        data.load_kinect_frame(path)
+        datasets.load_kinect_frame(path)
 
 
 def test_kinect_missing_file(tmp_path: Path) -> None:
     with pytest.raises(RuntimeError, match=r"missing\.rawlog: cannot read.*apt-get install"):
-        data.load_kinect_frame(tmp_path / "missing.rawlog")
+        datasets.load_kinect_frame(tmp_path / "missing.rawlog")
 
 
 # --------------------------------------------------------------- .deb extraction
@@ -247,7 +247,7 @@ def _deb(path: Path, payload: bytes, compression: str) -> Path:
 @pytest.mark.parametrize("compression", ["xz", "gz", ""])
 def test_extract_from_deb(tmp_path: Path, compression: str) -> None:
     deb = _deb(tmp_path / "p.deb", b"odd-length payload", compression)
-    assert data._extract_from_deb(deb, MEMBER) == b"odd-length payload"
+    assert datasets.extract_from_deb(deb, MEMBER) == b"odd-length payload"
 
 
 @pytest.mark.skipif(
@@ -256,34 +256,34 @@ def test_extract_from_deb(tmp_path: Path, compression: str) -> None:
 )
 def test_extract_from_deb_zstd_via_dpkg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     deb = _deb(tmp_path / "p.deb", b"payload", "")
-    members = data._ar_members(deb, deb.read_bytes())
+    members = datasets._ar_members(deb, deb.read_bytes())
     zst = subprocess.run(
         ["zstd", "-q", "-c"], input=members.pop("data.tar"), capture_output=True, check=True
     ).stdout
     deb.write_bytes(_ar({**members, "data.tar.zst": zst}))
-    monkeypatch.setattr(data, "_zstd_decompressor", lambda: None)  # force dpkg-deb
-    assert data._extract_from_deb(deb, MEMBER) == b"payload"
+    monkeypatch.setattr(datasets, "_zstd_decompressor", lambda: None)  # force dpkg-deb
+    assert datasets.extract_from_deb(deb, MEMBER) == b"payload"
 
 
 def test_extract_from_deb_errors(tmp_path: Path) -> None:
     bad = tmp_path / "bad.deb"
     bad.write_bytes(b"PK\x03\x04 not a deb")
     with pytest.raises(ValueError, match=r"bad\.deb: not a Debian package"):
-        data._extract_from_deb(bad, MEMBER)
+        datasets.extract_from_deb(bad, MEMBER)
     deb = _deb(tmp_path / "p.deb", b"payload", "xz")
     with pytest.raises(ValueError, match=r"p\.deb: the package has no file usr/share/other"):
-        data._extract_from_deb(deb, "usr/share/other")
+        datasets.extract_from_deb(deb, "usr/share/other")
     cut = tmp_path / "cut.deb"
     cut.write_bytes(deb.read_bytes()[:-40])
     with pytest.raises(ValueError, match=r"cut\.deb: ar member 'data\.tar\.xz' is truncated"):
-        data._extract_from_deb(cut, MEMBER)
+        datasets.extract_from_deb(cut, MEMBER)
 
 
 def test_fetch_without_apt_get(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CLOUDPROX_CACHE", str(tmp_path))
-    monkeypatch.setattr(data.shutil, "which", lambda _name: None)
+    monkeypatch.setattr(datasets.shutil, "which", lambda _name: None)
     with pytest.raises(RuntimeError, match=r"apt-get is not available"):
-        data.fetch_kinect_rawlog()
+        datasets.fetch_kinect_rawlog()
 
 
 def test_fetch_failing_apt_get(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -291,11 +291,11 @@ def test_fetch_failing_apt_get(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     fake.write_text("#!/bin/sh\necho 'E: Unable to locate package mrpt-common' >&2\nexit 100\n")
     fake.chmod(0o755)
     monkeypatch.setenv("CLOUDPROX_CACHE", str(tmp_path / "cache"))
-    monkeypatch.setattr(data.shutil, "which", lambda _name: str(fake))
+    monkeypatch.setattr(datasets.shutil, "which", lambda _name: str(fake))
     with pytest.raises(
         RuntimeError, match=r"(?s)exit status 100.*Unable to locate.*apt-get update"
     ):
-        data.fetch_kinect_rawlog()
+        datasets.fetch_kinect_rawlog()
     assert not (tmp_path / "cache" / "mrpt" / "tests_rgbd.rawlog").exists()
 
 
@@ -304,7 +304,7 @@ def test_fetch_failing_apt_get(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
 
 @pytest.fixture(scope="module")
 def open_parts() -> list[cp.Mesh]:
-    return data.panda_gripper_parts(0.04)
+    return datasets.panda_gripper_parts(0.04)
 
 
 def _finger_gap(parts: list[cp.Mesh]) -> float:
@@ -328,18 +328,18 @@ def test_gripper_parts(open_parts: list[cp.Mesh]) -> None:
 
 
 def test_gripper_extents(open_parts: list[cp.Mesh]) -> None:
-    gripper = data.panda_gripper()
+    gripper = datasets.panda_gripper()
     assert len(gripper.faces) == 7078 + 2 * 624
     lo, hi = gripper.bounds()
     np.testing.assert_allclose(hi - lo, [0.0630, 0.2045, 0.1382], atol=5e-4)
     # palm behind the flange plane, finger tips just beyond the tool centre point
-    assert lo[2] < 0 < data.PANDA_FINGER_MOUNT < data.PANDA_TCP_OFFSET < hi[2] < 0.12
+    assert lo[2] < 0 < datasets.PANDA_FINGER_MOUNT < datasets.PANDA_TCP_OFFSET < hi[2] < 0.12
     np.testing.assert_allclose(gripper.bounds()[1][2], open_parts[2].bounds()[1][2])
 
 
 def test_gripper_opening_moves_fingers(open_parts: list[cp.Mesh]) -> None:
-    closed = data.panda_gripper_parts(0.0)
-    half = data.panda_gripper_parts(0.01)
+    closed = datasets.panda_gripper_parts(0.0)
+    half = datasets.panda_gripper_parts(0.01)
     gap0 = _finger_gap(closed)
     assert abs(gap0) < 1e-3  # closed fingers touch (the mesh overlaps by 0.17 mm)
     assert _finger_gap(half) - gap0 == pytest.approx(0.02, abs=1e-9)
@@ -350,15 +350,15 @@ def test_gripper_opening_moves_fingers(open_parts: list[cp.Mesh]) -> None:
 @pytest.mark.parametrize("opening", [-0.001, 0.0401, float("nan"), float("inf")])
 def test_gripper_bad_opening(opening: float) -> None:
     with pytest.raises(ValueError, match=r"opening must be in \[0, 0.04\] m"):
-        data.panda_gripper(opening)
+        datasets.panda_gripper(opening)
 
 
 def test_panda_wheel_cached_and_checked(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    wheel = data.fetch_panda_wheel()
-    assert wheel.parent == data.cache_dir() / "pypi"
+    wheel = datasets.fetch_panda_wheel()
+    assert wheel.parent == datasets.cache_dir() / "pypi"
     fake = tmp_path / "pypi" / wheel.name
     fake.parent.mkdir()
     fake.write_bytes(b"tampered")
     monkeypatch.setenv("CLOUDPROX_CACHE", str(tmp_path))
     with pytest.raises(RuntimeError, match=r"SHA-256 .* differs from the published"):
-        data.fetch_panda_wheel()
+        datasets.fetch_panda_wheel()
