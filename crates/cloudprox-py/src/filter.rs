@@ -55,63 +55,18 @@ pub fn crop_box<'py>(
     Ok(indices_to_py(py, &keep))
 }
 
-/// What ``voxel_downsample`` returns: one point per occupied voxel, with the
-/// merged covariances and the member counts. Unpacks as
-/// ``points, covariances, counts = voxel_downsample(...)``.
-#[pyclass(name = "Voxels", frozen, module = "cloudprox._native")]
-pub struct PyVoxels {
-    points: Py<PyArray2<f64>>,
-    covariances: Option<Py<PyArray3<f64>>>,
-    counts: Py<PyArray1<i64>>,
-}
-
-impl PyVoxels {
-    fn as_tuple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        let items = [
-            self.points.clone_ref(py).into_any(),
-            self.covariances
-                .as_ref()
-                .map_or_else(|| py.None(), |c| c.clone_ref(py).into_any()),
-            self.counts.clone_ref(py).into_any(),
-        ];
-        PyTuple::new(py, items)
-    }
-}
-
-#[pymethods]
-impl PyVoxels {
-    /// The centroid of each voxel's members, shape ``(m, 3)``.
-    #[getter]
-    fn points(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
-        self.points.clone_ref(py)
-    }
-
-    /// The merged covariance of each voxel, shape ``(m, 3, 3)``; ``None`` when
-    /// no covariances were given.
-    #[getter]
-    fn covariances(&self, py: Python<'_>) -> Option<Py<PyArray3<f64>>> {
-        self.covariances.as_ref().map(|c| c.clone_ref(py))
-    }
-
-    /// The number of input points in each voxel, shape ``(m,)``, int64.
-    #[getter]
-    fn counts(&self, py: Python<'_>) -> Py<PyArray1<i64>> {
-        self.counts.clone_ref(py)
-    }
-
-    /// ``points``, ``covariances``, ``counts``, in that order (for unpacking).
-    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
-        self.as_tuple(py)?.try_iter()
-    }
-
-    /// ``(points, covariances, counts)[index]``.
-    fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyAny>> {
-        self.as_tuple(py)?.as_any().get_item(index)
-    }
-
-    #[allow(clippy::unused_self)]
-    fn __len__(&self) -> usize {
-        3
+tuple_class! {
+    /// What ``voxel_downsample`` returns: one point per occupied voxel, with the
+    /// merged covariances and the member counts. Unpacks as
+    /// ``points, covariances, counts = voxel_downsample(...)``.
+    "Voxels": PyVoxels {
+        /// The centroid of each voxel's members, shape ``(m, 3)``.
+        points: Py<PyArray2<f64>>,
+        /// The merged covariance of each voxel, shape ``(m, 3, 3)``; ``None`` when
+        /// no covariances were given.
+        covariances: Option<Py<PyArray3<f64>>>,
+        /// The number of input points in each voxel, shape ``(m,)``, int64.
+        counts: Py<PyArray1<i64>>,
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {

@@ -4,7 +4,7 @@
 //!
 //! | file | what |
 //! |---|---|
-//! | `macros.rs` | `stats_class!`: a statistics class from one list of its counters |
+//! | `macros.rs` | `stats_class!` (a statistics class from one list of its counters), `tuple_class!` (a class that unpacks as the tuple of its fields) |
 //! | `error.rs` | exception hierarchy, core error and panic mapping |
 //! | `convert.rs` | numpy <-> nalgebra conversion and shape checks |
 //! | `cloud.rs` | `PointCloud` |

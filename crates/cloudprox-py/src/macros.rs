@@ -105,3 +105,64 @@ macro_rules! stats_class {
         }
     };
 }
+
+/// A frozen Python class of a few named values that also unpacks as their
+/// tuple: the struct `$class` of `$field: $ty`, a getter per field, and
+/// `__iter__`, `__getitem__` and `__len__` over `(field, ...)` in the order
+/// given. `$ty` is a `Py<...>` or an `Option<Py<...>>` (`None` in Python).
+/// The methods after the fields (`__repr__`, ...) join the class's
+/// `#[pymethods]`.
+macro_rules! tuple_class {
+    (
+        $(#[doc = $doc:literal])*
+        $py_name:literal: $class:ident {
+            $( $(#[doc = $field_doc:literal])* $field:ident: $ty:ty, )+
+        }
+        $($methods:tt)*
+    ) => {
+        $(#[doc = $doc])*
+        #[pyclass(name = $py_name, frozen, module = "cloudprox._native")]
+        pub struct $class {
+            $( $field: $ty, )+
+        }
+
+        impl $class {
+            /// The fields as a tuple, in order.
+            fn as_tuple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+                ($(&self.$field,)+).into_pyobject(py)
+            }
+        }
+
+        #[pymethods]
+        impl $class {
+            $(
+                $(#[doc = $field_doc])*
+                #[getter]
+                fn $field<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                    pyo3::IntoPyObjectExt::into_bound_py_any(&self.$field, py)
+                }
+            )+
+
+            /// The fields in order (for unpacking).
+            fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
+                self.as_tuple(py)?.try_iter()
+            }
+
+            /// The field at `index` of the tuple of fields.
+            fn __getitem__<'py>(
+                &self,
+                py: Python<'py>,
+                index: isize,
+            ) -> PyResult<Bound<'py, PyAny>> {
+                self.as_tuple(py)?.as_any().get_item(index)
+            }
+
+            #[allow(clippy::unused_self)]
+            fn __len__(&self) -> usize {
+                [$(stringify!($field)),+].len()
+            }
+
+            $($methods)*
+        }
+    };
+}

@@ -19,59 +19,16 @@ use crate::convert::{
 };
 use crate::error::{invalid_input, run_detached};
 
-/// What ``Mesh.sample`` returns: the samples, their surface normals and the
-/// face each lies on. Unpacks as ``points, normals, faces = mesh.sample(...)``.
-#[pyclass(name = "MeshSample", frozen, module = "cloudprox._native")]
-pub struct PyMeshSample {
-    points: Py<PyArray2<f64>>,
-    normals: Py<PyArray2<f64>>,
-    faces: Py<PyArray1<i64>>,
-}
-
-impl PyMeshSample {
-    fn as_tuple<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        let items = [
-            self.points.clone_ref(py).into_any(),
-            self.normals.clone_ref(py).into_any(),
-            self.faces.clone_ref(py).into_any(),
-        ];
-        PyTuple::new(py, items)
-    }
-}
-
-#[pymethods]
-impl PyMeshSample {
-    /// The sampled points, shape ``(k, 3)``.
-    #[getter]
-    fn points(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
-        self.points.clone_ref(py)
-    }
-
-    /// The unit normal of the face under each point, shape ``(k, 3)``.
-    #[getter]
-    fn normals(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
-        self.normals.clone_ref(py)
-    }
-
-    /// The index of the face each point lies on, shape ``(k,)``, int64.
-    #[getter]
-    fn faces(&self, py: Python<'_>) -> Py<PyArray1<i64>> {
-        self.faces.clone_ref(py)
-    }
-
-    /// ``points``, ``normals``, ``faces``, in that order (for unpacking).
-    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyIterator>> {
-        self.as_tuple(py)?.try_iter()
-    }
-
-    /// ``(points, normals, faces)[index]``.
-    fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyAny>> {
-        self.as_tuple(py)?.as_any().get_item(index)
-    }
-
-    #[allow(clippy::unused_self)]
-    fn __len__(&self) -> usize {
-        3
+tuple_class! {
+    /// What ``Mesh.sample`` returns: the samples, their surface normals and the
+    /// face each lies on. Unpacks as ``points, normals, faces = mesh.sample(...)``.
+    "MeshSample": PyMeshSample {
+        /// The sampled points, shape ``(k, 3)``.
+        points: Py<PyArray2<f64>>,
+        /// The unit normal of the face under each point, shape ``(k, 3)``.
+        normals: Py<PyArray2<f64>>,
+        /// The index of the face each point lies on, shape ``(k,)``, int64.
+        faces: Py<PyArray1<i64>>,
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {
