@@ -113,7 +113,6 @@ pub struct PyRobot {
 /// What a robot was loaded from, to load it again after pickling: the URDF's
 /// text and name, the folder relative mesh paths are resolved against, and the
 /// `package://` folders. Mesh files are read again on unpickling.
-#[derive(Clone)]
 struct RobotSource {
     xml: String,
     name: String,
@@ -141,24 +140,13 @@ impl PyRobot {
         path: PathBuf,
         package_dirs: Option<Vec<PathBuf>>,
     ) -> PyResult<Self> {
-        let dirs = package_dirs.unwrap_or_default();
-        let d = dirs.clone();
-        let (robot, xml, path) = run_detached(py, move || {
-            let robot = Robot::from_urdf_file(&path, &d)?;
-            // Read again for pickling (the load above just read it).
-            let xml = std::fs::read_to_string(&path).unwrap_or_default();
-            Ok((robot, xml, path))
-        })?;
+        let name = path.display().to_string();
         let base_dir = path.parent().map(std::path::Path::to_path_buf);
-        Ok(Self {
-            inner: Arc::new(robot),
-            source: RobotSource {
-                xml,
-                name: path.display().to_string(),
-                base_dir,
-                package_dirs: dirs,
-            },
-        })
+        // Read once: the text is parsed and kept for pickling.
+        let xml = run_detached(py, move || {
+            std::fs::read_to_string(&path).map_err(|e| cloudprox::Error::io(&path, &e))
+        })?;
+        Self::_from_urdf_text(py, xml, name, base_dir, package_dirs)
     }
 
     /// Pickle support: the URDF text, its name, the folder relative mesh paths
@@ -200,9 +188,11 @@ impl PyRobot {
             base_dir,
             package_dirs: package_dirs.unwrap_or_default(),
         };
-        let s = source.clone();
-        let robot = run_detached(py, move || {
-            Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)
+        let (robot, source) = run_detached(py, move || {
+            let s = &source;
+            let robot =
+                Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)?;
+            Ok((robot, source))
         })?;
         Ok(Self {
             inner: Arc::new(robot),

@@ -53,7 +53,7 @@ impl Error {
     }
 
     /// An [`Error::Io`] for `path` from a `std::io::Error`.
-    pub(crate) fn io(path: &std::path::Path, err: &std::io::Error) -> Self {
+    pub fn io(path: &std::path::Path, err: &std::io::Error) -> Self {
         Error::Io {
             path: path.display().to_string(),
             kind: err.kind(),
