@@ -80,7 +80,6 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
-import subprocess
 import sys
 import tarfile
 import tempfile
@@ -91,7 +90,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from cloudprox.datasets import cache_dir, extract_from_deb, write_atomically
+from cloudprox.datasets import cache_dir, extract_from_deb, run_command, write_atomically
 
 __all__ = [
     "EXPECTED",
@@ -801,17 +800,7 @@ def _check_archive(package: Package, path: Path) -> None:
 def _run(cmd: list[str], cwd: Path, package: Package) -> None:
     """Run a registry client; raise RealFileUnavailable quoting its output if it fails."""
     what = f"cannot download {_describe(package)}"
-    try:
-        proc = subprocess.run(
-            cmd, cwd=cwd, capture_output=True, text=True, timeout=_COMMAND_TIMEOUT
-        )
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RealFileUnavailable(f"{what}: `{' '.join(cmd)}` could not run ({exc})") from exc
-    if proc.returncode != 0:
-        output = (proc.stderr.strip() or proc.stdout.strip())[-2000:]
-        raise RealFileUnavailable(
-            f"{what}: `{' '.join(cmd)}` failed with exit status {proc.returncode}:\n{output}"
-        )
+    run_command(cmd, cwd, what, error=RealFileUnavailable, timeout=_COMMAND_TIMEOUT)
 
 
 def _download_crate(package: Package, tmp: Path) -> Path:

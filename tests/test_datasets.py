@@ -39,6 +39,14 @@ def test_cache_dir_default(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> N
     assert datasets.cache_dir().is_dir()
 
 
+def test_run_command_quotes_the_failure(tmp_path: Path) -> None:
+    with pytest.raises(RuntimeError, match=r"^get x: `false` failed with exit status 1:\n\nretry$"):
+        datasets.run_command(["false"], tmp_path, "get x", "retry")
+    missing = str(tmp_path / "no-such-client")
+    with pytest.raises(LookupError, match=r"^get x: `.*no-such-client` could not run \(.*\)$"):
+        datasets.run_command([missing], tmp_path, "get x", error=LookupError)
+
+
 # ------------------------------------------------------------------ Kinect frame
 
 N_KINECT_POINTS = 273_225

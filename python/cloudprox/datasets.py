@@ -7,7 +7,8 @@ package registries and are kept in a local cache (:func:`cache_dir`:
 
 Public API:
 
-- :func:`cache_dir`: the cache folder; :func:`write_atomically` puts a file in it.
+- :func:`cache_dir`: the cache folder; :func:`write_atomically` puts a file in it;
+  :func:`run_command` runs a registry client (``apt-get download``, ``pip download``).
 - :func:`extract_from_deb`: one file of a Debian package (``ar`` archive holding
   a ``data.tar``, plain or compressed with xz, gzip or Zstandard), read in Python.
 - :func:`fetch_kinect_rawlog`, :func:`kinect_rawlog_path`,
@@ -92,6 +93,7 @@ __all__ = [
     "load_obj",
     "panda_gripper",
     "panda_gripper_parts",
+    "run_command",
     "write_atomically",
 ]
 
@@ -133,17 +135,32 @@ def cache_dir() -> Path:
     return path
 
 
-def _run(cmd: list[str], cwd: Path, what: str, howto: str) -> None:
-    """Run ``cmd`` in ``cwd``; on failure raise a RuntimeError that quotes its output."""
+def run_command(
+    cmd: list[str],
+    cwd: Path,
+    what: str,
+    howto: str = "",
+    *,
+    error: type[Exception] = RuntimeError,
+    timeout: float = 900,
+) -> None:
+    """Run ``cmd`` (a registry client: ``apt-get``, ``pip``) in ``cwd``.
+
+    On failure (it cannot start, times out or exits non-zero) raise ``error``
+    with a message that opens with ``what``, quotes the command and its output
+    and closes with ``howto`` when one is given.
+    """
     try:
-        proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=900)
+        proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout)
     except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RuntimeError(f"{what}: `{' '.join(cmd)}` could not run ({exc}); {howto}") from exc
+        advice = f"; {howto}" if howto else ""
+        raise error(f"{what}: `{' '.join(cmd)}` could not run ({exc}){advice}") from exc
     if proc.returncode != 0:
         output = (proc.stderr.strip() or proc.stdout.strip())[-2000:]
-        raise RuntimeError(
+        advice = f"\n{howto}" if howto else ""
+        raise error(
             f"{what}: `{' '.join(cmd)}` failed with exit status {proc.returncode}:\n"
-            f"{output}\n{howto}"
+            f"{output}{advice}"
         )
 
 
@@ -301,7 +318,7 @@ def fetch_kinect_rawlog() -> Path:
             f"Debian or Ubuntu package mrpt-common to {dest}, or pass its path"
         )
     with tempfile.TemporaryDirectory(dir=cache_dir(), prefix="apt-") as tmp:
-        _run([apt_get, "download", "mrpt-common"], Path(tmp), what, _MRPT_HOWTO)
+        run_command([apt_get, "download", "mrpt-common"], Path(tmp), what, _MRPT_HOWTO)
         debs = sorted(Path(tmp).glob("mrpt-common_*.deb"))
         if len(debs) != 1:
             raise RuntimeError(
@@ -698,7 +715,9 @@ def fetch_panda_wheel() -> Path:
             # The wheel declares Python < 3.13 (for its dependencies); only its data is used.
             cmd += ["--only-binary=:all:", "--ignore-requires-python", "-d", tmp]
             cmd += ["--disable-pip-version-check"]
-            _run(cmd, Path(tmp), f"cannot fetch the Panda gripper meshes ({_PANDA_WHEEL})", howto)
+            run_command(
+                cmd, Path(tmp), f"cannot fetch the Panda gripper meshes ({_PANDA_WHEEL})", howto
+            )
             got = Path(tmp) / _PANDA_WHEEL
             if not got.is_file():
                 raise RuntimeError(f"pip download did not produce {_PANDA_WHEEL}; {howto}")
