@@ -172,6 +172,7 @@ def test_voxel_lattice_count_centroids_counts() -> None:
     assert centroids.shape == (K**3, 3) and counts.shape == (K**3,)
     assert counts.dtype == np.int64
     assert counts.sum() == len(pts)
+    assert len(voxels) == 3 and repr(voxels) == f"Voxels(points={K**3}, covariances=None)"
     # Ordered by voxel (i, j, l), x slowest: the order of cube_lattice.
     cells = cube_lattice(K, 1.0)
     expected_counts = np.full(K**3, 27)

@@ -19,6 +19,7 @@ def test_meshes_and_exact_queries_from_python() -> None:
     np.testing.assert_array_equal(sample.normals, normals)
     np.testing.assert_array_equal(sample.faces, faces)
     assert pts.shape == (500, 3) and normals.shape == (500, 3) and faces.shape == (500,)
+    assert repr(sample) == "MeshSample(points=500)"
     assert np.allclose(np.max(np.abs(pts), axis=1), 0.1)
     shape = cloudprox.ExactShape([cube])
     assert shape.part_kinds == ["convex"]

@@ -72,7 +72,7 @@ tuple_class! {
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "Voxels(points={}, covariances={})",
-            self.points.bind(py).len(),
+            self.points.bind(py).shape()[0],
             if self.covariances.is_some() {
                 "yes"
             } else {

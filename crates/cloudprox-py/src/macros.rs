@@ -1,4 +1,6 @@
-//! Macros that write a Python class from one list of its fields.
+//! Macros that write a Python class from one list of its fields. The names
+//! they use (pyo3's prelude, `PyDict`, `PyTuple`, `PyIterator`) are resolved
+//! where they are invoked.
 
 /// A frozen Python class over a core statistics struct `$core` made of
 /// `counters: $counters` and `time_seconds`. The one list of counters given

@@ -32,7 +32,7 @@ tuple_class! {
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {
-        format!("MeshSample(points={})", self.points.bind(py).len())
+        format!("MeshSample(points={})", self.points.bind(py).shape()[0])
     }
 }
 
