@@ -73,6 +73,12 @@ fn organized_scan(sensor: &Pose) -> CloudData {
     data
 }
 
+/// Keeps the entries of `v` at the ascending indices `k`.
+fn take<T: Copy>(v: &mut Vec<T>, k: &[u32]) {
+    let old = std::mem::take(v);
+    *v = k.iter().map(|&i| old[i as usize]).collect();
+}
+
 fn sensor_pose() -> Pose {
     Pose::new(Vector3::new(0.1, -0.2, 0.3), Vector3::new(0.0, 0.0, 0.0))
 }
@@ -166,10 +172,6 @@ fn pipeline_agrees_with_the_steps_done_by_hand() {
     let mut pixels = data.grid.as_ref().unwrap().pixels.clone();
     let mut counts = vec![points.len()];
     let keep = filter::crop_box(&points, &lo, &hi, &Pose::identity(), false).unwrap();
-    fn take<T: Copy>(v: &mut Vec<T>, k: &[u32]) {
-        let old = std::mem::take(v);
-        *v = k.iter().map(|&i| old[i as usize]).collect();
-    }
     take(&mut points, &keep);
     take(&mut covs, &keep);
     take(&mut pixels, &keep);

@@ -4,7 +4,7 @@
 mod from_mesh;
 mod point_cloud;
 mod pose;
-mod scan;
+pub mod scan;
 
 pub use point_cloud::{PointCloud, MAX_COORDINATE};
 pub(crate) use pose::validate_pose;

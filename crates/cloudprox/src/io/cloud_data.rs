@@ -159,10 +159,10 @@ impl CloudData {
 
     /// The points at `indices` (valid, ascending) with everything aligned.
     fn gather(&self, indices: &[usize]) -> crate::Result<Self> {
-        self.check_aligned("CloudData::select")?;
         fn pick<T: Copy>(all: &[T], indices: &[usize]) -> Vec<T> {
             indices.iter().map(|&i| all[i]).collect()
         }
+        self.check_aligned("CloudData::select")?;
         Ok(Self {
             points: pick(&self.points, indices),
             covariances: self.covariances.as_deref().map(|c| pick(c, indices)),
