@@ -42,6 +42,8 @@ __all__ = [
     "RobotBatchResult",
     "RobotCollisionResult",
     "RobotStats",
+    "ScanResult",
+    "ScanStep",
     "SelfFilter",
     "SolverError",
     "StereoCamera",
@@ -70,6 +72,7 @@ __all__ = [
     "read_pointcloud2",
     "sample_box_surface",
     "sample_sphere",
+    "scan_to_cloud",
     "shadow_filter",
     "statistical_outlier_removal",
     "voxel_downsample",
@@ -1369,6 +1372,73 @@ class SelfFilter:
         """The padding (metres)."""
     def apply(self, points: npt.ArrayLike) -> _IntArray:
         """Return the indices (ascending) of the points not on the robot."""
+
+@final
+class ScanStep:
+    """One filter step of :func:`scan_to_cloud`, made by its static methods.
+
+    Parameters left ``None`` take the core's defaults (as in :mod:`cloudprox.filters`).
+    """
+
+    @staticmethod
+    def crop(
+        min: npt.ArrayLike,
+        max: npt.ArrayLike,
+        pose: npt.ArrayLike | None = None,
+        invert: bool = False,
+    ) -> ScanStep:
+        """Keep the points inside the box ``[min, max]`` (outside with ``invert``)."""
+    @staticmethod
+    def voxel(size: float, merge: str = "mean") -> ScanStep:
+        """One point per occupied voxel of side ``size``, covariances merged."""
+    @staticmethod
+    def outliers(k: int | None = None, std_ratio: float | None = None) -> ScanStep:
+        """Statistical outlier removal."""
+    @staticmethod
+    def shadow(
+        min_angle_deg: float | None = None, window: int | None = None, k: int | None = None
+    ) -> ScanStep:
+        """Remove the shadow (veil) points, seen from the sensor origin."""
+    @staticmethod
+    def self_filter(filter: SelfFilter) -> ScanStep:
+        """Remove the points on the robot (a copy of ``filter`` as it is now)."""
+    @property
+    def name(self) -> str:
+        """``"crop"``, ``"voxel"``, ``"outliers"``, ``"shadow"`` or ``"self"``."""
+
+@final
+class ScanResult:
+    """What :func:`scan_to_cloud` returns: the cloud and what each step did."""
+
+    @property
+    def cloud(self) -> PointCloud:
+        """The cloud; raises :class:`InvalidInputError` when a step removed every point."""
+    @property
+    def steps(self) -> list[tuple[str, int, int]]:
+        """``(name, before, after)`` for each step that ran, in order."""
+    @property
+    def emptied_by(self) -> int | None:
+        """The index of the step that left no point (the last one run), or ``None``."""
+
+def scan_to_cloud(
+    scan: CloudFile,
+    steps: Sequence[ScanStep] = ...,
+    *,
+    sigma: float | None = None,
+    sensor: DepthCamera | StereoCamera | Lidar | None = None,
+    origin: npt.ArrayLike | None = None,
+    sensor_pose: npt.ArrayLike | None = None,
+    discretization: bool = True,
+    k: int | None = None,
+) -> ScanResult:
+    """Run the core's scan pipeline on ``scan``: sensor covariances, ``steps``, ``PointCloud``.
+
+    The noise is ``sigma``, or ``sensor`` seen from ``origin`` / ``sensor_pose``
+    (default: the file's ``VIEWPOINT``), or with neither the covariances stored
+    in the file. The shadow step uses the same sensor origin. The
+    discretization part is added with ``k`` neighbours unless
+    ``discretization=False``. The GIL is released while it runs.
+    """
 
 def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> Mesh:
     """Read a triangle mesh from bytes in memory (e.g. a member of a zip archive).

@@ -12,6 +12,10 @@ A cloud side goes through
 3. the filter steps, in order (each one subsets the points, their covariances
    and pixels; voxel downsampling merges covariances);
 4. a :class:`cloudprox.PointCloud` with the discretization part added.
+
+Steps 2-4 run in the Rust core (``cloudprox::cloud::ScanPipeline``, here
+:func:`cloudprox._native.scan_to_cloud`); this module parses the command line's
+poses, sensors and filter steps into its arguments.
 """
 
 from __future__ import annotations
@@ -25,7 +29,16 @@ import numpy as np
 import numpy.typing as npt
 
 from cloudprox import filters, io
-from cloudprox._native import DepthCamera, Lidar, Mesh, PointCloud, StereoCamera, _read_mesh_counted
+from cloudprox._native import (
+    DepthCamera,
+    Lidar,
+    Mesh,
+    PointCloud,
+    ScanStep,
+    StereoCamera,
+    _read_mesh_counted,
+    scan_to_cloud,
+)
 
 __all__ = [
     "MESH_EXTENSIONS",
@@ -39,6 +52,7 @@ __all__ = [
     "parse_pose",
     "parse_vector",
     "read_mesh_file",
+    "scan_step",
     "sensor_spec",
 ]
 
@@ -75,10 +89,12 @@ class SensorSpec:
     origin: FloatArray | None = None
     sensor_pose: FloatArray | None = None
 
-    def covariances(self, scan: io.CloudFile, points: FloatArray) -> FloatArray | None:
-        """Return the sensor covariances ``(n, 3, 3)`` of ``points`` read from ``scan``.
+    def noise_arguments(self, scan: io.CloudFile) -> dict[str, Any]:
+        """Return the noise arguments of :func:`cloudprox._native.scan_to_cloud` for ``scan``.
 
-        ``None`` when the noise is an isotropic sigma (applied later).
+        ``sigma``; or ``sensor`` with ``origin`` or ``sensor_pose`` (the one given,
+        else the file's ``VIEWPOINT``); or nothing: the covariances stored in the
+        file. Raises :class:`PipelineError` when the noise is not known.
         """
         if self.model is None:
             if self.sigma is None:
@@ -87,32 +103,22 @@ class SensorSpec:
                         f"{scan.path}: no noise given and the file stores no covariances: "
                         "give --sigma or --sensor"
                     )
-                return np.asarray(scan.covariances)
-            return None
-        if self.origin is not None:
-            return self.model.covariances(points, origin=self.origin)
-        pose = self._pose(scan)
-        if pose is None:
+                return self._placement()
+            return {"sigma": self.sigma} | self._placement()
+        if self.origin is None and self._pose(scan) is None:
             raise PipelineError(
                 f"{scan.path} records no sensor viewpoint: give --origin or --sensor-pose "
                 f"for --sensor {self.kind}"
             )
-        return self.model.covariances(points, sensor_pose=pose)
+        return {"sensor": self.model} | self._placement()
 
-    def noise_correlation(self, scan: io.CloudFile, points: FloatArray) -> float | None:
-        """Return how much of the sensor noise the points of one surface share.
-
-        The sensor model's value for ``points`` (see
-        :attr:`cloudprox.PointCloud.noise_correlation`); ``None`` without a model.
-        """
-        if self.model is None:
-            return None
-        where = (
-            {"origin": self.origin}
-            if self.origin is not None
-            else {"sensor_pose": self._pose(scan)}
-        )
-        return PointCloud(points, sensor=self.model, **where).noise_correlation
+    def _placement(self) -> dict[str, Any]:
+        """Where the sensor sits, as given (the core falls back to the file's ``VIEWPOINT``)."""
+        if self.origin is not None:
+            return {"origin": self.origin}
+        if self.sensor_pose is not None:
+            return {"sensor_pose": self.sensor_pose}
+        return {}
 
     def sensor_origin(self, scan: io.CloudFile) -> FloatArray | None:
         """Return where the sensor sits (for the shadow filter), if known."""
@@ -237,51 +243,27 @@ def read_mesh_file(path: str) -> tuple[Mesh, int]:
     return _read_mesh_counted(path)
 
 
-def _apply_filter(
-    step: FilterStep,
-    points: FloatArray,
-    covs: FloatArray | None,
-    pixels: npt.NDArray[np.int64] | None,
-    scan: io.CloudFile,
-    sensor: SensorSpec,
-) -> tuple[FloatArray, FloatArray | None, npt.NDArray[np.int64] | None]:
-    """One filter step on the side's points (and their covariances and pixels)."""
-    keep: npt.NDArray[np.int64]
+def scan_step(step: FilterStep) -> ScanStep:
+    """Parse the arguments of a ``--filter`` step into the core's :class:`ScanStep`.
+
+    Arguments left out are ``None``: the core's defaults. ``self`` reads its mesh.
+    """
     if step.name == "crop":
         box = parse_vector(step.args[0], 6, "crop")
-        keep = filters.crop_box(points, box[:3], box[3:])
-    elif step.name == "voxel":
-        size = _float(step.args[0], "voxel size")
-        voxels = filters.voxel_downsample(points, size, covariances=covs)
-        new_points, new_covs = voxels.points, voxels.covariances
-        return new_points, new_covs, None
-    elif step.name == "outliers":
-        # Arguments left out are None: the core's defaults.
+        return ScanStep.crop(box[:3], box[3:])
+    if step.name == "voxel":
+        return ScanStep.voxel(_float(step.args[0], "voxel size"))
+    if step.name == "outliers":
         k = _int(step.args[0], "outliers K") if step.args else None
         std = _float(step.args[1], "outliers STD") if len(step.args) > 1 else None
-        keep = filters.statistical_outlier_removal(points, k=k, std_ratio=std)
-    elif step.name == "shadow":
-        origin = sensor.sensor_origin(scan)
-        if origin is None:
-            raise PipelineError(
-                f"shadow filter on {scan.path}: the sensor origin is unknown (the file has no "
-                "VIEWPOINT): give --origin or --sensor-pose"
-            )
+        return ScanStep.outliers(k, std)
+    if step.name == "shadow":
         angle = _float(step.args[0], "shadow angle") if step.args else None
-        grid = scan.grid_shape if pixels is not None else None
-        keep = filters.shadow_filter(
-            points, origin, pixels=pixels, grid_shape=grid, min_angle_deg=angle
-        )
-    else:  # self
-        mesh, _ = read_mesh_file(step.args[0])
-        padding = _float(step.args[1], "self padding") if len(step.args) > 1 else None
-        pose = parse_pose(step.args[2], "self pose") if len(step.args) > 2 else np.eye(4)
-        keep = filters.SelfFilter([(mesh, pose)], padding).apply(points)
-    return (
-        points[keep],
-        None if covs is None else covs[keep],
-        None if pixels is None else pixels[keep],
-    )
+        return ScanStep.shadow(angle)
+    mesh, _ = read_mesh_file(step.args[0])
+    padding = _float(step.args[1], "self padding") if len(step.args) > 1 else None
+    pose = parse_pose(step.args[2], "self pose") if len(step.args) > 2 else np.eye(4)
+    return ScanStep.self_filter(filters.SelfFilter([(mesh, pose)], padding))
 
 
 def load_side(
@@ -302,27 +284,23 @@ def load_side(
     scan = io.read_point_cloud(path)
     side = LoadedSide(path, "cloud", read_points=len(scan) + scan.skipped, skipped=scan.skipped)
     side.fields = scan.fields
-    points = np.asarray(scan.points)
-    if len(points) == 0:
+    if len(scan) == 0:
         raise PipelineError(f"{path}: no point with finite coordinates ({scan.skipped} skipped)")
     spec = sensor if sigma_override is None else SensorSpec(sigma=sigma_override)
-    covs = spec.covariances(scan, points)
-    pixels = None if scan.pixels is None else np.asarray(scan.pixels)
-    for step in steps:
-        before = len(points)
-        points, covs, pixels = _apply_filter(step, points, covs, pixels, scan, spec)
-        side.filters.append({"filter": step.describe(), "before": before, "after": len(points)})
-        if len(points) == 0:
-            raise PipelineError(f"{path}: filter {step.describe()} removed every point")
-    if covs is not None:
-        side.cloud = PointCloud(
-            points,
-            cov=covs,
-            discretization=True,
-            noise_correlation=spec.noise_correlation(scan, points),
+    noise = spec.noise_arguments(scan)
+    native_steps = [scan_step(step) for step in steps]
+    if any(step.name == "shadow" for step in steps) and spec.sensor_origin(scan) is None:
+        raise PipelineError(
+            f"shadow filter on {scan.path}: the sensor origin is unknown (the file has no "
+            "VIEWPOINT): give --origin or --sensor-pose"
         )
-    else:
-        side.cloud = PointCloud(points, sigma=spec.sigma, discretization=True)
+    result = scan_to_cloud(scan, native_steps, **noise)
+    for step, (_, before, after) in zip(steps, result.steps, strict=False):
+        side.filters.append({"filter": step.describe(), "before": before, "after": after})
+    if result.emptied_by is not None:
+        emptied = steps[result.emptied_by].describe()
+        raise PipelineError(f"{path}: filter {emptied} removed every point")
+    side.cloud = result.cloud
     return side
 
 

@@ -142,6 +142,21 @@ type CloudStateIn<'py> = (
 const CLOUD_STATE_VERSION: u32 = 1;
 
 impl PyPointCloud {
+    /// Wraps a cloud made in the core whose covariances are its sensor part
+    /// plus, with `disc_k`, the discretization part of `disc_k` neighbours
+    /// (what pickling rebuilds).
+    pub(crate) fn from_core(cloud: PointCloud, disc_k: Option<usize>) -> Self {
+        let inner = Arc::new(cloud);
+        Self {
+            recipe: Recipe {
+                root: Arc::clone(&inner),
+                disc_k,
+                poses: Vec::new(),
+            },
+            inner,
+        }
+    }
+
     /// A cloud from points and noise, with the discretization part if asked for
     /// (`k` neighbours), built without the GIL.
     pub(crate) fn build(

@@ -236,6 +236,14 @@ impl PySelfFilter {
             inner: RwLock::new(inner),
         }
     }
+
+    /// A copy of the core filter as it is now (links and poses).
+    pub(crate) fn snapshot(&self, py: Python<'_>) -> PyResult<SelfFilter> {
+        self.inner
+            .read()
+            .map(|f| f.clone())
+            .map_err(|_| invalid_input(py, "SelfFilter is poisoned by an earlier panic"))
+    }
 }
 
 #[pymethods]

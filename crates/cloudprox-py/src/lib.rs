@@ -16,6 +16,7 @@
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
 //! | `pose.rs` | pose constructors (translation, quaternion, rpy, rotation vector, look-at, random) |
 //! | `sample.rs` | seeded synthetic shapes |
+//! | `scan.rs` | `scan_to_cloud`: the core's scan pipeline (noise, filter steps, cloud) |
 //! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
 //! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
 //! | `robot.rs` | `Robot`, `collide_robot`, `collide_robot_many`, `check_motion` |
@@ -41,6 +42,7 @@ mod request;
 mod result;
 mod robot;
 mod sample;
+mod scan;
 mod sensor;
 mod side;
 
@@ -80,6 +82,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(io::parse_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(io::read_pointcloud2, m)?)?;
     m.add_function(wrap_pyfunction!(io::write_pointcloud2, m)?)?;
+    m.add_class::<scan::PyScanStep>()?;
+    m.add_class::<scan::PyScanResult>()?;
+    m.add_function(wrap_pyfunction!(scan::scan_to_cloud, m)?)?;
     m.add_class::<sensor::PyDepthCamera>()?;
     m.add_class::<sensor::PyStereoCamera>()?;
     m.add_class::<sensor::PyLidar>()?;

@@ -16,7 +16,7 @@
 //!
 //! | stage | module |
 //! |---|---|
-//! | points, covariances, poses | [`cloud`] |
+//! | points, covariances, poses; from a scan file's points to a cloud ([`cloud::ScanPipeline`]) | [`cloud`] |
 //! | noise models, discretization error, robustness radius | [`uncertainty`] |
 //! | surface elements: the surfaces the points sample, at the resolution the data supports | [`element`] |
 //! | bounding volume hierarchy with noise-inflated pruning | [`bvh`] |

@@ -83,6 +83,102 @@ impl CloudData {
         Ok(())
     }
 
+    /// The data of the points where `keep` is `true`, in their order: the
+    /// points, their covariances, normals and (organized cloud) pixels stay
+    /// aligned; the grid keeps its `width x height`, the sensor pose, field
+    /// names and `skipped` count are kept as they are.
+    ///
+    /// # Errors
+    /// [`crate::Error::Shape`] if `keep` does not have one entry per point, or
+    /// if the normals, covariances or grid pixels do not (naming which).
+    pub fn select(&self, keep: &[bool]) -> crate::Result<Self> {
+        if keep.len() != self.points.len() {
+            return Err(crate::Error::Shape {
+                what: "CloudData::select: keep mask (one entry per point)".into(),
+                expected: self.points.len(),
+                got: keep.len(),
+            });
+        }
+        let indices: Vec<usize> = keep
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &k)| k.then_some(i))
+            .collect();
+        self.gather(&indices)
+    }
+
+    /// The data of the points at `indices` (strictly ascending, as the
+    /// [`crate::filter`] functions return them), everything kept aligned as in
+    /// [`CloudData::select`].
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidInput`] if an index is out of range or the
+    /// indices are not strictly ascending; [`crate::Error::Shape`] as
+    /// [`CloudData::select`].
+    pub fn select_indices(&self, indices: &[u32]) -> crate::Result<Self> {
+        let n = self.points.len();
+        let mut out = Vec::with_capacity(indices.len());
+        for (pos, &i) in indices.iter().enumerate() {
+            let i = i as usize;
+            if i >= n {
+                return Err(crate::Error::invalid(format!(
+                    "CloudData::select_indices: index {i} (at {pos}) is out of range for {n} points"
+                )));
+            }
+            if out.last().is_some_and(|&last| last >= i) {
+                return Err(crate::Error::invalid(format!(
+                    "CloudData::select_indices: indices must be strictly ascending; index {i} \
+                     (at {pos}) follows {}",
+                    out[out.len() - 1]
+                )));
+            }
+            out.push(i);
+        }
+        self.gather(&out)
+    }
+
+    /// Checks that everything per point has one entry per point, including the
+    /// grid's pixels.
+    fn check_aligned(&self, what: &str) -> crate::Result<()> {
+        let n = self.points.len();
+        for (field, len) in [
+            ("normals", self.normals.as_ref().map(Vec::len)),
+            ("covariances", self.covariances.as_ref().map(Vec::len)),
+            ("grid pixels", self.grid.as_ref().map(|g| g.pixels.len())),
+        ] {
+            if let Some(len) = len.filter(|&len| len != n) {
+                return Err(crate::Error::Shape {
+                    what: format!("{what}: {field} (one per point)"),
+                    expected: n,
+                    got: len,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The points at `indices` (valid, ascending) with everything aligned.
+    fn gather(&self, indices: &[usize]) -> crate::Result<Self> {
+        fn pick<T: Copy>(all: &[T], indices: &[usize]) -> Vec<T> {
+            indices.iter().map(|&i| all[i]).collect()
+        }
+        self.check_aligned("CloudData::select")?;
+        Ok(Self {
+            points: pick(&self.points, indices),
+            covariances: self.covariances.as_deref().map(|c| pick(c, indices)),
+            normals: self.normals.as_deref().map(|c| pick(c, indices)),
+            sensor: self.sensor,
+            sensor_is_default: self.sensor_is_default,
+            grid: self.grid.as_ref().map(|g| Grid {
+                width: g.width,
+                height: g.height,
+                pixels: pick(&g.pixels, indices),
+            }),
+            fields: self.fields.clone(),
+            skipped: self.skipped,
+        })
+    }
+
     /// Data holding just these points (no covariances, normals, sensor or grid).
     pub fn from_points(points: Vec<Point3>) -> Self {
         Self {
