@@ -144,7 +144,18 @@ pub(crate) fn fit_element(
     // quadric's extra coefficients would only add their noise).
     match weighted_fit(&local, plane_row) {
         Some(p) if spans_a_plane(&p) => {
-            let e = element(&pa, idx, sensor, spacing, &local, first, settings, &p);
+            // The tangent axes of the points' tightest bounding rectangle (a
+            // square face gets axes along its sides, not along its diagonals).
+            let (c, s) = tightest_rectangle_axes(&local);
+            let local: Vec<(Real, Real, Real, Real)> = local
+                .iter()
+                .map(|&(u, v, h, var)| (c * u + s * v, -s * u + c * v, h, var))
+                .collect();
+            let tangents = [c * t1 + s * t2, -s * t1 + c * t2];
+            let p = p.rotated(c, s);
+            let e = element(
+                &pa, idx, sensor, spacing, &local, tangents, first, settings, &p,
+            );
             if covers_its_extent(&e, &local) {
                 Fit::Element(Box::new(e))
             } else {
@@ -157,7 +168,8 @@ pub(crate) fn fit_element(
 
 /// Whether an element's points cover the surface its extent claims: at least
 /// half of the cells of side twice the points' mean sampling spacing over the
-/// extent's rectangle hold a point. Two coplanar patches apart (the faces of two
+/// extent's rectangle hold a point, and no strip of empty cells runs across
+/// it. Two coplanar patches apart (the faces of two
 /// objects on one plane, or what a crop or a voxel grid left of them) pass the
 /// residual and curvature tests together, but the plane between them was never
 /// sampled and must not be probed. A uniformly sampled surface leaves a cell of
@@ -175,7 +187,15 @@ fn covers_its_extent(e: &SurfaceElement, local: &[(Real, Real, Real, Real)]) -> 
         .collect();
     occupied.sort_unstable();
     occupied.dedup();
-    occupied.len() as Real >= 0.5 * expected
+    // No empty strip across the extent either: the columns (and the rows) of
+    // cells that hold a point follow one another.
+    let contiguous = |key: fn(&(i32, i32)) -> i32| {
+        let mut lines: Vec<i32> = occupied.iter().map(key).collect();
+        lines.sort_unstable();
+        lines.dedup();
+        lines.windows(2).all(|w| w[1] - w[0] <= 1)
+    };
+    occupied.len() as Real >= 0.5 * expected && contiguous(|c| c.0) && contiguous(|c| c.1)
 }
 
 /// The most points of an element's surface probed in a query.
@@ -222,6 +242,86 @@ fn weighted_fit<const D: usize>(
 /// fits, and the plane's normal says nothing.
 const MAX_SLOPE_SD: Real = 0.5;
 
+impl HeightFit<3> {
+    /// The plane's fit in tangent axes turned by the angle of cosine `c` and
+    /// sine `s` (`u' = c u + s v`, `v' = -s u + c v`).
+    fn rotated(&self, c: Real, s: Real) -> Self {
+        let j = SMatrix::<Real, 3, 3>::new(1.0, 0.0, 0.0, 0.0, c, s, 0.0, -s, c);
+        Self {
+            coef: j * self.coef,
+            cov: j * self.cov * j.transpose(),
+            residual: self.residual,
+        }
+    }
+}
+
+/// The direction `(cos, sin)`, in the tangential coordinates of `local`, of
+/// the longer side of the smallest-area rectangle holding the points (its
+/// sides run along an edge of their convex hull). Principal axes are the
+/// directions of largest and smallest spread, which a square or a disc leaves
+/// to the noise: a square's may run along its diagonals, where a rectangle
+/// summary would claim corners outside the face. `(1, 0)` for fewer than three
+/// points in general position.
+fn tightest_rectangle_axes(local: &[(Real, Real, Real, Real)]) -> (Real, Real) {
+    let hull = convex_hull_2d(local.iter().map(|t| (t.0, t.1)).collect());
+    let mut best = (Real::INFINITY, (1.0, 0.0));
+    for k in 0..hull.len() {
+        let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let len = dx.hypot(dy);
+        if len <= 0.0 || !len.is_finite() {
+            continue;
+        }
+        let (c, s) = (dx / len, dy / len);
+        let (mut lo, mut hi) = ([Real::INFINITY; 2], [Real::NEG_INFINITY; 2]);
+        for &(u, v) in &hull {
+            let q = [c * u + s * v, -s * u + c * v];
+            for i in 0..2 {
+                lo[i] = lo[i].min(q[i]);
+                hi[i] = hi[i].max(q[i]);
+            }
+        }
+        let (wu, wv) = (hi[0] - lo[0], hi[1] - lo[1]);
+        if wu * wv < best.0 {
+            // The longer side first.
+            best = (wu * wv, if wu >= wv { (c, s) } else { (-s, c) });
+        }
+    }
+    best.1
+}
+
+/// The convex hull of `pts` in counter-clockwise order (Andrew's monotone
+/// chain), without collinear points.
+fn convex_hull_2d(mut pts: Vec<(Real, Real)>) -> Vec<(Real, Real)> {
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    let mut lower = half_hull(pts.iter());
+    let mut upper = half_hull(pts.iter().rev());
+    // Each chain ends where the other starts.
+    lower.pop();
+    upper.pop();
+    lower.extend(upper);
+    lower
+}
+
+/// One chain of [`convex_hull_2d`]: the points in order, keeping left turns.
+fn half_hull<'a>(pts: impl Iterator<Item = &'a (Real, Real)>) -> Vec<(Real, Real)> {
+    let cross = |o: (Real, Real), a: (Real, Real), b: (Real, Real)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut chain: Vec<(Real, Real)> = Vec::new();
+    for &p in pts {
+        while chain.len() >= 2 && cross(chain[chain.len() - 2], chain[chain.len() - 1], p) <= 0.0 {
+            chain.pop();
+        }
+        chain.push(p);
+    }
+    chain
+}
+
 /// Whether a fitted plane's slopes are determined (see [`MAX_SLOPE_SD`]).
 fn spans_a_plane(fit: &HeightFit<3>) -> bool {
     fit.cov[(1, 1)].sqrt() <= MAX_SLOPE_SD && fit.cov[(2, 2)].sqrt() <= MAX_SLOPE_SD
@@ -239,6 +339,7 @@ fn element(
     sensor: &[Matrix3],
     spacing: &[Real],
     local: &[(Real, Real, Real, Real)],
+    tangents: [Vector3; 2],
     first: u32,
     settings: &ElementSettings,
     fit: &HeightFit<3>,
@@ -248,20 +349,19 @@ fn element(
     let sum_cov: Matrix3 = idx.iter().map(|&i| sensor[i as usize]).sum();
     let cov_mean = sum_cov * ((1.0 - rho) / (n * n) + rho / n);
     let mean_var = local.iter().map(|t| t.3).sum::<Real>() / n;
-    // The surface's half width along each tangent from the points' spread: a
-    // surface sampled uniformly over `[-e, e]` (each sample standing for its
-    // cell) has positional variance `e^2 / 3`, and the noise along the tangent
-    // adds its own variance `s^2`, so `e = sqrt(3 (var - s^2))`. Unlike the
-    // points' range, it is not pushed out by the outermost noisy points.
-    let tangents = [pa.largest(), pa.axes.column(1).into_owned()];
+    // The surface's range along each tangent: where its sampled edges are,
+    // read from the points with their noise taken out (see `sampled_edges`).
     let range = |k: usize| -> [Real; 2] {
         let noise_var = idx
             .iter()
             .map(|&i| directional_std_of(&sensor[i as usize], &tangents[k]).powi(2))
             .sum::<Real>()
             / n;
-        let e = (3.0 * (pa.variances[2 - k] - noise_var).max(0.0)).sqrt();
-        [-e, e]
+        let mut along: Vec<Real> = local
+            .iter()
+            .map(|t| if k == 0 { t.0 } else { t.1 })
+            .collect();
+        sampled_edges(&mut along, noise_var.sqrt())
     };
     let extent = [range(0), range(1)];
     // Where the element's surface is probed: at most `MAX_PROBES` of its
@@ -326,6 +426,65 @@ fn element(
     }
 }
 
+/// Where a surface sampled at the tangential coordinates `along` (noisy,
+/// with noise standard deviation `s` along the tangent) has its edges.
+///
+/// Without noise, the outermost points. With it, the points near an edge are
+/// smeared across it: a surface sampled at density `rho` (points per unit
+/// length of the tangent) up to an edge puts `rho s / sqrt(2 pi)` of its points
+/// beyond it on average (the integral of the normal tail). The edge is read as
+/// the point past which as many points lie as that predicts, `rho` counted in
+/// the window of `2 s` inside it (where the smear leaves about 0.8 of the
+/// density: `1 - (1/2) int_0^2 (1 - Phi(z)) dz`), so `m ≈ c / (0.8 * 2 *
+/// sqrt(2 pi)) ≈ c / 4` points beyond for `c` points in the window. Unlike the
+/// points' spread (`var = e^2 / 3` for a uniform sampling of `[-e, e]`), it
+/// follows the density near each edge: a floor seen at a grazing angle has its
+/// points bunched towards the camera and its noise running along the rays,
+/// nearly in the floor's plane, and a spread estimate covers a fraction of it.
+/// Unlike the outermost points, it is not pushed out by the noise (by about
+/// `s sqrt(2 ln n)`). Sorts `along`.
+fn sampled_edges(along: &mut [Real], s: Real) -> [Real; 2] {
+    along.sort_by(Real::total_cmp);
+    let hi = upper_edge(along, s);
+    along.reverse();
+    for x in along.iter_mut() {
+        *x = -*x;
+    }
+    let lo = -upper_edge(along, s);
+    [lo.min(hi), hi.max(lo)]
+}
+
+/// Points beyond a sampled edge per point in the window of `2 s` inside it
+/// (see [`sampled_edges`]).
+const BEYOND_PER_WINDOW_POINT: Real = 0.25;
+
+/// The upper edge of [`sampled_edges`] over ascending `sorted`: the point with
+/// the fewest points `m` beyond it such that `m >= c / 4 - 1/2`, `c` the points
+/// in the window `(edge - 2 s, edge]`. `0` for no points.
+fn upper_edge(sorted: &[Real], s: Real) -> Real {
+    let n = sorted.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let window = 2.0 * s;
+    // `low`: the first index inside the window of the current edge; it only
+    // moves down as the edge does.
+    let mut low = n - 1;
+    for m in 0..n {
+        let top = n - 1 - m;
+        let edge = sorted[top];
+        low = low.min(top);
+        while low > 0 && sorted[low - 1] > edge - window {
+            low -= 1;
+        }
+        let c = (top + 1 - low) as Real;
+        if m as Real >= BEYOND_PER_WINDOW_POINT * c - 0.5 {
+            return edge;
+        }
+    }
+    sorted[0]
+}
+
 /// Where the values (residuals, with their variances) fall into two groups
 /// that are each as tight as the noise and whose means are more than four noise
 /// standard deviations apart, as the two faces of a thin plate do: the value
@@ -364,6 +523,75 @@ fn two_surfaces(values: &[(Real, Real)]) -> Option<Real> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampled_edges_take_the_noise_out_of_the_range() {
+        // Without noise: the outermost points.
+        let mut exact: Vec<Real> = (0..=20).map(|i| Real::from(i) * 0.1 - 1.0).collect();
+        let [lo, hi] = sampled_edges(&mut exact, 0.0);
+        assert!((lo + 1.0).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
+        // A dense uniform sampling of [-1, 2] with noise 0.05: the outermost
+        // points lie about 0.05 sqrt(2 ln n) = 0.2 beyond the edges; the edges
+        // are read within a fifth of that.
+        let mut rng = crate::sample::NormalRng::new(3);
+        let s = 0.05;
+        let mut along: Vec<Real> = (0..4000)
+            .map(|_| -1.0 + 3.0 * rng.uniform() + s * rng.normal())
+            .collect();
+        let (min, max) = along
+            .iter()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        assert!(min < -1.1 && max > 2.1, "{min} {max}");
+        let [lo, hi] = sampled_edges(&mut along, s);
+        assert!(
+            (lo + 1.0).abs() < 0.04 && (hi - 2.0).abs() < 0.04,
+            "{lo} {hi}"
+        );
+        // A density falling to the far edge (a floor seen at a grazing angle):
+        // the far edge is still found, where a spread estimate
+        // (`sqrt(3 (var - s^2))` about the mean) stops short of it.
+        let mut along: Vec<Real> = (0..4000)
+            .map(|_| 2.0 * (1.0 - rng.uniform().sqrt()) + s * rng.normal())
+            .collect();
+        let n = along.len() as Real;
+        let mean = along.iter().sum::<Real>() / n;
+        let var = along.iter().map(|x| (x - mean).powi(2)).sum::<Real>() / n;
+        let spread_hi = mean + (3.0 * (var - s * s)).sqrt();
+        let [lo, hi] = sampled_edges(&mut along, s);
+        assert!(lo.abs() < 0.04 && (hi - 2.0).abs() < 0.15, "{lo} {hi}");
+        assert!(spread_hi < 1.7, "{spread_hi}");
+    }
+
+    #[test]
+    fn the_tightest_rectangle_runs_along_a_squares_sides() {
+        for deg in [0.0, 30.0, 45.0, 80.0] {
+            let t: Real = Real::to_radians(deg);
+            let local: Vec<(Real, Real, Real, Real)> = (0..144)
+                .map(|k| {
+                    let (x, y) = (Real::from(k / 12) - 5.5, Real::from(k % 12) - 5.5);
+                    (
+                        t.cos() * x - t.sin() * y,
+                        t.sin() * x + t.cos() * y,
+                        0.0,
+                        1.0,
+                    )
+                })
+                .collect();
+            let (c, s) = tightest_rectangle_axes(&local);
+            // A side's direction, up to quarter turns.
+            let off = (s.atan2(c) - t).rem_euclid(std::f64::consts::FRAC_PI_2);
+            let off = off.min(std::f64::consts::FRAC_PI_2 - off);
+            assert!(off < 1e-9, "{deg}: off by {off}");
+        }
+        // A 3 x 1 strip: the longer side first.
+        let local: Vec<(Real, Real, Real, Real)> = (0..40)
+            .map(|k| (Real::from(k % 4) * 0.1, Real::from(k / 4) * 0.3, 0.0, 1.0))
+            .collect();
+        let (c, s) = tightest_rectangle_axes(&local);
+        assert!(c.abs() < 1e-9 && (s.abs() - 1.0).abs() < 1e-9, "{c} {s}");
+    }
 
     #[test]
     fn chi_square_quantiles_match_tables() {

@@ -83,12 +83,19 @@ pub struct SurfaceElement {
     pub mean: Point3,
     /// Unit normal of the points' principal plane (its sign is arbitrary).
     pub normal: Vector3,
-    /// Unit tangents, the largest spread first.
+    /// Unit tangents: the sides of the smallest rectangle holding the points
+    /// in the tangent plane, the longer first (a square face gets its sides,
+    /// not its diagonals, which principal axes may give).
     pub tangents: [Vector3; 2],
     /// The surface's range along each tangent, `[min, max]` from the mean:
-    /// `-+sqrt(3 (var - s^2))` with `var` the points' variance along the
-    /// tangent and `s^2` their noise's (a uniformly sampled strip of half width
-    /// `e`, each sample standing for its cell, has variance `e^2 / 3`).
+    /// where its sampled edges are, read from the points with their noise
+    /// taken out (a noisy sampling up to an edge puts `rho s / sqrt(2 pi)` of
+    /// its points beyond it, `rho` the density there and `s` the noise along
+    /// the tangent, so about a quarter of the points within `2 s` inside the
+    /// edge lie beyond it). It follows the density near each edge, so a floor
+    /// seen at a grazing angle (points bunched towards the camera, noise along
+    /// the rays nearly in the floor's plane) is covered to its far edge, and it
+    /// is not pushed out by the outermost noisy points.
     pub extent: [[Real; 2]; 2],
     /// Tangential coordinates where the fitted surface is probed in a query: up
     /// to 25 of the points' own (the extremes along each tangent and a stride

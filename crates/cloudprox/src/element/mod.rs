@@ -9,7 +9,7 @@
 //! two surfaces where the points along the normal fall into two groups further
 //! apart than the noise, as the two faces of a thin plate do); a group is an
 //! element as soon as two statistical tests at the significance level
-//! [`ElementSettings::significance`] accept it:
+//! [`ElementSettings::significance`] and a coverage test accept it:
 //!
 //! 1. **Residual test.** A quadric height field `h(u, v)` over the group's
 //!    principal plane is fitted by weighted least squares, each point weighted by
@@ -23,6 +23,14 @@
 //!    surface's curvature scale at this noise, and is split. So elements are
 //!    large where the surface is flat or the noise is high, and shrink with
 //!    curvature and with falling noise; no threshold is tuned to a scene.
+//!
+//! 3. **Coverage test.** The points cover the rectangle the element claims
+//!    (its tangents along the sides of the smallest rectangle holding them, its
+//!    extent their sampled edges with the noise taken out, see
+//!    [`SurfaceElement::extent`]): at least half of its cells of twice the
+//!    sampling spacing hold a point, and no strip of empty cells runs across
+//!    it. Two coplanar patches apart pass the first two tests together, but the
+//!    plane between them was never sampled.
 //!
 //! An accepted element keeps its mean, normal and tangents, its extent, and the
 //! covariance of its mean (`sum(Sigma_i) / m^2` for independent noise;
