@@ -356,9 +356,10 @@ pub(crate) fn elements_within_reach(
 /// `x`'s tangential coordinates (clamped to that element's range; an element
 /// `x` lies over is preferred to one it lies beside) that lies
 /// within half a sampling spacing of `x` across its surface. The two surfaces
-/// there are `g = (y - x) . u` apart along the separating surface's unit normal
-/// `u` at their midpoint (oriented from A to B: only the direction of `sep` is
-/// used, not where it runs), with the standard deviation
+/// there are `g = (y - x) . u` apart along the direction `u` across them (the
+/// facing element's normal, turned from A towards B by the separating
+/// surface's normal at the pair's midpoint; see [`pair_direction`]), with the
+/// standard deviation
 /// `s = sqrt(u^T (Sigma_x + Sigma_y) u)` of the two fitted surfaces, and cross
 /// with probability `Phi(-g / s)`. A pair farther apart than the noise can
 /// reach (`|y - x| > h/2 + reach_sds s`, `h` the spacing) cannot cross there
@@ -396,11 +397,9 @@ pub(crate) fn element_crossing_probabilities(
         if gn <= 0.0 || !gn.is_finite() {
             return true;
         }
-        // From A towards B: f decreases from A's side to B's. (Measured along
-        // the facing element's own normal instead, the piano scene of
-        // `cloudprox reproduce` lost 0.07 of decided accuracy at 2% noise:
-        // probes beside an element, not over it, read a gap near 0.)
-        let u = g / (-gn);
+        // From A towards B: f decreases from A's side to B's.
+        let u_sep = g / (-gn);
+        let (u, steep) = pair_direction(&po[f.own], &pt[f.other], f.key.0, &u_sep);
         let gap = own.label * (f.y - f.x).dot(&u);
         let sd = (po[f.own].var_along(f.var_x, &u) + pt[f.other].var_along(f.var_y, &u))
             .max(0.0)
@@ -408,7 +407,11 @@ pub(crate) fn element_crossing_probabilities(
         let span = (f.y - f.x).norm();
         if span <= f.allowed + reach_sds * sd {
             let p = wrong_side(gap, sd);
-            if p < 0.5 {
+            if steep {
+                // The separating surface runs across the two surfaces here,
+                // not between them: it says nothing of their order.
+                out.undescribed_max = out.undescribed_max.max(p);
+            } else if p < 0.5 {
                 out.described_max = out.described_max.max(p);
             } else if p > out.undescribed_max.min(out.described_max) {
                 // Only a pair that would cross and could raise one of the two
@@ -428,12 +431,56 @@ pub(crate) fn element_crossing_probabilities(
     out
 }
 
+/// The direction across a facing pair, from A towards B, along which its gap
+/// is measured, and whether the separating surface (unit normal `u_sep` at
+/// the pair, from A towards B) runs *across* the two surfaces there rather
+/// than between them.
+///
+/// A probe lying over the other element (`beside` false) is measured along
+/// that element's normal (along the own element's when the other is a single
+/// point), turned towards B by the separating surface: the surfaces' own
+/// geometry gives the distance, the separator only the order. A probe beside
+/// the other element is measured along `u_sep` (along the normal, a probe
+/// beside a coplanar neighbour reads a gap near 0). Two single points are
+/// measured along `u_sep`. The separator runs across the surfaces when its
+/// normal is closer to their tangent plane than to their normal (more than
+/// 45 degrees from the facing element's normal): there the side each surface
+/// is on is not the side the separator puts it, and the order it gives is
+/// not known.
+fn pair_direction(
+    own: &Posed<'_>,
+    other: &Posed<'_>,
+    beside: bool,
+    u_sep: &Vector3,
+) -> (Vector3, bool) {
+    let normal = if !other.e.is_point() {
+        Some(other.normal)
+    } else if !own.e.is_point() {
+        Some(own.normal)
+    } else {
+        None
+    };
+    let Some(n) = normal else {
+        return (*u_sep, false);
+    };
+    let c = n.dot(u_sep);
+    let steep = c.abs() < std::f64::consts::FRAC_1_SQRT_2;
+    if beside {
+        (*u_sep, steep)
+    } else {
+        (if c >= 0.0 { n } else { -n }, steep)
+    }
+}
+
 /// The crossing probabilities of one side's elements
 /// ([`element_crossing_probabilities`]), and the largest crossing probability
 /// among the pairs the separating surface describes and among those it does
 /// not.
 ///
-/// A pair that would cross (`Phi(-g/s) >= 1/2`) is *undescribed* when `x` and
+/// A pair is *undescribed* where the separating surface runs across the two
+/// surfaces rather than between them (its normal more than 45 degrees from
+/// the facing element's; see [`pair_direction`]); and a pair that would cross
+/// (`Phi(-g/s) >= 1/2`) is also undescribed when `x` and
 /// `y` lie on the same side of the separating surface, both farther from it
 /// than the pair spans (the pair's length plus `h/2 + reach_sds s`; the
 /// distance to the surface read as `|f| / |grad f|` at the nearer end). There
@@ -562,6 +609,66 @@ mod tests {
             }
         }
         assert!(checked > 1000);
+    }
+
+    #[test]
+    fn a_pair_is_measured_along_the_facing_normal_and_steep_separators_are_flagged() {
+        // Elements of a noisy flat square (normal along z); the separating
+        // surface's normal at 30 and 60 degrees from it, either sign.
+        use crate::cloud::PointCloud;
+        use crate::sample::add_noise;
+        let grid: Vec<Point3> = (0..40)
+            .flat_map(|i| {
+                (0..40).map(move |j| Point3::new(i as Real * 0.005, j as Real * 0.005, 0.0))
+            })
+            .collect();
+        let mut points = add_noise(&grid, 0.0005, 3);
+        // An outlier a metre away stays a single point.
+        points.push(Point3::new(1.0, 1.0, 1.0));
+        let cloud = PointCloud::from_sigma(points, 0.0005).unwrap();
+        let els = cloud.elements();
+        let k = els
+            .elements()
+            .iter()
+            .position(|e| !e.is_point())
+            .expect("a surface element");
+        let plane = Posed::new(
+            (&els.elements()[k], els.hulls().hull(k as u32)),
+            &Pose::identity(),
+        );
+        let point_k = els
+            .elements()
+            .iter()
+            .position(SurfaceElement::is_point)
+            .expect("a single point");
+        assert!(plane.normal.z.abs() > 0.99);
+        for sign in [1.0, -1.0] {
+            for (deg, steep) in [(30.0, false), (60.0, true)] {
+                let a = (deg as Real).to_radians();
+                let u_sep = Vector3::new(a.sin(), 0.0, sign * a.cos());
+                let (u, s) = pair_direction(&plane, &plane, false, &u_sep);
+                assert_eq!(s, steep, "{deg} degrees");
+                // Along the normal, turned to the separator's side.
+                assert!((u.dot(&plane.normal).abs() - 1.0).abs() < 1e-12);
+                assert!(u.dot(&u_sep) > 0.0);
+                // Beside the other element: along the separator's normal.
+                let (u, s) = pair_direction(&plane, &plane, true, &u_sep);
+                assert_eq!((u, s), (u_sep, steep));
+            }
+        }
+        // Two single points: the separator's normal, never steep.
+        let j = point_k;
+        {
+            let pt = Posed::new(
+                (&els.elements()[j], els.hulls().hull(j as u32)),
+                &Pose::identity(),
+            );
+            let u_sep = Vector3::new(1.0, 0.0, 0.0);
+            assert_eq!(pair_direction(&pt, &pt, false, &u_sep), (u_sep, false));
+            // A point facing an element: the element's normal.
+            let (u, s) = pair_direction(&plane, &pt, false, &u_sep);
+            assert!(s && (u.dot(&plane.normal).abs() - 1.0).abs() < 1e-12);
+        }
     }
 
     #[test]
