@@ -106,6 +106,12 @@ def test_transformed_moves_points_and_rotates_covariances() -> None:
     np.testing.assert_array_equal(cloud.points, pts)  # the original is untouched
 
 
+def test_transformed_refuses_a_pose_that_moves_points_out_of_range() -> None:
+    cloud = cp.PointCloud(random_points())
+    with pytest.raises(cp.InvalidInputError, match="moves the cloud out of range"):
+        cloud.transformed(from_translation((1e300, 0.0, 0.0)))
+
+
 def test_pointcloud_is_frozen() -> None:
     cloud = cp.PointCloud(random_points())
     with pytest.raises(AttributeError):

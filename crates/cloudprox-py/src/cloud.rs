@@ -285,7 +285,7 @@ impl PyPointCloud {
     fn transformed(&self, py: Python<'_>, transform: &Bound<'_, PyAny>) -> PyResult<Self> {
         let pose = pose_from(py, Some(transform), "transform")?;
         let inner = Arc::clone(&self.inner);
-        let moved = run_detached(py, move || Ok(inner.transformed(&pose)))?;
+        let moved = run_detached(py, move || inner.transformed(&pose))?;
         let mut recipe = self.recipe.clone();
         recipe.poses.push(pose);
         Ok(Self {
@@ -344,7 +344,7 @@ impl PyPointCloud {
             let root = Arc::new(root);
             let mut cloud = Arc::clone(&root);
             for pose in &moves {
-                cloud = Arc::new(cloud.transformed(pose));
+                cloud = Arc::new(cloud.transformed(pose)?);
             }
             Ok((root, cloud))
         })?;

@@ -31,7 +31,7 @@ fn collide_moved_data(
     pb: &Pose,
     req: &CollisionRequest,
 ) -> CollisionResult {
-    let (ma, mb) = (a.transformed(t), b.transformed(&(t * pb)));
+    let (ma, mb) = (a.transformed(t).unwrap(), b.transformed(&(t * pb)).unwrap());
     collide(&Pose::identity(), &ma, &Pose::identity(), &mb, req).unwrap()
 }
 

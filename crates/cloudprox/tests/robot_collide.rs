@@ -187,7 +187,7 @@ fn a_common_rigid_motion_of_base_and_cloud_changes_nothing() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 5);
     let motion = Pose::new(Vector3::new(0.7, -1.2, 0.4), Vector3::new(0.3, -0.5, 0.9));
-    let moved = cloud.transformed(&motion);
+    let moved = cloud.transformed(&motion).unwrap();
     let req = RobotRequest::default();
     for q in [
         [0.0, 0.0, 0.065, 0.0],
@@ -283,7 +283,9 @@ fn check_motion_finds_a_collision_between_two_free_waypoints() {
         "check_motion {t}, sweep {first}, step {step}"
     );
     // The same motion with the obstacle moved off the path is safe.
-    let away = obstacle().transformed(&Pose::translation(0.0, 0.0, 0.5));
+    let away = obstacle()
+        .transformed(&Pose::translation(0.0, 0.0, 0.5))
+        .unwrap();
     let m = check_motion(&robot, &q0, &q1, &Pose::identity(), &away, &req).unwrap();
     assert!(m.safe && m.first_unsafe.is_none());
     assert_eq!(m.states_checked, m.states_total);

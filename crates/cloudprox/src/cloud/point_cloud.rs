@@ -400,12 +400,22 @@ impl PointCloud {
 
     /// Applies `pose` to the points and rotates the covariances (`R Sigma R^T`);
     /// the hierarchy is rebuilt lazily.
-    pub fn transform(&mut self, pose: &Pose) {
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] when a moved point would have a non-finite
+    /// coordinate or one beyond the range every cloud is held to (a pose with
+    /// a huge or non-finite translation); the cloud is then left unchanged.
+    pub fn transform(&mut self, pose: &Pose) -> Result<()> {
+        let moved: Vec<Point3> = self.points.iter().map(|p| pose * p).collect();
+        validate_points(&moved).map_err(|e| match e {
+            Error::InvalidInput(m) => {
+                Error::invalid(format!("the pose moves the cloud out of range: {m}"))
+            }
+            e => e,
+        })?;
         let r = pose.rotation.to_rotation_matrix();
         let r = r.matrix();
-        for p in &mut self.points {
-            *p = pose * *p;
-        }
+        self.points = moved;
         for c in self
             .covariances
             .iter_mut()
@@ -416,13 +426,17 @@ impl PointCloud {
         self.bvh = OnceLock::new();
         self.spacing = OnceLock::new();
         self.elements = OnceLock::new();
+        Ok(())
     }
 
     /// A copy moved by `pose` (see [`PointCloud::transform`]).
-    pub fn transformed(&self, pose: &Pose) -> Self {
+    ///
+    /// # Errors
+    /// As [`PointCloud::transform`].
+    pub fn transformed(&self, pose: &Pose) -> Result<Self> {
         let mut c = self.clone();
-        c.transform(pose);
-        c
+        c.transform(pose)?;
+        Ok(c)
     }
 }
 
@@ -430,6 +444,28 @@ impl PointCloud {
 mod spacing_tests {
     use super::*;
     use crate::sample::{add_noise, box_surface};
+
+    /// A pose that moves the points out of range is refused by name and leaves
+    /// the cloud as it was.
+    #[test]
+    fn a_pose_out_of_range_is_refused() {
+        let pts = vec![Point3::new(0.0, 0.0, 0.0), Point3::new(0.1, 0.0, 0.0)];
+        let mut cloud = PointCloud::from_sigma(pts.clone(), 0.001).unwrap();
+        for t in [1e300, Real::INFINITY, Real::NAN] {
+            let pose = Pose::translation(t, 0.0, 0.0);
+            let err = cloud.transformed(&pose).unwrap_err().to_string();
+            assert!(
+                err.contains("the pose moves the cloud out of range"),
+                "{err}"
+            );
+            assert!(cloud.transform(&pose).is_err());
+            assert_eq!(cloud.points(), &pts[..]);
+        }
+        let moved = cloud
+            .transformed(&Pose::translation(1.0, 0.0, 0.0))
+            .unwrap();
+        assert_eq!(moved.points()[1], Point3::new(1.1, 0.0, 0.0));
+    }
 
     /// The grid path (large clouds) and the tree path give the same spacing.
     #[test]
