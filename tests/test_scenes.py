@@ -107,6 +107,11 @@ def test_elements_do_not_read_a_collision_off_a_surface_that_does_not_describe_i
         pose = scene.piano_pose(gap_sigmas * s)
         return cloudprox.collide(pa, room_cloud, pose_a=pose, model="elements").probability
 
-    assert p(4.0) <= 0.1
+    # 20 mm (4 sigma) is less than half the clouds' sampling spacing (the
+    # 6th-neighbour distance: 44 mm on the piano, 53 mm in the room), where
+    # sampled surfaces may touch: no collision is read there (it read P = 1),
+    # and 8 sigma is free.
+    assert p(4.0) < 0.5
+    assert p(8.0) <= 0.1
     assert p(15.0) == 0.0
     assert p(-1.0) >= 0.9 and p(-3.0) >= 0.9

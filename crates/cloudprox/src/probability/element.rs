@@ -407,18 +407,16 @@ pub(crate) fn element_crossing_probabilities(
         let span = (f.y - f.x).norm();
         if span <= f.allowed + reach_sds * sd {
             let p = wrong_side(gap, sd);
-            if steep {
-                // The separating surface runs across the two surfaces here,
-                // not between them: it says nothing of their order.
-                out.undescribed_max = out.undescribed_max.max(p);
-            } else if p < 0.5 {
+            if p < 0.5 {
                 out.described_max = out.described_max.max(p);
             } else if p > out.undescribed_max.min(out.described_max) {
                 // Only a pair that would cross and could raise one of the two
                 // maxima needs the test.
                 let (fx, fy) = (sep.value_local(&f.x), sep.value_local(&f.y));
                 let near_end = fx.abs().min(fy.abs()) / gn;
-                if fx * fy > 0.0 && near_end > span + f.allowed + reach_sds * sd {
+                // A separating surface running across the two surfaces here,
+                // not between them, says nothing of their order either.
+                if steep || (fx * fy > 0.0 && near_end > span + f.allowed + reach_sds * sd) {
                     out.undescribed_max = out.undescribed_max.max(p);
                 } else {
                     out.described_max = out.described_max.max(p);
@@ -441,12 +439,13 @@ pub(crate) fn element_crossing_probabilities(
 /// point), turned towards B by the separating surface: the surfaces' own
 /// geometry gives the distance, the separator only the order. A probe beside
 /// the other element is measured along `u_sep` (along the normal, a probe
-/// beside a coplanar neighbour reads a gap near 0). Two single points are
-/// measured along `u_sep`. The separator runs across the surfaces when its
-/// normal is closer to their tangent plane than to their normal (more than
-/// 45 degrees from the facing element's normal): there the side each surface
-/// is on is not the side the separator puts it, and the order it gives is
-/// not known.
+/// beside a coplanar neighbour reads a gap near 0) and is never flagged. Two
+/// single points are measured along `u_sep`. The separator runs across the
+/// surfaces when its normal is closer to their tangent plane than to their
+/// normal (more than 45 degrees from the facing element's normal): there the
+/// side each surface is on is not the side the separator puts it, and the
+/// order it gives is not known (a crossing read there is undescribed, see
+/// [`ElementCrossings`]).
 fn pair_direction(
     own: &Posed<'_>,
     other: &Posed<'_>,
@@ -466,7 +465,7 @@ fn pair_direction(
     let c = n.dot(u_sep);
     let steep = c.abs() < std::f64::consts::FRAC_1_SQRT_2;
     if beside {
-        (*u_sep, steep)
+        (*u_sep, false)
     } else {
         (if c >= 0.0 { n } else { -n }, steep)
     }
@@ -477,10 +476,10 @@ fn pair_direction(
 /// among the pairs the separating surface describes and among those it does
 /// not.
 ///
-/// A pair is *undescribed* where the separating surface runs across the two
-/// surfaces rather than between them (its normal more than 45 degrees from
-/// the facing element's; see [`pair_direction`]); and a pair that would cross
-/// (`Phi(-g/s) >= 1/2`) is also undescribed when `x` and
+/// A pair that would cross (`Phi(-g/s) >= 1/2`) is *undescribed* where the
+/// separating surface runs across the two surfaces rather than between them
+/// (its normal more than 45 degrees from the facing element's; see
+/// [`pair_direction`]), or when `x` and
 /// `y` lie on the same side of the separating surface, both farther from it
 /// than the pair spans (the pair's length plus `h/2 + reach_sds s`; the
 /// distance to the surface read as `|f| / |grad f|` at the nearer end). There
@@ -653,7 +652,7 @@ mod tests {
                 assert!(u.dot(&u_sep) > 0.0);
                 // Beside the other element: along the separator's normal.
                 let (u, s) = pair_direction(&plane, &plane, true, &u_sep);
-                assert_eq!((u, s), (u_sep, steep));
+                assert_eq!((u, s), (u_sep, false));
             }
         }
         // Two single points: the separator's normal, never steep.
