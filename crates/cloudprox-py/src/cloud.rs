@@ -79,6 +79,32 @@ pub(crate) fn noise_from(
     }
 }
 
+/// The discretization settings asked for: `None` without discretization, the
+/// core's defaults with `k` (checked) replaced when given; `k` without
+/// discretization is refused.
+pub(crate) fn discretization_settings(
+    py: Python<'_>,
+    discretization: bool,
+    k: Option<i64>,
+) -> PyResult<Option<DiscretizationSettings>> {
+    match (discretization, k) {
+        (true, k) => {
+            let mut settings = DiscretizationSettings::default();
+            if let Some(k) = k {
+                settings.k = usize::try_from(k).map_err(|_| {
+                    invalid_input(py, format!("discretization k must be >= 2, got {k}"))
+                })?;
+            }
+            Ok(Some(settings))
+        }
+        (false, None) => Ok(None),
+        (false, Some(k)) => Err(invalid_input(
+            py,
+            format!("k = {k} is only used with discretization=True"),
+        )),
+    }
+}
+
 /// A point cloud with a 3x3 covariance per point (the sensor noise, plus the
 /// discretization error if requested), in its own frame.
 ///
@@ -167,22 +193,7 @@ impl PyPointCloud {
         k: Option<i64>,
         noise_correlation: Option<f64>,
     ) -> PyResult<Self> {
-        let disc = if discretization {
-            let mut settings = DiscretizationSettings::default();
-            if let Some(k) = k {
-                settings.k = usize::try_from(k).map_err(|_| {
-                    invalid_input(py, format!("discretization k must be >= 2, got {k}"))
-                })?;
-            }
-            Some(settings)
-        } else if let Some(k) = k {
-            return Err(invalid_input(
-                py,
-                format!("k = {k} is only used with discretization=True"),
-            ));
-        } else {
-            None
-        };
+        let disc = discretization_settings(py, discretization, k)?;
         let disc_k = disc.map(|d| d.k);
         let cloud = run_detached(py, move || {
             let cloud = match noise {

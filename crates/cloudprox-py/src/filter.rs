@@ -24,7 +24,8 @@ fn point3_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Point3> {
     Ok(Point3::from(vector3_from(obj, what)?))
 }
 
-fn usize_arg(py: Python<'_>, v: i64, what: &str, min: i64) -> PyResult<usize> {
+/// `v` as a `usize`, refused by name below `min`.
+pub(crate) fn usize_arg(py: Python<'_>, v: i64, what: &str, min: i64) -> PyResult<usize> {
     if v < min {
         return Err(invalid_input(
             py,
@@ -32,6 +33,42 @@ fn usize_arg(py: Python<'_>, v: i64, what: &str, min: i64) -> PyResult<usize> {
         ));
     }
     usize::try_from(v).map_err(|_| invalid_input(py, format!("{what} is too large: {v}")))
+}
+
+/// The voxel filter's covariance rule by name: `"mean"` or `"independent"`.
+pub(crate) fn covariance_merge(py: Python<'_>, merge: &str) -> PyResult<CovarianceMerge> {
+    match merge {
+        "mean" => Ok(CovarianceMerge::Mean),
+        "independent" => Ok(CovarianceMerge::MeanOfIndependent),
+        other => Err(invalid_input(
+            py,
+            format!("merge must be \"mean\" or \"independent\", got {other:?}"),
+        )),
+    }
+}
+
+/// The outlier filter's neighbour count: `k` checked, or the core's default.
+pub(crate) fn outlier_k(py: Python<'_>, k: Option<i64>) -> PyResult<usize> {
+    match k {
+        Some(k) => usize_arg(py, k, "k", 1),
+        None => Ok(SOR_DEFAULT_K),
+    }
+}
+
+/// The shadow filter's settings: those given, checked, the core's defaults
+/// for the others.
+pub(crate) fn shadow_settings(
+    py: Python<'_>,
+    min_angle_deg: Option<f64>,
+    window: Option<i64>,
+    k: Option<i64>,
+) -> PyResult<ShadowSettings> {
+    let default = ShadowSettings::default();
+    Ok(ShadowSettings {
+        min_angle: min_angle_deg.map_or(default.min_angle, f64::to_radians),
+        window: window.map_or(Ok(default.window), |w| usize_arg(py, w, "window", 1))?,
+        k: k.map_or(Ok(default.k), |k| usize_arg(py, k, "k", 1))?,
+    })
 }
 
 /// Indices (ascending, int64) of the points inside the box `[min, max]` (outside
@@ -99,16 +136,7 @@ pub fn voxel_downsample<'py>(
     let covs = covariances
         .map(|c| matrices3_from(c, "covariances"))
         .transpose()?;
-    let merge = match merge {
-        "mean" => CovarianceMerge::Mean,
-        "independent" => CovarianceMerge::MeanOfIndependent,
-        other => {
-            return Err(invalid_input(
-                py,
-                format!("merge must be \"mean\" or \"independent\", got {other:?}"),
-            ))
-        }
-    };
+    let merge = covariance_merge(py, merge)?;
     let v = run_detached(py, move || {
         filter::voxel_downsample_with(&points, covs.as_deref(), voxel_size, merge)
     })?;
@@ -139,10 +167,7 @@ pub fn statistical_outlier_removal<'py>(
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let std_ratio = std_ratio.unwrap_or(SOR_DEFAULT_STD_RATIO);
     let points = points_from(points, "points")?;
-    let k = match k {
-        Some(k) => usize_arg(py, k, "k", 1)?,
-        None => SOR_DEFAULT_K,
-    };
+    let k = outlier_k(py, k)?;
     let keep = run_detached(py, move || {
         filter::statistical_outlier_removal(&points, k, std_ratio)
     })?;
@@ -209,12 +234,7 @@ pub fn shadow_filter<'py>(
             ))
         }
     };
-    let default = ShadowSettings::default();
-    let settings = ShadowSettings {
-        min_angle: min_angle_deg.map_or(default.min_angle, f64::to_radians),
-        window: window.map_or(Ok(default.window), |w| usize_arg(py, w, "window", 1))?,
-        k: k.map_or(Ok(default.k), |k| usize_arg(py, k, "k", 1))?,
-    };
+    let settings = shadow_settings(py, min_angle_deg, window, k)?;
     let keep = run_detached(py, move || {
         filter::shadow_filter(&points, &origin, grid.as_ref(), &settings)
     })?;

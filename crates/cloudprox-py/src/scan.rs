@@ -2,27 +2,16 @@
 //! core's `cloud::ScanPipeline`).
 
 use cloudprox::cloud::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
-use cloudprox::filter::{CovarianceMerge, ShadowSettings, SOR_DEFAULT_K, SOR_DEFAULT_STD_RATIO};
+use cloudprox::filter::SOR_DEFAULT_STD_RATIO;
 use cloudprox::math::Point3;
-use cloudprox::uncertainty::DiscretizationSettings;
 use pyo3::prelude::*;
 
-use crate::cloud::PyPointCloud;
+use crate::cloud::{discretization_settings, PyPointCloud};
 use crate::convert::{pose_from, vector3_from};
 use crate::error::{invalid_input, run_detached};
-use crate::filter::PySelfFilter;
+use crate::filter::{covariance_merge, outlier_k, shadow_settings, PySelfFilter};
 use crate::io::PyCloudFile;
 use crate::sensor::sensor_model_from;
-
-fn usize_arg(py: Python<'_>, v: i64, what: &str, min: i64) -> PyResult<usize> {
-    if v < min {
-        return Err(invalid_input(
-            py,
-            format!("{what} must be >= {min}, got {v}"),
-        ));
-    }
-    usize::try_from(v).map_err(|_| invalid_input(py, format!("{what} is too large: {v}")))
-}
 
 /// One filter step of `scan_to_cloud`, made by its static methods.
 #[pyclass(name = "ScanStep", frozen, module = "cloudprox._native")]
@@ -58,16 +47,7 @@ impl PyScanStep {
     #[staticmethod]
     #[pyo3(signature = (size, merge="mean"))]
     fn voxel(py: Python<'_>, size: f64, merge: &str) -> PyResult<Self> {
-        let merge = match merge {
-            "mean" => CovarianceMerge::Mean,
-            "independent" => CovarianceMerge::MeanOfIndependent,
-            other => {
-                return Err(invalid_input(
-                    py,
-                    format!("merge must be \"mean\" or \"independent\", got {other:?}"),
-                ))
-            }
-        };
+        let merge = covariance_merge(py, merge)?;
         Ok(Self {
             inner: ScanStep::Voxel { size, merge },
         })
@@ -78,13 +58,9 @@ impl PyScanStep {
     #[staticmethod]
     #[pyo3(signature = (k=None, std_ratio=None))]
     fn outliers(py: Python<'_>, k: Option<i64>, std_ratio: Option<f64>) -> PyResult<Self> {
-        let k = match k {
-            Some(k) => usize_arg(py, k, "k", 1)?,
-            None => SOR_DEFAULT_K,
-        };
         Ok(Self {
             inner: ScanStep::Outliers {
-                k,
+                k: outlier_k(py, k)?,
                 std_ratio: std_ratio.unwrap_or(SOR_DEFAULT_STD_RATIO),
             },
         })
@@ -100,13 +76,8 @@ impl PyScanStep {
         window: Option<i64>,
         k: Option<i64>,
     ) -> PyResult<Self> {
-        let default = ShadowSettings::default();
         Ok(Self {
-            inner: ScanStep::Shadow(ShadowSettings {
-                min_angle: min_angle_deg.map_or(default.min_angle, f64::to_radians),
-                window: window.map_or(Ok(default.window), |w| usize_arg(py, w, "window", 1))?,
-                k: k.map_or(Ok(default.k), |k| usize_arg(py, k, "k", 1))?,
-            }),
+            inner: ScanStep::Shadow(shadow_settings(py, min_angle_deg, window, k)?),
         })
     }
 
@@ -223,24 +194,7 @@ pub fn scan_to_cloud(
         (None, Some(p)) => SensorPlacement::Pose(pose_from(py, Some(p), "sensor_pose")?),
         (None, None) => SensorPlacement::FromScan,
     };
-    let disc = match (discretization, k) {
-        (true, k) => {
-            let mut settings = DiscretizationSettings::default();
-            if let Some(k) = k {
-                settings.k = usize::try_from(k).map_err(|_| {
-                    invalid_input(py, format!("discretization k must be >= 2, got {k}"))
-                })?;
-            }
-            Some(settings)
-        }
-        (false, None) => None,
-        (false, Some(k)) => {
-            return Err(invalid_input(
-                py,
-                format!("k = {k} is only used with discretization=True"),
-            ))
-        }
-    };
+    let disc = discretization_settings(py, discretization, k)?;
     let pipeline = ScanPipeline::new(noise)
         .placement(placement)
         .steps(steps.into_iter().map(|s| s.get().inner.clone()))
