@@ -77,6 +77,7 @@ def test_result_fields(sweep, spheres) -> None:
         "patches",
         "misfit_cuts",
         "patches_beyond_reach",
+        "surface_crossings",
         "points_classified",
         "solver_iterations",
         "barrier_fallbacks",

@@ -359,6 +359,9 @@ class QueryStats:
     def patches_beyond_reach(self) -> int:
         """Patches of the elements model pruned because no element faces the other side within the noise's reach."""
     @property
+    def surface_crossings(self) -> int:
+        """Element surface pairs found crossing before any patch (``decide_only`` with elements: a collision decided without a classifier)."""
+    @property
     def points_classified(self) -> int:
         """Points of both clouds that went into a classifier."""
     @property

@@ -5,7 +5,7 @@
 mod common;
 
 use cloudprox::prelude::*;
-use cloudprox::probability::{normal_cdf, point_probability};
+use cloudprox::probability::{normal_cdf, normal_quantile, point_probability};
 use cloudprox::sample::{add_noise, NormalRng};
 use common::{sphere_pose, spheres, SIGMA};
 
@@ -200,13 +200,99 @@ fn decide_only_gives_the_full_querys_state() {
             .decide_only(true)
             .build()
             .unwrap();
+        let mut crossings = 0;
         for gap in [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 20.0] {
             let pb = sphere_pose(gap * SIGMA);
             let r = collide(&Pose::identity(), &a, &pb, &b, &full).unwrap();
             let q = collide(&Pose::identity(), &a, &pb, &b, &quick).unwrap();
             assert_eq!(r.state, q.state, "{model:?} gap {gap}");
             assert!(q.probabilities_a.iter().all(|&p| p == 0.0));
+            crossings += q.stats.counters.surface_crossings;
         }
+        // The elements' deepest pose (4 sigma, 8 mm) is decided by a crossing
+        // of surfaces; the points model has none.
+        match model {
+            QueryModel::Elements => assert!(crossings >= 1, "{crossings} crossings"),
+            QueryModel::Points => assert_eq!(crossings, 0),
+        }
+    }
+}
+
+#[test]
+fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classifier() {
+    // Two 10 000-point spheres: interpenetrating by 3 sigma their surfaces
+    // cross along a ring, which the hierarchies find before any near set; a
+    // sigma apart and beyond nothing crosses, and the query goes on as before.
+    let (a, b) = spheres(10000);
+    let quick = CollisionRequest::builder()
+        .model(QueryModel::Elements)
+        .decide_only(true)
+        .build()
+        .unwrap();
+    for gap in [-6.0, -3.0, -2.0] {
+        let q = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &quick).unwrap();
+        assert_eq!(q.stats.counters.surface_crossings, 1, "gap {gap}");
+        assert_eq!(q.state, CollisionState::Collision, "gap {gap}");
+        assert!(q.regions.is_empty() && q.stats.counters.points_classified == 0);
+        // The crossing's bound at the noise's reach: 1 - 2 Phi(-z).
+        let z = -normal_quantile(0.5 * quick.prune_epsilon);
+        assert!((q.probability - (1.0 - 2.0 * normal_cdf(-z))).abs() < 1e-12);
+    }
+    for gap in [1.0, 3.0, 8.0] {
+        let q = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &quick).unwrap();
+        assert_eq!(q.stats.counters.surface_crossings, 0, "gap {gap}");
+        assert_ne!(q.state, CollisionState::Collision, "gap {gap}");
+    }
+    // The full query never takes the shortcut.
+    let r = collide(
+        &Pose::identity(),
+        &a,
+        &sphere_pose(-3.0 * SIGMA),
+        &b,
+        &elements(),
+    )
+    .unwrap();
+    assert_eq!(r.stats.counters.surface_crossings, 0);
+    assert_eq!(r.state, CollisionState::Collision);
+    // A collision threshold above the reach's confidence asks more of the
+    // crossing: both probes then read beyond the threshold's quantile.
+    let strict = CollisionRequest::builder()
+        .model(QueryModel::Elements)
+        .decide_only(true)
+        .thresholds(1.0 - 1e-9, 0.1)
+        .build()
+        .unwrap();
+    let q = collide(
+        &Pose::identity(),
+        &a,
+        &sphere_pose(-6.0 * SIGMA),
+        &b,
+        &strict,
+    )
+    .unwrap();
+    assert!(q.probability >= 1.0 - 1e-9);
+}
+
+#[test]
+fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
+    // A's slab face tilted by 0.2 rad about y through B's (flat) face: the
+    // faces cross along the y axis. B's face lifted so that A's face lies
+    // 2 sigma below it everywhere: parallel, no crossing (though in contact).
+    let sigma = 0.0005;
+    let a = slab(30, 0.004, (0.2, 0.0), -0.05, sigma, 1);
+    let tilted_back = slab(30, 0.004, (0.0, 0.0), 0.05, sigma, 2);
+    let quick = CollisionRequest::builder()
+        .model(QueryModel::Elements)
+        .decide_only(true)
+        .build()
+        .unwrap();
+    let q = collide_at_height(&a, &tilted_back, 0.0, &quick);
+    assert_eq!(q.stats.counters.surface_crossings, 1);
+    assert_eq!(q.state, CollisionState::Collision);
+    let flat = slab(30, 0.004, (0.0, 0.0), -0.05, sigma, 3);
+    for z in [-2.0 * sigma, 0.0, 2.0 * sigma] {
+        let q = collide_at_height(&flat, &tilted_back, z, &quick);
+        assert_eq!(q.stats.counters.surface_crossings, 0, "height {z}");
     }
 }
 
@@ -375,5 +461,38 @@ proptest! {
             prop_assert!(!(x <= 0.01 && y > 0.1), "{}: {} vs {} at gap {} sigma", what, x, y, gap);
             prop_assert!(!(x >= 0.99 && y < 0.9), "{}: {} vs {} at gap {} sigma", what, x, y, gap);
         }
+    }
+
+    /// Deciding only gives the full query's state, with or without a crossing
+    /// of element surfaces found first (sphere pairs of random sizes, noise,
+    /// outliers and poses from 6 sigma of interpenetration to 6 apart).
+    #[test]
+    fn decide_only_agrees_with_the_full_query(
+        na in 300usize..3000,
+        nb in 300usize..3000,
+        ra in 0.03f64..0.08,
+        rb in 0.03f64..0.08,
+        sigma in 0.0005f64..0.004,
+        outliers in 0usize..6,
+        gap in -6.0f64..6.0,
+        dir in prop::array::uniform3(-1.0f64..1.0).prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01),
+        rot in prop::array::uniform3(-3.0f64..3.0),
+        seed in 0u64..1000,
+    ) {
+        let (a, b, pose_b) = sphere_scene(
+            (na, nb), (ra, rb), sigma, outliers, gap, Vector3::from(dir), Vector3::from(rot), seed,
+        );
+        let quick = CollisionRequest::builder()
+            .model(QueryModel::Elements)
+            .decide_only(true)
+            .build()
+            .unwrap();
+        let r = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
+        let q = collide(&Pose::identity(), &a, &pose_b, &b, &quick).unwrap();
+        prop_assert_eq!(
+            r.state, q.state,
+            "gap {} sigma: full P = {}, decide-only P = {} (crossings {})",
+            gap, r.probability, q.probability, q.stats.counters.surface_crossings
+        );
     }
 }

@@ -219,18 +219,19 @@ struct PosedHull {
     corners: [Point3; 4],
 }
 
-/// Whether some element of `a` (at `rel` in `b`'s frame) may reach one of
-/// `b`: two single points whose hulls pass [`pair_may_reach`] (a superset of
-/// the near rule), or a pair with a surface that passes it and then
-/// `faces(ea, eb)` (the caller's exact test of the pair). `false` proves that
-/// no pair does. Returns the answer and the number of node pairs tested.
+/// Whether some pair of elements, `ea` of `a` (at `rel` in `b`'s frame) and
+/// `eb` of `b`, passes [`pair_may_reach`] (its surfaces may lie within reach
+/// of each other) and then `test(ea, eb)`, the caller's exact test of the pair
+/// (whether it faces the other within reach, or whether the two surfaces
+/// cross). The traversal stops at the first such pair; `false` proves that no
+/// pair passes both. Returns the answer and the number of node pairs tested.
 pub(crate) fn surfaces_may_reach(
     a: &ElementHulls,
     rel: &Pose,
     b: &ElementHulls,
     reach_sds: Real,
     workspace: &mut BvhWorkspace,
-    mut faces: impl FnMut(u32, u32) -> bool,
+    mut test: impl FnMut(u32, u32) -> bool,
 ) -> (bool, usize) {
     // All of A as one box first: a node pair of the traversal below can only
     // pass where A's root passes with B's node (the root's box, sigma and
@@ -276,7 +277,7 @@ pub(crate) fn surfaces_may_reach(
                 let h = &a.hulls[e as usize];
                 for &f in b.tree.node_points(lb) {
                     let g = &b.hulls[f as usize];
-                    if pair_may_reach(h, p, g, reach_sds) && ((h.point && g.point) || faces(e, f)) {
+                    if pair_may_reach(h, p, g, reach_sds) && test(e, f) {
                         found = true;
                         return false;
                     }

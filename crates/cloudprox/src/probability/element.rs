@@ -325,6 +325,80 @@ pub(crate) fn element_pair_within_reach(
         && (pa.probes_reach(&pb, reach_sds) || pb.probes_reach(&pa, reach_sds))
 }
 
+/// Whether the fitted surfaces of elements `a` (its cloud at `pose_a` in `b`'s
+/// frame) and `b` cross: probes of one lie over the other's sampled surface
+/// (within its extent, where its footprint has points) on both sides of it,
+/// each farther from it than `z_sds` standard deviations of the pair's heights
+/// and no farther than half a spacing plus `z_sds` of them (near the crossing,
+/// where a facing pair of [`element_crossing_probabilities`] counts).
+///
+/// Two sampled surfaces of different objects cross only where the objects
+/// overlap, whichever side of either is inside, so a crossing decides a
+/// collision without a separating surface. The probability that the two
+/// surfaces do not cross although both probes read beyond `z_sds` is at most
+/// `2 Phi(-z_sds)` (a union bound over the two probes). Single points never
+/// cross anything: they have no side.
+pub(crate) fn element_pair_crosses(
+    a: (&SurfaceElement, &Hull),
+    pose_a: &Pose,
+    b: (&SurfaceElement, &Hull),
+    z_sds: Real,
+) -> bool {
+    if a.0.is_point() || b.0.is_point() {
+        return false;
+    }
+    let (pa, pb) = (Posed::new(a, pose_a), Posed::new(b, &Pose::identity()));
+    pa.may_reach(&pb, z_sds) && (pa.straddles(&pb, z_sds) || pb.straddles(&pa, z_sds))
+}
+
+impl Posed<'_> {
+    /// Whether probes of `self` lie over `other`'s sampled surface on both
+    /// sides of it, each between `z_sds` standard deviations of the pair's
+    /// heights and half a spacing plus that (see [`element_pair_crosses`]).
+    fn straddles(&self, other: &Posed<'_>, z_sds: Real) -> bool {
+        let n = other.normal;
+        // The height over `other`'s plane is affine along `self`'s plane, so
+        // its probes lie on both sides only if its hull's corners do.
+        let height = |x: &Point3| {
+            let (u, v) = other.coordinates(x);
+            let h = &other.e.height;
+            n.dot(&(x - other.mean)) - (h[0] + h[1] * u + h[2] * v)
+        };
+        let (lo, hi) = self
+            .corners
+            .iter()
+            .map(height)
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), c| {
+                (l.min(c), h.max(c))
+            });
+        if lo >= 0.0 || hi <= 0.0 {
+            return false;
+        }
+        let allowed = HALF_SPACING * self.e.spacing.max(other.e.spacing);
+        let (mut above, mut below) = (false, false);
+        for &[u, v] in &self.e.probes {
+            let (x, var_x) = self.at(u, v);
+            let (ou, ov) = other.coordinates(&x);
+            if !other.is_over(ou, ov) || !other.e.covers(ou, ov) {
+                continue;
+            }
+            let (y, var_y) = other.at(ou, ov);
+            let h = n.dot(&(x - y));
+            let sd = (self.var_along(var_x, &n) + other.var_along(var_y, &n))
+                .max(0.0)
+                .sqrt();
+            if h.abs() > z_sds * sd && h.abs() <= allowed + z_sds * sd {
+                above |= h > 0.0;
+                below |= h < 0.0;
+                if above && below {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
 /// Whether some probe of either side faces the other side within the noise's
 /// reach (`|y - x| <= h/2 + reach_sds s` with `s` bounded over all directions):
 /// when none does, the surfaces cannot cross and no separating surface is

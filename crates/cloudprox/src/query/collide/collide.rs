@@ -7,11 +7,11 @@ use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{crossing_probabilities, normal_quantile, Aggregation};
+use crate::probability::{crossing_probabilities, normal_cdf, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
-    element_crossings, element_points, element_sides_within_reach, element_surfaces_may_reach,
-    has_surface_element,
+    element_crossings, element_points, element_sides_within_reach, element_surfaces_cross,
+    element_surfaces_may_reach, has_surface_element,
 };
 use crate::query::collide::near::{near_set, NearSet};
 use crate::query::collide::probabilities::{
@@ -102,6 +102,33 @@ pub(crate) fn collide_with_workspace(
         }
         _ => false,
     };
+    // Deciding only, the elements model then looks for two element surfaces
+    // that cross: a collision, whichever side of either is inside, decided
+    // without a near set or a classifier.
+    if let (true, true, false, Some((ea, eb))) = (
+        request.decide_only,
+        request.use_hierarchy,
+        beyond_reach,
+        elements,
+    ) {
+        let z = crossing_sds(reach, request.thresholds.collision);
+        let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
+        stats.counters.node_pairs_visited += visited;
+        if crossed {
+            stats.counters.surface_crossings += 1;
+            // The bound's confidence (at least the collision threshold).
+            let probability = (1.0 - 2.0 * normal_cdf(-z)).max(request.thresholds.collision);
+            stats.time_seconds = start.elapsed().as_secs_f64();
+            return Ok(CollisionResult {
+                probability,
+                state: request.thresholds.state(probability),
+                probabilities_a: vec![0.0; a.len()],
+                probabilities_b: vec![0.0; b.len()],
+                regions: Vec::new(),
+                stats,
+            });
+        }
+    }
     let near = if beyond_reach {
         NearSet::empty(sa.len(), sb.len())
     } else {
@@ -310,6 +337,14 @@ pub(crate) fn collide_with_workspace(
         regions,
         stats,
     })
+}
+
+/// The standard deviations beyond which both probes of a crossing must read
+/// ([`element_surfaces_cross`]): the noise's reach (`reach`), or more when the
+/// collision threshold asks for more confidence than the reach gives (the
+/// crossing's probability is at least `1 - 2 Phi(-z)`).
+fn crossing_sds(reach: Real, collision: Real) -> Real {
+    reach.max(-normal_quantile(0.5 * (1.0 - collision)))
 }
 
 /// Patches are cut on a misfit only while both halves keep this many points of

@@ -7,7 +7,8 @@ use crate::classify::Separator;
 use crate::element::{surfaces_may_reach, SurfaceElements};
 use crate::math::Pose;
 use crate::probability::{
-    element_crossing_probabilities, element_pair_within_reach, elements_within_reach, ElementSide,
+    element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
+    elements_within_reach, ElementSide,
 };
 use crate::Real;
 
@@ -73,12 +74,45 @@ pub(crate) fn element_surfaces_may_reach(
         return (true, 0);
     }
     let (ha, hb) = (ea.hulls(), eb.hulls());
+    // Two single points whose hulls pass the hull test (a superset of the
+    // near rule) may reach each other; a pair with a surface must face.
     let faces = |i: u32, j: u32| {
-        let a = (&ea.elements()[i as usize], ha.hull(i));
-        let b = (&eb.elements()[j as usize], hb.hull(j));
-        element_pair_within_reach(a, rel, b, reach_sds)
+        let (h, g) = (ha.hull(i), hb.hull(j));
+        (h.point && g.point) || {
+            let a = (&ea.elements()[i as usize], h);
+            let b = (&eb.elements()[j as usize], g);
+            element_pair_within_reach(a, rel, b, reach_sds)
+        }
     };
     surfaces_may_reach(ha, rel, hb, reach_sds, workspace, faces)
+}
+
+/// Whether the fitted surfaces of some element of `ea` (at `rel` in `eb`'s
+/// frame) and some element of `eb` cross, each beyond `z_sds` standard
+/// deviations on both sides of the other ([`element_pair_crosses`]), found by
+/// the hierarchies over both clouds' element hulls. Returns the answer and
+/// the number of node pairs tested.
+///
+/// Two sampled surfaces of different objects cross only where the objects
+/// overlap, whichever side of each is inside: a crossing decides a collision
+/// without a separating surface (the `decide_only` query's first test).
+pub(crate) fn element_surfaces_cross(
+    ea: &SurfaceElements,
+    rel: &Pose,
+    eb: &SurfaceElements,
+    z_sds: Real,
+    workspace: &mut BvhWorkspace,
+) -> (bool, usize) {
+    if !z_sds.is_finite() {
+        return (false, 0);
+    }
+    let (ha, hb) = (ea.hulls(), eb.hulls());
+    let crosses = |i: u32, j: u32| {
+        let a = (&ea.elements()[i as usize], ha.hull(i));
+        let b = (&eb.elements()[j as usize], hb.hull(j));
+        element_pair_crosses(a, rel, b, z_sds)
+    };
+    surfaces_may_reach(ha, rel, hb, z_sds, workspace, crosses)
 }
 
 /// Whether some sample of `samples` stands for an element of more than one point.

@@ -57,6 +57,10 @@ pub struct QueryCounters {
     /// of either side faces the other within the noise's reach (their points
     /// keep `p_i = 0`).
     pub patches_beyond_reach: usize,
+    /// Element surface pairs found crossing by the hierarchies before any
+    /// patch (`decide_only` with the elements model: a collision decided
+    /// without a classifier; 0 or 1).
+    pub surface_crossings: usize,
     /// Points of both clouds that went into a classifier.
     pub points_classified: usize,
     /// Interior-point iterations over all patches.
