@@ -23,14 +23,15 @@ pub(crate) fn point_probabilities(
     label: Real,
     out: &mut [Real],
 ) {
-    let r = pose.rotation.to_rotation_matrix();
-    let r = r.matrix();
+    // The gradient is turned into the cloud's frame rather than every
+    // covariance into the separator's: `g^T (R C R^T) g = (R^T g)^T C (R^T g)`.
+    let back = pose.rotation.inverse();
     for &i in idx {
         let i = i as usize;
         let x = pose * cloud.points()[i];
-        let cov = r * cloud.covariances()[i] * r.transpose();
         let (f, g) = sep.value_and_gradient_local(&x);
-        out[i] = out[i].max(point_probability(f, &g, &cov, label));
+        let p = point_probability(f, &(back * g), &cloud.covariances()[i], label);
+        out[i] = out[i].max(p);
     }
 }
 
