@@ -11,9 +11,11 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   the robot's exact link meshes (a ``DynamicAABBTreeCollisionManager``) against
   the exact scene meshes (the anchor) and against the collision map's occupied
   voxels as boxes (sensor resolution and 2 cm), the links posed beforehand (not
-  timed). Far: uniformly random configurations whose exact clearance exceeds 5
-  sigma (the scan's median sigma); near contact: the agreement set below, free
-  and within 5 sigma.
+  timed). Each model also with ``decide_only=True`` (what a planner's chance
+  constraint asks). Far: uniformly random configurations whose exact clearance
+  exceeds 5 sigma (the scan's median sigma); near contact: the agreement set
+  below, free and within 5 sigma; penetrating: the agreement set's colliding
+  configurations.
 * **collide_robot_many** on 10 000 random configurations with 1 and 2 threads
   (separate processes).
 * **Agreement with the exact scene** over ``--near`` configurations near it: from
@@ -234,17 +236,24 @@ def main() -> None:
     for model in MODELS:  # link samples, scan hierarchy and elements: built once
         cp.collide_robot(robot, qs[0], cloud, model=model)
     rows = []
-    for name, sel in (("far (> 5 sigma)", far), ("near contact (free, <= 5 sigma)", free_near)):
+    penetrating = near_q[near_d < 0]
+    cases = (
+        ("far (> 5 sigma)", far),
+        ("near contact (free, <= 5 sigma)", free_near),
+        ("penetrating", penetrating),
+    )
+    for name, sel in cases:
         t_cp = {
-            model: np.array(
+            (model, decide): np.array(
                 [
                     cp.collide_robot(
-                        robot, q, cloud, self_collision=False, model=model
+                        robot, q, cloud, self_collision=False, model=model, decide_only=decide
                     ).stats.time_seconds
                     for q in sel
                 ]
             )
             for model in MODELS
+            for decide in (False, True)
         }
         t_ex = fcl_call_times(exact, sel)
         t_maps = {k: fcl_call_times(c, sel) for k, c in maps.items()}
@@ -254,21 +263,24 @@ def main() -> None:
         f"(median sigma {sigma * 1e3:.2f} mm):\n"
     )
     map_names = list(maps)
+    modes = [(m, d) for m in MODELS for d in (False, True)]
     print(
         "| configurations | n | "
-        + " | ".join(f"cloudprox `collide_robot`, {m}" for m in MODELS)
+        + " | ".join(
+            f"cloudprox `collide_robot`, {m}{', decide-only' if d else ''}" for m, d in modes
+        )
         + " | python-fcl exact meshes | "
         + " | ".join(f"python-fcl {k} boxes" for k in map_names)
         + " | cloudprox (elements) / fcl exact |"
     )
-    print("|---|---|" + "---|" * (len(MODELS) + 1 + len(map_names)) + "---|")
+    print("|---|---|" + "---|" * (len(modes) + 1 + len(map_names)) + "---|")
     for name, n, t_cp, t_ex, t_maps in rows:
         print(
             f"| {name} | {n} | "
-            + " | ".join(us(t_cp[m]) for m in MODELS)
+            + " | ".join(us(t_cp[md]) for md in modes)
             + f" | {us(t_ex)} | "
             + " | ".join(us(t_maps[k]) for k in map_names)
-            + f" | {np.median(t_cp[MODELS[0]]) / np.median(t_ex):.1f}x |"
+            + f" | {np.median(t_cp[(MODELS[0], False)]) / np.median(t_ex):.1f}x |"
         )
 
     seconds = {k: many_seconds(k, args.many, args.seed) for k in (1, 2)}
@@ -279,10 +291,13 @@ def main() -> None:
     )
 
     answers = {
-        f"cloudprox ({model})": np.asarray(
-            cp.collide_robot_many(robot, near_q, cloud, self_collision=False, model=model).states
+        f"cloudprox ({model}{', decide-only' if decide else ''})": np.asarray(
+            cp.collide_robot_many(
+                robot, near_q, cloud, self_collision=False, model=model, decide_only=decide
+            ).states
         )
         for model in MODELS
+        for decide in (False, True)
     }
     states = answers[f"cloudprox ({MODELS[0]})"]
     label = near_d <= 0.0

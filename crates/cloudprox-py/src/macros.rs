@@ -5,7 +5,9 @@
 /// A frozen Python class over a core statistics struct `$core` made of
 /// `counters: $counters` and `time_seconds`. The one list of counters given
 /// here makes the getters, `to_dict` (the counters, then `time_seconds`),
-/// pickling (a tuple of the same, in that order) and `__repr__` (the fields
+/// pickling (the tuple of the counters in that order, then `time_seconds`:
+/// nested, so that a tuple stays within the 12 items pyo3 converts) and
+/// `__repr__` (the fields
 /// named after `repr:`, then `time_seconds`); equality is the core's, which
 /// compares the counters. The counters are destructured without `..`, so a
 /// counter added in the core must be added to the list.
@@ -21,7 +23,7 @@ macro_rules! stats_class {
     ) => {
         /// The pickled form of the statistics: the counters in order, then the
         /// wall time.
-        type $state = ($($ty,)+ f64);
+        type $state = (($($ty,)+), f64);
 
         $(#[doc = $doc])*
         #[pyclass(name = $py_name, frozen, module = "cloudprox._native")]
@@ -38,12 +40,12 @@ macro_rules! stats_class {
             /// The pickled form of `s`.
             pub(crate) fn state_of(s: &$core) -> $state {
                 let $counters { $($field),+ } = &s.counters;
-                ($(*$field,)+ s.time_seconds)
+                (($(*$field,)+), s.time_seconds)
             }
 
             /// Statistics from their pickled form.
             pub(crate) fn from_state(state: $state) -> $core {
-                let ($($field,)+ time_seconds) = state;
+                let (($($field,)+), time_seconds) = state;
                 $core {
                     counters: $counters { $($field),+ },
                     time_seconds,
@@ -69,7 +71,7 @@ macro_rules! stats_class {
 
             /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
             fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-                let ($($field,)+ time_seconds) = Self::state_of(&self.inner);
+                let (($($field,)+), time_seconds) = Self::state_of(&self.inner);
                 let d = PyDict::new(py);
                 $( d.set_item(stringify!($field), $field)?; )+
                 d.set_item("time_seconds", time_seconds)?;
