@@ -416,6 +416,33 @@ fn sphere_scene(
 
 use proptest::prelude::*;
 
+/// Random [`sphere_scene`]s: `points` per sphere, radii 3-8 cm, noise 0.5-4
+/// mm, up to 5 outliers, exact gap in `gaps` (sigmas), any direction and
+/// turn; with the gap.
+fn sphere_scenes(
+    points: std::ops::Range<usize>,
+    gaps: std::ops::Range<f64>,
+) -> impl Strategy<Value = (PointCloud, PointCloud, Pose, f64)> {
+    let dir = prop::array::uniform3(-1.0f64..1.0)
+        .prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01);
+    (
+        (points.clone(), points),
+        (0.03f64..0.08, 0.03f64..0.08),
+        0.0005f64..0.004,
+        0usize..6,
+        gaps,
+        dir,
+        prop::array::uniform3(-3.0f64..3.0),
+        0u64..1000,
+    )
+        .prop_map(|(n, r, sigma, outliers, gap, dir, rot, seed)| {
+            let rot = Vector3::from(rot);
+            let (a, b, pose) =
+                sphere_scene(n, r, sigma, outliers, gap, Vector3::from(dir), rot, seed);
+            (a, b, pose, gap)
+        })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 48,
@@ -431,20 +458,8 @@ proptest! {
     /// wherever either is decisive.
     #[test]
     fn element_hierarchy_agrees_with_brute_force(
-        na in 300usize..1500,
-        nb in 300usize..1500,
-        ra in 0.03f64..0.08,
-        rb in 0.03f64..0.08,
-        sigma in 0.0005f64..0.004,
-        outliers in 0usize..6,
-        gap in -3.0f64..14.0,
-        dir in prop::array::uniform3(-1.0f64..1.0).prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01),
-        rot in prop::array::uniform3(-3.0f64..3.0),
-        seed in 0u64..1000,
+        (a, b, pose_b, gap) in sphere_scenes(300..1500, -3.0..14.0),
     ) {
-        let (a, b, pose_b) = sphere_scene(
-            (na, nb), (ra, rb), sigma, outliers, gap, Vector3::from(dir), Vector3::from(rot), seed,
-        );
         let brute = CollisionRequest::builder()
             .model(QueryModel::Elements)
             .use_hierarchy(false)
@@ -468,20 +483,8 @@ proptest! {
     /// outliers and poses from 6 sigma of interpenetration to 6 apart).
     #[test]
     fn decide_only_agrees_with_the_full_query(
-        na in 300usize..3000,
-        nb in 300usize..3000,
-        ra in 0.03f64..0.08,
-        rb in 0.03f64..0.08,
-        sigma in 0.0005f64..0.004,
-        outliers in 0usize..6,
-        gap in -6.0f64..6.0,
-        dir in prop::array::uniform3(-1.0f64..1.0).prop_filter("non-zero", |d| d.iter().map(|x| x * x).sum::<f64>() > 0.01),
-        rot in prop::array::uniform3(-3.0f64..3.0),
-        seed in 0u64..1000,
+        (a, b, pose_b, gap) in sphere_scenes(300..3000, -6.0..6.0),
     ) {
-        let (a, b, pose_b) = sphere_scene(
-            (na, nb), (ra, rb), sigma, outliers, gap, Vector3::from(dir), Vector3::from(rot), seed,
-        );
         let quick = CollisionRequest::builder()
             .model(QueryModel::Elements)
             .decide_only(true)

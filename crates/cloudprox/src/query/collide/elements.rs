@@ -4,7 +4,7 @@
 
 use crate::bvh::BvhWorkspace;
 use crate::classify::Separator;
-use crate::element::{surfaces_may_reach, SurfaceElements};
+use crate::element::{surfaces_may_reach, Hull, SurfaceElement, SurfaceElements};
 use crate::math::Pose;
 use crate::probability::{
     element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
@@ -73,18 +73,12 @@ pub(crate) fn element_surfaces_may_reach(
     if !reach_sds.is_finite() {
         return (true, 0);
     }
-    let (ha, hb) = (ea.hulls(), eb.hulls());
     // Two single points whose hulls pass the hull test (a superset of the
     // near rule) may reach each other; a pair with a surface must face.
-    let faces = |i: u32, j: u32| {
-        let (h, g) = (ha.hull(i), hb.hull(j));
-        (h.point && g.point) || {
-            let a = (&ea.elements()[i as usize], h);
-            let b = (&eb.elements()[j as usize], g);
-            element_pair_within_reach(a, rel, b, reach_sds)
-        }
+    let faces = |a: ElementRef<'_>, b: ElementRef<'_>| {
+        (a.1.point && b.1.point) || element_pair_within_reach(a, rel, b, reach_sds)
     };
-    surfaces_may_reach(ha, rel, hb, reach_sds, workspace, faces)
+    first_hull_pair(ea, rel, eb, reach_sds, workspace, faces)
 }
 
 /// Whether the fitted surfaces of some element of `ea` (at `rel` in `eb`'s
@@ -106,13 +100,32 @@ pub(crate) fn element_surfaces_cross(
     if !z_sds.is_finite() {
         return (false, 0);
     }
+    let crosses = |a: ElementRef<'_>, b: ElementRef<'_>| element_pair_crosses(a, rel, b, z_sds);
+    first_hull_pair(ea, rel, eb, z_sds, workspace, crosses)
+}
+
+/// An element and its hull.
+type ElementRef<'a> = (&'a SurfaceElement, &'a Hull);
+
+/// Whether some pair of elements of `ea` (at `rel` in `eb`'s frame) and `eb`
+/// passes the hull test at `sds` standard deviations and then `test`
+/// ([`surfaces_may_reach`]).
+fn first_hull_pair(
+    ea: &SurfaceElements,
+    rel: &Pose,
+    eb: &SurfaceElements,
+    sds: Real,
+    workspace: &mut BvhWorkspace,
+    test: impl Fn(ElementRef<'_>, ElementRef<'_>) -> bool,
+) -> (bool, usize) {
     let (ha, hb) = (ea.hulls(), eb.hulls());
-    let crosses = |i: u32, j: u32| {
-        let a = (&ea.elements()[i as usize], ha.hull(i));
-        let b = (&eb.elements()[j as usize], hb.hull(j));
-        element_pair_crosses(a, rel, b, z_sds)
+    let pair = |i: u32, j: u32| {
+        test(
+            (&ea.elements()[i as usize], ha.hull(i)),
+            (&eb.elements()[j as usize], hb.hull(j)),
+        )
     };
-    surfaces_may_reach(ha, rel, hb, z_sds, workspace, crosses)
+    surfaces_may_reach(ha, rel, hb, sds, workspace, pair)
 }
 
 /// Whether some sample of `samples` stands for an element of more than one point.
