@@ -23,9 +23,10 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::classify::problem::Normalized;
 use crate::classify::Surface;
-use crate::math::Vector3;
+use crate::math::{Point3, Vector3};
 use crate::Real;
 
 const MU: Real = 20.0;
@@ -130,17 +131,52 @@ pub(crate) fn solve_barrier(
     })
 }
 
+/// Above this many points the nearest opposite point is found with a
+/// hierarchy over each cloud's points instead of by testing every pair.
+const WORKING_SET_TREE_MIN: usize = 512;
+
+/// The squared distance from each point to the nearest point of the other
+/// label (infinite when there is none).
+fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
+    let n = labels.len();
+    if n <= WORKING_SET_TREE_MIN {
+        return (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| labels[j] != labels[i])
+                    .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                    .fold(Real::INFINITY, Real::min)
+            })
+            .collect();
+    }
+    // One hierarchy per label, each queried by the other label's points.
+    let mut d2 = vec![Real::INFINITY; n];
+    let mut ws = BvhWorkspace::default();
+    let mut out = Vec::with_capacity(1);
+    for label in [1.0, -1.0] {
+        let (own, other): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == label);
+        let points: Vec<Point3> = other.iter().map(|&j| Point3::from(norm.u[j])).collect();
+        let Ok(tree) = Bvh::build(&points, &vec![0.0; points.len()], &BvhSettings::default())
+        else {
+            continue; // no point of the other label
+        };
+        for i in own {
+            tree.nearest_k(&points, &Point3::from(norm.u[i]), 1, &mut ws, &mut out);
+            if let Some(&(d, _)) = out.first() {
+                d2[i] = d;
+            }
+        }
+    }
+    d2
+}
+
 /// The `WORKING_SET_STEP` points of each cloud nearest any point of the other.
 fn initial_working_set(norm: &Normalized, labels: &[Real]) -> Vec<bool> {
     let n = labels.len();
-    let mut nearest: Vec<(Real, usize)> = (0..n)
-        .map(|i| {
-            let d2 = (0..n)
-                .filter(|&j| labels[j] != labels[i])
-                .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
-                .fold(Real::INFINITY, Real::min);
-            (d2, i)
-        })
+    let mut nearest: Vec<(Real, usize)> = nearest_opposite(norm, labels)
+        .into_iter()
+        .enumerate()
+        .map(|(i, d2)| (d2, i))
         .collect();
     nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut in_set = vec![false; n];
@@ -419,4 +455,38 @@ fn barrier_value(
     }
     val -= prod.ln();
     val.is_finite().then_some(val)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Matrix3;
+    use crate::sample::{add_noise, sphere};
+
+    #[test]
+    fn the_nearest_opposite_point_from_the_hierarchies_is_the_brute_forces() {
+        // Two interpenetrating noisy spheres, above the size where the
+        // hierarchies take over; and one label alone (no opposite point).
+        let a = add_noise(&sphere(&Point3::origin(), 0.1, 700), 0.002, 1);
+        let b = add_noise(&sphere(&Point3::new(0.15, 0.0, 0.0), 0.1, 500), 0.002, 2);
+        let points: Vec<Point3> = a.iter().chain(&b).copied().collect();
+        let labels: Vec<Real> = (0..points.len())
+            .map(|i| if i < a.len() { 1.0 } else { -1.0 })
+            .collect();
+        let covs = vec![Matrix3::identity() * 4e-6; points.len()];
+        let norm = Normalized::new(&points, &covs);
+        assert!(points.len() > WORKING_SET_TREE_MIN);
+        let fast = nearest_opposite(&norm, &labels);
+        for (i, &d2) in fast.iter().enumerate() {
+            let brute = (0..points.len())
+                .filter(|&j| labels[j] != labels[i])
+                .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                .fold(Real::INFINITY, Real::min);
+            assert_eq!(d2, brute, "point {i}");
+        }
+        let alone = vec![1.0; points.len()];
+        assert!(nearest_opposite(&norm, &alone)
+            .iter()
+            .all(|d| d.is_infinite()));
+    }
 }
