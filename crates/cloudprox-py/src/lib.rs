@@ -25,6 +25,7 @@
 //! constructors and synthetic samplers through its `filters`, `pose` and
 //! `synthetic` modules); `_native.pyi` is the stub.
 #![deny(unused_qualifications)]
+#![deny(clippy::unwrap_used, clippy::expect_used)]
 
 use pyo3::prelude::*;
 

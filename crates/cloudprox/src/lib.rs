@@ -49,6 +49,7 @@
 //! ```
 #![deny(missing_docs)]
 #![deny(unused_qualifications)]
+#![deny(clippy::unwrap_used, clippy::expect_used)]
 
 pub mod bvh;
 pub mod classify;

@@ -407,6 +407,7 @@ impl PointGrid {
         }
     }
 
+    #[allow(clippy::expect_used)] // every caller builds the level first
     fn level(&self, level: u32) -> &Level {
         self.levels[level as usize]
             .as_ref()
@@ -669,6 +670,7 @@ impl PointGrid {
 /// `f(i, neighbours)` with its `k` nearest other points as `(squared distance,
 /// index)`, in no particular order (fewer if the cloud has fewer than `k + 1`
 /// points). Runs in parallel; results in point order.
+#[allow(clippy::expect_used)] // every query finishes on the coarsest level, which holds every point
 pub(crate) fn for_each_knn<T, F>(points: &[Point3], k: usize, f: F) -> Vec<T>
 where
     T: Send,

@@ -102,8 +102,8 @@ pub(crate) fn assemble(
     }
     let mut phi = [0.0; 9];
     let mut jac = [Vector3::zeros(); 9];
-    if shared_cone {
-        let sig = norm.isotropic.as_ref().expect("checked above");
+    // `shared_cone` holds exactly when `sig` is `Some` and the surface linear.
+    if let (true, Some(sig)) = (shared_cone, norm.isotropic.as_ref()) {
         // c_i (w.u_i + b) + xi_i - 1 - r s_i t >= 0
         for i in 0..n {
             let row = n + i;

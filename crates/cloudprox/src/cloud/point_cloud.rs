@@ -204,6 +204,7 @@ impl PointCloud {
 
     /// The cloud's surface elements (see [`crate::element`]), built on first
     /// call in the cloud's own frame and kept until the points move.
+    #[allow(clippy::expect_used)] // settings validated when set, cloud non-empty and finite
     pub fn elements(&self) -> &SurfaceElements {
         self.elements.get_or_init(|| {
             Box::new(
@@ -314,6 +315,7 @@ impl PointCloud {
     }
 
     /// The hierarchy over the points, built on first call.
+    #[allow(clippy::expect_used)] // a validated cloud is non-empty and finite
     pub fn bvh(&self) -> &Bvh {
         self.bvh.get_or_init(|| {
             Bvh::build(&self.points, &self.sensor_sigma_max, &self.bvh_settings)

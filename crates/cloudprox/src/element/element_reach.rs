@@ -151,6 +151,7 @@ impl ElementHulls {
     /// The hulls of `elements`, with the largest standard deviation and
     /// sampling spacing of each element's samples (`sample_sigma`,
     /// `sample_spacing`, one per element).
+    #[allow(clippy::expect_used)] // a cloud has at least one element, every mean finite
     pub(crate) fn new(
         elements: &[SurfaceElement],
         sample_sigma: &[Real],

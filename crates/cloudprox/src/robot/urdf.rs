@@ -491,12 +491,19 @@ fn resolve_mimics(
                 j.name, parsed.joints[current].name
             )));
         };
-        let target = *joint_index
-            .get(m.joint.as_str())
-            .expect("checked in the loop");
+        // Both hold by the loop above (the mimicked joint exists, the chain
+        // ends at a joint with a degree of freedom); an error, not a panic,
+        // if that ever changes.
+        let (Some(&target), Some(dof)) = (joint_index.get(m.joint.as_str()), joints[master].dof)
+        else {
+            return Err(res.format_error(format!(
+                "joint '{}' mimics '{}', which has no degree of freedom",
+                j.name, m.joint
+            )));
+        };
         joints[i].mimic = Some(Mimic {
             joint: target,
-            dof: joints[master].dof.expect("a master has a dof"),
+            dof,
             multiplier,
             offset,
         });

@@ -42,10 +42,11 @@ pub(crate) fn element_crossings(
     let per_sample = |els: &SurfaceElements, idx: &[u32], unique: &[u32], q: &[Real]| {
         let owner = els.sample_owner();
         idx.iter()
+            // `unique` lists every owner of `idx` (it was made from them).
             .map(|&s| {
-                q[unique
+                unique
                     .binary_search(&owner[s as usize])
-                    .expect("owner listed")]
+                    .map_or(0.0, |k| q[k])
             })
             .collect::<Vec<Real>>()
     };
