@@ -328,6 +328,24 @@ impl PointCloud {
         &self.spacing_data().per_point
     }
 
+    /// The side of the square of surface each point stands for: the median of
+    /// [`PointCloud::spacing`] (`d_6`) times `sqrt(pi / 6)` (a surface density
+    /// of 6 points in a disc of radius `d_6`, `6 / (pi d_6^2)` points per square
+    /// metre). A regular grid of pitch `h` gives `h sqrt(2 pi / 6)`.
+    pub fn cell_side(&self) -> Real {
+        let mut s = self.spacing().to_vec();
+        let mid = s.len() / 2;
+        s.select_nth_unstable_by(mid, Real::total_cmp);
+        let median = if s.len() % 2 == 1 {
+            s[mid]
+        } else {
+            // The mean of the two middle values, as numpy's median.
+            let lower = s[..mid].iter().copied().fold(Real::NEG_INFINITY, Real::max);
+            0.5 * (lower + s[mid])
+        };
+        median * (std::f64::consts::PI / SPACING_NEIGHBOURS as Real).sqrt()
+    }
+
     /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].
     pub fn node_spacing(&self) -> &[Real] {
         &self.spacing_data().per_node
