@@ -54,8 +54,8 @@ from cloudprox._native import (
     ExactShape,
     Mesh,
     PointCloud,
-    exact_intersects_many,
     exact_proximity_many,
+    exact_time_of_impact_many,
 )
 from cloudprox.datasets import (
     DepthFrame,
@@ -88,13 +88,10 @@ FloatArray = npt.NDArray[np.float64]
 STRIDE = 4
 #: Gripper: standard deviation of its pose (calibration, metres) and its sampling spacing.
 GRIPPER_SIGMA, GRIPPER_SPACING = 0.001, 0.005
-#: Approach: reach (metres), sphere-tracing steps, march step (metres) and steps,
-#: bisection steps.
-_REACH, _TRACE, _MARCH, _MARCHES, _BISECT = 0.8, 100, 0.002, 100, 24
+#: Approach: reach (metres) of the gripper's travel.
+_REACH = 0.8
 #: How far before the anchor the gripper's centre starts (about its size, metres).
 _START = 0.2
-#: Hulls' gap (metres) at which the march of the gripper itself takes over.
-_COARSE = 0.005
 #: Rounds of fresh starts for the targets not yet reached.
 _ROUNDS = 200
 
@@ -215,49 +212,31 @@ def sample_scan_poses(
             out[:, :3, 3] += ry[idx] * t[:, None]
             return out
 
-        def gap(t: FloatArray, idx: npt.NDArray[np.intp]) -> FloatArray:
-            r = exact_proximity_many(bound, reference, at(t, idx))
-            return np.where(np.asarray(r.intersecting), -1.0, np.asarray(r.distance))
-
-        def hits(t: FloatArray, idx: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
-            return np.asarray(exact_intersects_many(gripper, reference, at(t, idx)))
-
-        # 1. Sphere-trace the hulls to within _COARSE of the surface: a translation
-        # by L changes a distance by at most L, so stepping by the gap never jumps
-        # over a contact; the gripper is inside its hulls, hence still clear.
-        t = np.zeros(k)
-        g = gap(t, np.arange(k))
-        alive = g > 0.0
-        for _ in range(_TRACE):
-            todo = np.flatnonzero(alive & (g > _COARSE))
-            if len(todo) == 0:
-                break
-            t[todo] += g[todo]
-            alive[todo] &= t[todo] <= _REACH
-            todo = todo[alive[todo]]
-            g[todo] = gap(t[todo], todo)
-        # 2. March the gripper itself in steps of _MARCH to its first contact.
-        lo, hi = t.copy(), np.full(k, np.nan)
-        for _ in range(_MARCHES):
-            todo = np.flatnonzero(alive & np.isnan(hi))
-            if len(todo) == 0:
-                break
-            step = lo[todo] + _MARCH
-            hit = hits(step, todo)
-            hi[todo[hit]] = step[hit]
-            lo[todo[~hit]] = step[~hit]
-        ok = np.flatnonzero(~np.isnan(hi))
-        # 3. Bisect the contact.
-        a_, b_ = lo[ok], hi[ok]
-        for _ in range(_BISECT):
-            mid = 0.5 * (a_ + b_)
-            hit = hits(mid, ok)
-            b_ = np.where(hit, mid, b_)
-            a_ = np.where(hit, a_, mid)
-        # 4. From the contact, travel |target| further (penetration) or back off by
-        # the target; backing off by L leaves a gap of at most L, measured exactly.
+        # A gap target is reached by the gripper itself; a depth target from its
+        # first contact (a surface has no depth: the travel past it).
+        gap = np.maximum(target, 0.0)
+        # 1. The convex hulls' travel to the target: cheap, and no more than the
+        # gripper's (it lies inside them). Starts already there are redrawn.
+        hull = exact_time_of_impact_many(
+            bound, reference, start, ray, target=gap, max_travel=_REACH
+        )
+        near = np.flatnonzero(np.isfinite(hull) & (hull > 0.0))
+        # 2. The gripper's own travel from there (shape casting of its triangles).
+        rest = exact_time_of_impact_many(
+            gripper,
+            reference,
+            at(hull[near], near),
+            ray[near],
+            target=gap[near],
+            max_travel=_REACH,
+        )
+        reached = np.isfinite(rest)
+        ok = near[reached]
+        hit = hull[ok] + rest[reached]
+        # 3. Past contact, |target| further; before it, the exact gap is measured
+        # (the gripper may start within the target where the hulls reach it).
         tg = target[ok]
-        final = at(np.where(tg < 0.0, b_ - tg, a_ - tg), ok)
+        final = at(np.where(tg < 0.0, hit - tg, hit), ok)
         r = exact_proximity_many(gripper, reference, final)
         apart = ~np.asarray(r.intersecting)
         # Past contact the gripper must still cross the surface; backed off, clear.
