@@ -172,8 +172,8 @@ impl PointCloud {
     }
 
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
-        let sigma_max: Vec<Real> = covariances.iter().map(max_std).collect();
-        let sensor_sigma_min = covariances.iter().map(min_std).collect();
+        let sigma_max: Vec<Real> = covariances.par_iter().map(max_std).collect();
+        let sensor_sigma_min = covariances.par_iter().map(min_std).collect();
         Self {
             points,
             covariances,
@@ -198,7 +198,7 @@ impl PointCloud {
     ) -> Self {
         let mut c = Self::from_parts(points, sensor);
         c.sensor = Some(std::mem::replace(&mut c.covariances, total));
-        c.sigma_max = c.covariances.iter().map(max_std).collect();
+        c.sigma_max = c.covariances.par_iter().map(max_std).collect();
         c
     }
 
@@ -242,7 +242,7 @@ impl PointCloud {
         for (c, d) in self.covariances.iter_mut().zip(disc) {
             *c += d;
         }
-        self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.sigma_max = self.covariances.par_iter().map(max_std).collect();
         self.elements = OnceLock::new();
         Ok(self)
     }
@@ -267,7 +267,7 @@ impl PointCloud {
         for (c, d) in self.covariances.iter_mut().zip(disc) {
             *c += d;
         }
-        self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.sigma_max = self.covariances.par_iter().map(max_std).collect();
         self.elements = OnceLock::new();
         Ok(self)
     }
