@@ -207,3 +207,36 @@ fn many_starts_equal_a_loop_and_bad_input_is_refused() {
         exact_time_of_impact_many(&poses, &a, &dirs, &pb, &b, &targets[..1], 1.0).unwrap_err();
     assert!(err.to_string().contains("targets"), "{err}");
 }
+
+#[test]
+fn a_large_face_meets_a_small_mesh_inside_it() {
+    // A 2 m square (two triangles, an open surface) lowered onto a cube seen
+    // as a surface: the first contact is deep inside one triangle, far from
+    // every corner, and the cube is not the mesh with fewer triangles.
+    let square = Mesh::new(
+        vec![
+            Point3::new(-1.0, -1.0, 0.0),
+            Point3::new(1.0, -1.0, 0.0),
+            Point3::new(1.0, 1.0, 0.0),
+            Point3::new(-1.0, 1.0, 0.0),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .unwrap();
+    let plate = ExactShape::surfaces(&[square]).unwrap();
+    let block = ExactShape::surfaces(&[cube(0.05)]).unwrap();
+    let o = Pose::identity();
+    let start = at(0.3, 0.2, 1.0);
+    for (target, want) in [(0.0, 0.95), (0.02, 0.93), (0.3, 0.65)] {
+        let t = toi(&start, &plate, -Vector3::z(), &o, &block, target).unwrap();
+        assert!((t - want).abs() < 1e-7, "target {target}: {t}");
+        // Swapped: the cube moves up into the square.
+        let t = toi(&o, &block, Vector3::z(), &start, &plate, target).unwrap();
+        assert!((t - want).abs() < 1e-7, "target {target}, swapped: {t}");
+    }
+    // Already within 1 m of it, with a corner 1.3 m away.
+    assert_eq!(
+        toi(&start, &plate, -Vector3::z(), &o, &block, 1.0),
+        Some(0.0)
+    );
+}

@@ -2,7 +2,8 @@
 //! before its signed distance to another reaches a target.
 
 use nalgebra::Translation3;
-use parry3d_f64::query::{self, ShapeCastOptions};
+use parry3d_f64::query::{self, PointQuery, ShapeCastOptions};
+use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
 
 use super::exact::{as_shape, exact_intersects, exact_proximity};
@@ -28,9 +29,10 @@ fn moved(pose: &Pose, direction: &Vector3, t: Real) -> Pose {
 }
 
 /// The first travel (at most `max_travel`) along `direction` at which part `a`
-/// comes within `target` (>= 0) of part `b`; the part with more triangles is
-/// cast against the other (parry prunes the outer shape's hierarchy with the
-/// inner shape's whole box).
+/// comes within `target` (>= 0) of part `b`. A convex part and a mesh: the
+/// part with more triangles is cast against the other (parry prunes the outer
+/// shape's hierarchy with the inner shape's whole box); two meshes: see
+/// [`cast_mesh_mesh`].
 fn cast_pair(
     pa: &Pose,
     a: &ExactPart,
@@ -51,6 +53,9 @@ fn cast_pair(
         compute_impact_geometry_on_penetration: false,
     };
     let zero = Vector3::zeros();
+    if let (ExactPart::Mesh { mesh: ma, .. }, ExactPart::Mesh { mesh: mb, .. }) = (a, b) {
+        return Ok(cast_mesh_mesh(pa, ma, direction, pb, mb, options));
+    }
     let hit = if triangles(b) > triangles(a) {
         // b moves by -direction relative to a: the same travel.
         query::cast_shapes(
@@ -69,6 +74,91 @@ fn cast_pair(
     Ok(hit
         .map(|h| h.time_of_impact.max(0.0))
         .filter(|&t| t <= max_travel))
+}
+
+/// Two triangle meshes: each triangle of the one with fewer triangles is cast
+/// against the other's tree, the nearest first, each with the best travel so
+/// far as its reach (parry's own mesh-mesh cast prunes the
+/// outer tree with the inner mesh's whole box, and gives every inner cast the
+/// full reach: far slower for a gripper against a scanned surface).
+fn cast_mesh_mesh(
+    pa: &Pose,
+    a: &TriMesh,
+    direction: &Vector3,
+    pb: &Pose,
+    b: &TriMesh,
+    options: ShapeCastOptions,
+) -> Option<Real> {
+    // Cast the smaller mesh, moving by `dir` relative to the larger one.
+    let (ps, small, dir, pl, large) = if a.num_triangles() <= b.num_triangles() {
+        (pa, a, *direction, pb, b)
+    } else {
+        (pb, b, -direction, pa, a)
+    };
+    // Each triangle's key: the smallest distance of its corners to the other
+    // mesh at the start (point queries on its tree, cheap). A corner within
+    // the target means the start is; otherwise the nearest triangles go first,
+    // so that a hit comes early and shortens every later cast.
+    let corner: Vec<Real> = small
+        .vertices()
+        .iter()
+        .map(|v| large.distance_to_point(pl, &(ps * v), false))
+        .collect();
+    // With its longest edge: no point of the triangle is nearer than its
+    // nearest corner less that edge, and a move by `L` brings it at most `L`
+    // closer, so a triangle whose bound exceeds the target plus the best
+    // travel so far cannot hit first and is skipped.
+    let verts = small.vertices();
+    let mut order: Vec<(Real, Real, usize)> = small
+        .indices()
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let near = t
+                .iter()
+                .map(|&k| corner[k as usize])
+                .fold(Real::INFINITY, Real::min);
+            let [p, q, r] = t.map(|k| verts[k as usize]);
+            let edge = (p - q).norm().max((q - r).norm()).max((r - p).norm());
+            (near, edge, i)
+        })
+        .collect();
+    if order.iter().any(|&(d, _, _)| d <= options.target_distance) {
+        return Some(0.0);
+    }
+    order.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let zero = Vector3::zeros();
+    let mut best: Option<Real> = None;
+    for (near, edge, i) in order {
+        let reach = best.unwrap_or(options.max_time_of_impact);
+        if near - edge > options.target_distance + reach {
+            continue;
+        }
+        let tri = small.triangle(i as u32);
+        let hit = query::cast_shapes(
+            ps,
+            &dir,
+            &tri,
+            pl,
+            &zero,
+            large,
+            ShapeCastOptions {
+                max_time_of_impact: reach,
+                ..options
+            },
+        )
+        .ok()
+        .flatten()
+        .map(|h| h.time_of_impact.max(0.0))
+        .filter(|&t| t <= reach);
+        if let Some(t) = hit {
+            best = Some(t);
+            if t == 0.0 {
+                break;
+            }
+        }
+    }
+    best
 }
 
 /// The first travel at which the closest part pair comes within `target` (>= 0):
