@@ -370,15 +370,21 @@ fn check_layered_chunks(
 /// The LAZ chunk table: the crate sizes a buffer from its chunk count.
 fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Result<()> {
     let len = bytes.len() as u64;
-    let data_start = usize::try_from(data_start).map_err(|_| cur.error("offset too large"))?;
-    cur.seek(data_start)?;
-    let table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
-    let table_data = data_start as u64 + 8;
-    if table == -1 {
-        return Ok(()); // written by a streaming writer: the table is found at the end
-    }
-    if u64::try_from(table).map_or(true, |t| t <= table_data) {
-        return Ok(()); // no chunk table: the crate reads the points sequentially
+    let start = usize::try_from(data_start).map_err(|_| cur.error("offset too large"))?;
+    cur.seek(start)?;
+    let mut table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
+    let table_data = data_start + 8;
+    // As the crate does: an offset at or before the point data (-1 from a
+    // streaming writer, or any other) sends it to the file's last 8 bytes.
+    if u64::try_from(table).map_or(true, |t| t <= data_start) {
+        if len < table_data + 8 {
+            return Ok(()); // the crate fails to read it: a format error
+        }
+        cur.seek((len - 8) as usize)?;
+        table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
+        if u64::try_from(table).map_or(true, |t| t <= data_start) {
+            return Ok(()); // no chunk table: the crate reads the points sequentially
+        }
     }
     let table = table.unsigned_abs();
     if table.checked_add(8).is_none_or(|e| e > len) {
@@ -388,11 +394,12 @@ fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Res
     }
     cur.seek(table as usize + 4)?;
     let chunks = u64::from(cur.u32_le()?);
-    // Every chunk holds at least one byte of compressed points before the table.
-    if chunks > table - table_data {
+    // Every chunk holds at least one byte of compressed points before the
+    // table (a file without points lists one empty chunk).
+    let data = table.saturating_sub(table_data);
+    if chunks > data.max(1) {
         return Err(cur.error(format!(
-            "the chunk table lists {chunks} chunks but there are only {} bytes of point data",
-            table - table_data
+            "the chunk table lists {chunks} chunks but there are only {data} bytes of point data"
         )));
     }
     Ok(())
