@@ -97,9 +97,10 @@ fn build_node(input: &Input<'_>, nodes: &mut [BvhNode], id: u32, indices: &mut [
         aabb.take_point(&input.points[i as usize]);
         sigma_max = sigma_max.max(input.sigmas[i as usize]);
     }
-    let (node, below) = nodes
-        .split_first_mut()
-        .expect("a subtree has at least one node");
+    // A subtree has at least one node (its root); `subtree_nodes` sized it.
+    let Some((node, below)) = nodes.split_first_mut() else {
+        return;
+    };
     *node = BvhNode {
         aabb,
         sigma_max,
