@@ -49,6 +49,8 @@ from cloudprox._native import (
     exact_intersects_many,
     exact_proximity,
     exact_proximity_many,
+    exact_time_of_impact_many,
+    ray_covariances,
 )
 from cloudprox.exceptions import (
     CloudproxError,
@@ -93,8 +95,10 @@ __all__ = [
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
+    "exact_time_of_impact_many",
     "filters",
     "io",
     "pose",
+    "ray_covariances",
     "synthetic",
 ]

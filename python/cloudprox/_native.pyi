@@ -60,6 +60,7 @@ __all__ = [
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
+    "exact_time_of_impact_many",
     "parse_mesh",
     "pose_from_quaternion",
     "pose_from_rotation_vector",
@@ -67,6 +68,7 @@ __all__ = [
     "pose_from_translation",
     "pose_look_at",
     "random_rotations",
+    "ray_covariances",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
@@ -208,6 +210,14 @@ class PointCloud:
     @property
     def spacing(self) -> _FloatArray:
         """Per-point sampling spacing ``(n,)``: the distance to the 6th nearest neighbour."""
+    @property
+    def cell_side(self) -> float:
+        """The side of the square of surface each point stands for (metres).
+
+        The median :attr:`spacing` ``d_6`` times ``sqrt(pi / 6)``: a density of
+        ``6 / (pi d_6^2)`` points per square metre (a grid of pitch ``h`` gives
+        ``h sqrt(2 pi / 6)``).
+        """
     @property
     def sensor_covariances(self) -> _FloatArray:
         """Per-point sensor covariances (without the discretization part), ``(n, 3, 3)``."""
@@ -573,6 +583,40 @@ def exact_proximity_many(
         One :class:`Proximity` per pose, read as arrays of shape ``(m,)``
         (``intersecting``, ``distance``, ``penetration_depth`` (NaN when
         unknown), ``signed_distance``) or pose by pose (``batch[i]``).
+    """
+
+def exact_time_of_impact_many(
+    a: ExactShape,
+    b: ExactShape,
+    poses_a: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    target: npt.ArrayLike | None = None,
+    max_travel: float = ...,
+    pose_b: npt.ArrayLike | None = None,
+) -> npt.NDArray[np.float64]:
+    """How far ``a`` moves from each start before its signed distance to ``b`` reaches a target.
+
+    Each start ``poses_a[i]`` ``(m, 4, 4)`` is translated (orientation kept)
+    along ``directions[i]`` (``(m, 3)``, or one ``(3,)`` for all; normalized).
+    ``target`` (metres, a scalar or ``(m,)``, default 0: contact) is the signed
+    distance to reach: ``>= 0`` a gap, found by shape casting; ``< 0`` a
+    penetration depth (every intersecting part pair convex), found past the
+    first contact on :func:`exact_proximity`'s signed distance. Runs in
+    parallel, the GIL released.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The travel (metres along the unit direction) to the first pose at the
+        target: 0 where the start is already at or within it, ``inf`` where it
+        is not reached within ``max_travel`` (default: unbounded).
+
+    Raises
+    ------
+    InvalidInputError
+        A pose or direction not finite (or a zero direction), a target not
+        finite, ``max_travel`` negative or NaN, shapes that do not match, or a
+        negative target where a non-convex part intersects (depth unknown).
     """
 
 @final
@@ -1174,6 +1218,28 @@ class Lidar:
         sensor_pose: npt.ArrayLike | None = None,
     ) -> _FloatArray:
         """Sensor covariances ``(n, 3, 3)`` of ``points`` seen from ``origin`` or ``sensor_pose``."""
+
+def ray_covariances(
+    points: npt.ArrayLike,
+    sigma_ray: float,
+    sigma_lateral: float,
+    *,
+    origin: npt.ArrayLike | None = None,
+    sensor_pose: npt.ArrayLike | None = None,
+) -> _FloatArray:
+    """Covariances ``(n, 3, 3)`` with fixed standard deviations along and across each viewing ray.
+
+    ``sigma_ray^2 u u^T + sigma_lateral^2 (I - u u^T)`` for the unit ray ``u``
+    from ``origin`` (or ``sensor_pose``) to each point: the form every sensor
+    model gives, with a noise level set by hand instead of a sensor's laws.
+
+    Raises
+    ------
+    InvalidInputError
+        A negative or non-finite standard deviation, neither or both of
+        ``origin`` and ``sensor_pose``, a non-finite point, a point at the
+        origin (or behind a ``sensor_pose``).
+    """
 
 @final
 class CloudFile:

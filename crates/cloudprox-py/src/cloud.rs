@@ -278,6 +278,14 @@ impl PyPointCloud {
         Ok(PyArray1::from_vec(py, s))
     }
 
+    /// The side of the square of surface each point stands for (metres): the
+    /// median `spacing` times `sqrt(pi / 6)` (computed without the GIL).
+    #[getter]
+    fn cell_side(&self, py: Python<'_>) -> PyResult<f64> {
+        let inner = Arc::clone(&self.inner);
+        run_detached(py, move || Ok(inner.cell_side()))
+    }
+
     /// Correlation of the sensor noise between the points of one surface element
     /// (set by `noise_correlation=`, else the sensor model's; 0 for `sigma`/`cov`).
     #[getter]

@@ -93,6 +93,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::exact_proximity, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_proximity_many_py, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::exact_intersects_many_py, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::exact_time_of_impact_many_py, m)?)?;
+    m.add_function(wrap_pyfunction!(sensor::ray_covariances, m)?)?;
     m.add_function(wrap_pyfunction!(pose::pose_from_translation, m)?)?;
     m.add_function(wrap_pyfunction!(pose::pose_from_quaternion, m)?)?;
     m.add_function(wrap_pyfunction!(pose::pose_from_rpy, m)?)?;

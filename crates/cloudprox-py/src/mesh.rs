@@ -565,3 +565,71 @@ pub fn exact_intersects_many_py<'py>(
     let hits = run_detached(py, move || Ok(exact_intersects_many(&poses, &sa, &pb, &sb)))?;
     Ok(PyArray1::from_vec(py, hits))
 }
+
+/// One value per pose from `obj`: a scalar (repeated) or an array `(m,)`.
+fn per_pose_values(obj: &Bound<'_, PyAny>, m: usize, what: &str) -> PyResult<Vec<f64>> {
+    let arr = crate::convert::to_f64_array(obj, what)?;
+    let values: Vec<f64> = arr.readonly().as_array().iter().copied().collect();
+    match (arr.ndim(), values.as_slice()) {
+        (0, &[v]) => Ok(vec![v; m]),
+        (1, _) if values.len() == m => Ok(values),
+        _ => Err(invalid_input(
+            obj.py(),
+            format!(
+                "{what} must be a scalar or an array of shape ({m},), got shape {}",
+                shape_str(arr.shape())
+            ),
+        )),
+    }
+}
+
+/// How far `a` at each start `(m, 4, 4)` moves along its direction before its
+/// signed distance to `b` first reaches the target, in parallel: a float array
+/// `(m,)` of travels (0 where the start is already at or within the target,
+/// infinity where the target is not reached within `max_travel`). The GIL is
+/// released during the queries.
+#[pyfunction]
+#[pyo3(
+    name = "exact_time_of_impact_many",
+    signature = (a, b, poses_a, directions, target=None, max_travel=f64::INFINITY, pose_b=None)
+)]
+#[allow(clippy::too_many_arguments)]
+pub fn exact_time_of_impact_many_py<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyExactShape>,
+    b: &Bound<'py, PyExactShape>,
+    poses_a: &Bound<'py, PyAny>,
+    directions: &Bound<'py, PyAny>,
+    target: Option<&Bound<'py, PyAny>>,
+    max_travel: f64,
+    pose_b: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let poses = poses_from(poses_a, "poses_a")?;
+    let m = poses.len();
+    let dirs_arr = crate::convert::to_f64_array(directions, "directions")?;
+    let dirs: Vec<cloudprox::math::Vector3> = if dirs_arr.ndim() == 1 {
+        vec![crate::convert::vector3_from(directions, "directions")?; m]
+    } else {
+        crate::convert::check_shape(&dirs_arr, &[Some(m), Some(3)], "directions", "(m, 3)")?;
+        points_from(directions, "directions")?
+            .into_iter()
+            .map(|p| p.coords)
+            .collect()
+    };
+    let targets = match target {
+        Some(t) => per_pose_values(t, m, "target")?,
+        None => vec![0.0; m],
+    };
+    let pb = pose_from(py, pose_b, "pose_b")?;
+    let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
+    let travel = run_detached(py, move || {
+        cloudprox::query::exact::exact_time_of_impact_many(
+            &poses, &sa, &dirs, &pb, &sb, &targets, max_travel,
+        )
+    })?;
+    let travel: Vec<f64> = travel
+        .into_iter()
+        .map(|t| t.unwrap_or(f64::INFINITY))
+        .collect();
+    Ok(PyArray1::from_vec(py, travel))
+}

@@ -376,3 +376,24 @@ impl PyLidar {
         )
     }
 }
+
+/// Covariances `(n, 3, 3)` with fixed standard deviations along (`sigma_ray`)
+/// and across (`sigma_lateral`) each point's viewing ray from `origin` or
+/// `sensor_pose`: the form of every sensor model, without its laws.
+#[pyfunction]
+#[pyo3(signature = (points, sigma_ray, sigma_lateral, *, origin=None, sensor_pose=None))]
+pub fn ray_covariances<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    sigma_ray: f64,
+    sigma_lateral: f64,
+    origin: Option<&Bound<'py, PyAny>>,
+    sensor_pose: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let points = points_from(points, "points")?;
+    let vp = viewpoint_from(py, origin, sensor_pose)?;
+    let covs = run_detached(py, move || {
+        cloudprox::uncertainty::ray_covariances(&points, &vp, sigma_ray, sigma_lateral)
+    })?;
+    matrices3_to_py(py, &covs)
+}

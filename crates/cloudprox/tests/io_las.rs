@@ -337,3 +337,26 @@ fn laszip_items_have_their_fixed_sizes() {
     let p = problem(read_las(&odd, "t.las"), "LAZ");
     assert!(p.contains("item of type 6 is 21 bytes, not 20"), "{p}");
 }
+
+/// Found by the fuzz target `las` (2026-11-25, 208 708 executions): a LAZ file
+/// whose chunk table offset lies before the point data makes the `laz` crate
+/// take the offset from the file's last 8 bytes, and it sized its chunk table
+/// from the count found there (up to 2^32 entries of 16 bytes) before reading
+/// it. The header check now follows the crate to that table too.
+#[test]
+fn a_chunk_table_found_at_the_end_must_fit_in_the_file() {
+    let mut bytes = write_file((1, 2), 1, true);
+    let n = read_las(&bytes, "t.las").unwrap().points.len();
+    let start = u32::from_le_bytes(bytes[96..100].try_into().unwrap()) as usize;
+    let table = i64::from_le_bytes(bytes[start..start + 8].try_into().unwrap());
+    assert!(usize::try_from(table).unwrap() > start);
+    // The file read back as written, with the offset moved to the end.
+    bytes[start..start + 8].copy_from_slice(&(-1i64).to_le_bytes());
+    bytes.extend_from_slice(&table.to_le_bytes());
+    assert_eq!(read_las(&bytes, "t.las").unwrap().points.len(), n);
+    // A count of 2^32 - 1 chunks there is refused before any allocation.
+    let t = usize::try_from(table).unwrap();
+    bytes[t + 4..t + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    let p = problem(read_las(&bytes, "t.las"), "LAZ");
+    assert!(p.contains("4294967295 chunks"), "{p}");
+}

@@ -280,3 +280,39 @@ fn depth_quantization_sets_the_noise_correlation_of_elements() {
         .to_string()
         .contains("baseline_m"));
 }
+
+#[test]
+fn ray_covariances_have_their_two_standard_deviations() {
+    use cloudprox::uncertainty::ray_covariances;
+    let vp = Viewpoint::at(Point3::new(0.0, 0.0, 2.0));
+    let pts = [Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 2.0, 0.5)];
+    let cov = ray_covariances(&pts, &vp, 0.03, 0.0075).unwrap();
+    for (p, c) in pts.iter().zip(&cov) {
+        let u = (p - vp.origin).normalize();
+        assert!(close(var_along(c, &u), 0.03 * 0.03, 1e-12));
+        let side = u.cross(&Vector3::x()).normalize();
+        assert!(close(var_along(c, &side), 0.0075 * 0.0075, 1e-12));
+        assert!((c - c.transpose()).amax() < 1e-18);
+    }
+    // The origin's point is refused, as are negative or non-finite sigmas.
+    let msg = |r: Result<Vec<Matrix3>, Error>| r.unwrap_err().to_string();
+    assert!(msg(ray_covariances(&[vp.origin], &vp, 0.01, 0.01)).contains("origin"));
+    assert!(msg(ray_covariances(&pts, &vp, -0.01, 0.01)).contains("sigma_ray"));
+    assert!(msg(ray_covariances(&pts, &vp, 0.01, f64::NAN)).contains("sigma_lat"));
+}
+
+#[test]
+fn cell_side_of_a_grid_is_its_pitch_times_sqrt_2pi_over_6() {
+    // The 6th neighbour of a square grid's inner point is at sqrt(2) h.
+    let h = 0.01;
+    let pts: Vec<Point3> = (0..60 * 60)
+        .map(|k| Point3::new((k % 60) as f64 * h, (k / 60) as f64 * h, 0.0))
+        .collect();
+    let cloud = cloudprox::cloud::PointCloud::from_sigma(pts, 0.0).unwrap();
+    let want = h * (2.0 * std::f64::consts::PI / 6.0).sqrt();
+    assert!(
+        close(cloud.cell_side(), want, 1e-9),
+        "{}",
+        cloud.cell_side()
+    );
+}

@@ -30,7 +30,6 @@ Baselines, each with parameters set from the data, not tuned to the scene:
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -146,11 +145,14 @@ class Draw:
         return self._cache["tree"]  # type: ignore[return-value]
 
     def sensor_std(self) -> tuple[FloatArray, FloatArray]:
-        """Largest sensor standard deviation per point, piano and room."""
+        """Largest sensor standard deviation per point, piano and room (core: ``sigma_max``)."""
         if "std" not in self._cache:
             self._cache["std"] = tuple(
-                np.sqrt(np.linalg.eigvalsh(c)[:, -1])
-                for c in (self.piano_sensor_cov, self.room_sensor_cov)
+                np.asarray(PointCloud(p, cov=c).sigma_max)
+                for p, c in (
+                    (self.piano_points, self.piano_sensor_cov),
+                    (self.room_points, self.room_sensor_cov),
+                )
             )
         return self._cache["std"]  # type: ignore[return-value]
 
@@ -190,15 +192,14 @@ def reconstruct_answer(
     return MethodAnswer(scores, np.where(hit, "collision", "free"), seconds)
 
 
-def sampling_spacing(points: FloatArray, k: int = 6) -> float:
+def sampling_spacing(points: FloatArray) -> float:
     """Return the side of the square cell each point stands for on the surface.
 
-    From the median distance ``d_k`` to the ``k``-th nearest neighbour: a surface
-    density of ``k / (pi d_k^2)`` points per square metre gives cells of side
-    ``d_k sqrt(pi / k)``.
+    The core's :attr:`cloudprox.PointCloud.cell_side`: from the median distance
+    ``d_6`` to the 6th nearest neighbour, a surface density of ``6 / (pi d_6^2)``
+    points per square metre gives cells of side ``d_6 sqrt(pi / 6)``.
     """
-    d, _ = cKDTree(points).query(points, k=k + 1)
-    return float(np.median(d[:, k]) * math.sqrt(math.pi / k))
+    return float(PointCloud(points).cell_side)
 
 
 def _world(points: FloatArray, pose: FloatArray) -> FloatArray:

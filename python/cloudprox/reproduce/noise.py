@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cloudprox._native import ray_covariances
+
 __all__ = ["NoiseModel"]
 
 FloatArray = npt.NDArray[np.float64]
@@ -43,16 +45,16 @@ class NoiseModel:
         return self.origin is None
 
     def covariances(self, points: FloatArray) -> FloatArray:
-        """Per-point sensor covariances ``(n, 3, 3)`` for surface points ``(n, 3)``."""
-        n = len(points)
-        eye = np.broadcast_to(np.eye(3), (n, 3, 3))
+        """Per-point sensor covariances ``(n, 3, 3)`` for surface points ``(n, 3)``.
+
+        Anisotropic: the core's :func:`cloudprox.ray_covariances` from ``origin``.
+        """
         if self.origin is None:
+            eye = np.broadcast_to(np.eye(3), (len(points), 3, 3))
             return np.ascontiguousarray(self.sigma**2 * eye)
-        ray = points - np.asarray(self.origin, dtype=float)
-        ray /= np.linalg.norm(ray, axis=1, keepdims=True)
-        outer = ray[:, :, None] * ray[:, None, :]
-        lat = (self.sigma * self.lateral_ratio) ** 2
-        return np.ascontiguousarray(lat * (eye - outer) + self.sigma**2 * outer)
+        return np.asarray(
+            ray_covariances(points, self.sigma, self.sigma * self.lateral_ratio, origin=self.origin)
+        )
 
     def draw(self, points: FloatArray, rng: np.random.Generator) -> tuple[FloatArray, FloatArray]:
         """Noisy copies of ``points`` and their sensor covariances.

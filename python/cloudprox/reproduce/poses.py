@@ -5,8 +5,10 @@ where the piano is farther from everything than the distance wanted; it then
 moves along a random direction (downwards or sideways) until the exact signed
 distance to the room equals a target drawn from ``[-3, 10]`` sigma (or, for the
 far share, from ``[10 sigma, 0.5 m]``, and for the deep share from ``[-8, -3]``
-sigma, so that false negatives at penetrations beyond 3 sigma are measured): a
-scan along the line brackets the first crossing and bisection pins it down. The
+sigma, so that false negatives at penetrations beyond 3 sigma are measured):
+:func:`cloudprox.exact_time_of_impact_many` finds the first pose along the line
+at the target (shape casting to a gap, or past the first contact to a
+penetration depth). The
 target is drawn first and the start redrawn until it reaches it, so the targets
 keep their designed distribution (rejecting targets instead favours the ones that
 are easy to reach: penetrations). The exact signed distance of the final pose
@@ -22,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from cloudprox._native import exact_proximity_many
+from cloudprox._native import exact_proximity_many, exact_time_of_impact_many
 from cloudprox.pose import from_rpy
 from cloudprox.scenes import SceneObject
 
@@ -30,10 +32,8 @@ __all__ = ["QueryPoses", "draw_target_units", "sample_poses"]
 
 FloatArray = npt.NDArray[np.float64]
 
-#: Length of the line searched for the target distance (metres) and its step.
-_REACH, _STEP = 3.0, 0.05
-#: Bisection steps (the bracket shrinks to 0.05 m / 2^40).
-_BISECT = 40
+#: Length of the line searched for the target distance (metres).
+_REACH = 3.0
 #: Rounds of fresh starts for the targets not yet reached.
 _ROUNDS = 200
 
@@ -63,11 +63,6 @@ def _translated(poses: FloatArray, dirs: FloatArray, t: FloatArray) -> FloatArra
     out = poses.copy()
     out[:, :3, 3] += dirs * t[:, None]
     return out
-
-
-def _signed(piano: SceneObject, room: SceneObject, poses: FloatArray) -> FloatArray:
-    r = exact_proximity_many(piano.exact, room.exact, poses)
-    return np.asarray(r.signed_distance, dtype=float)
 
 
 def draw_target_units(
@@ -164,32 +159,13 @@ def sample_poses(
         dirs = np.stack(
             [np.sin(polar) * np.cos(azim), np.sin(polar) * np.sin(azim), -np.cos(polar)], 1
         )
-        # Scan the line for the first step at or below the target.
-        t_prev = np.zeros(m)
-        g_prev = _signed(piano, room, starts) - tg
-        found = np.full(m, np.nan)
-        valid = g_prev > 0.0
-        for k in range(1, int(_REACH / _STEP) + 1):
-            t = np.full(m, k * _STEP)
-            todo = valid & np.isnan(found)
-            if not todo.any():
-                break
-            g = np.full(m, np.inf)
-            g[todo] = (
-                _signed(piano, room, _translated(starts[todo], dirs[todo], t[todo])) - tg[todo]
-            )
-            hit = todo & (g <= 0.0)
-            found[hit] = t[hit]
-            t_prev = np.where(todo & ~hit, t, t_prev)
-        ok = ~np.isnan(found)
-        a, b = t_prev[ok], found[ok]
-        st, dr, tk = starts[ok], dirs[ok], tg[ok]
-        for _ in range(_BISECT):
-            mid = 0.5 * (a + b)
-            below = _signed(piano, room, _translated(st, dr, mid)) - tk <= 0.0
-            b = np.where(below, mid, b)
-            a = np.where(below, a, mid)
-        poses[pending[ok]] = _translated(st, dr, b)
+        # The first pose along the line at the target (0 where the start is
+        # already at or within it, inf where the target is out of reach).
+        travel = exact_time_of_impact_many(
+            piano.exact, room.exact, starts, dirs, target=tg, max_travel=_REACH
+        )
+        ok = np.isfinite(travel) & (travel > 0.0)
+        poses[pending[ok]] = _translated(starts[ok], dirs[ok], travel[ok])
         pending = pending[~ok]
     if len(pending):
         raise RuntimeError(

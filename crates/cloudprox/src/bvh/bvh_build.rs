@@ -12,7 +12,8 @@ impl Bvh {
     /// Each node is split at the median of the points' projections on the largest
     /// principal axis of their scatter (the thesis version of the method), which
     /// keeps the tree balanced and follows thin surfaces. Build time is
-    /// `O(n log n)`.
+    /// `O(n log n)`; the two halves of every node of at least 4096 points are
+    /// built in parallel (rayon), into the same tree a single thread builds.
     pub fn build(points: &[Point3], sigmas: &[Real], settings: &BvhSettings) -> Result<Bvh> {
         settings.validate()?;
         if points.is_empty() {
@@ -29,55 +30,105 @@ impl Bvh {
         }
         let n = u32::try_from(points.len())
             .map_err(|_| Error::invalid("clouds are limited to 2^32 - 1 points"))?;
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * points.len() / settings.leaf_max_points.max(1) + 1),
-            indices: (0..n).collect(),
-        };
-        bvh.build_node(points, sigmas, 0, n, settings.leaf_max_points);
-        Ok(bvh)
-    }
-
-    fn build_node(
-        &mut self,
-        points: &[Point3],
-        sigmas: &[Real],
-        first: u32,
-        count: u32,
-        leaf_max: usize,
-    ) -> u32 {
-        let id = self.nodes.len() as u32;
-        let range = first as usize..(first + count) as usize;
-        let mut aabb = Aabb::empty();
-        let mut sigma_max: Real = 0.0;
-        for &i in &self.indices[range.clone()] {
-            aabb.take_point(&points[i as usize]);
-            sigma_max = sigma_max.max(sigmas[i as usize]);
-        }
-        self.nodes.push(BvhNode {
-            aabb,
-            sigma_max,
-            first,
-            count,
+        let leaf_max = settings.leaf_max_points;
+        // Every node's place in the pre-order array follows from its point
+        // count alone, so the two halves of a node are built into disjoint
+        // parts of one array at once: the same tree as one thread builds.
+        let placeholder = BvhNode {
+            aabb: Aabb::empty(),
+            sigma_max: 0.0,
+            first: 0,
+            count: 0,
             children: None,
-        });
-        if count as usize <= leaf_max {
-            return id;
-        }
-        let axis = principal_axis(points, &self.indices[range.clone()]);
-        let slice = &mut self.indices[range];
-        let mid = slice.len() / 2;
-        let key = |i: &u32| points[*i as usize].coords.dot(&axis);
-        slice.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
-        let left = self.build_node(points, sigmas, first, mid as u32, leaf_max);
-        let right = self.build_node(
+        };
+        let mut nodes = vec![placeholder; subtree_nodes(points.len(), leaf_max)];
+        let mut indices: Vec<u32> = (0..n).collect();
+        let input = Input {
             points,
             sigmas,
-            first + mid as u32,
-            count - mid as u32,
             leaf_max,
+        };
+        build_node(&input, &mut nodes, 0, &mut indices, 0);
+        Ok(Bvh { nodes, indices })
+    }
+}
+
+/// Below this many points a subtree is built on the current thread.
+const PARALLEL_MIN_POINTS: usize = 4096;
+
+/// What every node of one build reads.
+struct Input<'a> {
+    points: &'a [Point3],
+    sigmas: &'a [Real],
+    leaf_max: usize,
+}
+
+/// Number of nodes of the subtree over `count` points: halving gives at most
+/// two distinct counts per depth (consecutive integers), so this walks the
+/// depths with their multiplicities.
+fn subtree_nodes(count: usize, leaf_max: usize) -> usize {
+    let mut level: Vec<(usize, usize)> = vec![(count, 1)];
+    let mut total = 0;
+    while !level.is_empty() {
+        let mut next: Vec<(usize, usize)> = Vec::with_capacity(2);
+        for (c, m) in level {
+            total += m;
+            if c > leaf_max {
+                for half in [c / 2, c - c / 2] {
+                    match next.iter_mut().find(|(k, _)| *k == half) {
+                        Some((_, mult)) => *mult += m,
+                        None => next.push((half, m)),
+                    }
+                }
+            }
+        }
+        level = next;
+    }
+    total
+}
+
+/// Builds the subtree over `indices` (the points of `first..first + len`) into
+/// `nodes`, its pre-order block, whose first node has index `id`.
+fn build_node(input: &Input<'_>, nodes: &mut [BvhNode], id: u32, indices: &mut [u32], first: u32) {
+    let count = indices.len() as u32;
+    let mut aabb = Aabb::empty();
+    let mut sigma_max: Real = 0.0;
+    for &i in indices.iter() {
+        aabb.take_point(&input.points[i as usize]);
+        sigma_max = sigma_max.max(input.sigmas[i as usize]);
+    }
+    // A subtree has at least one node (its root); `subtree_nodes` sized it.
+    let Some((node, below)) = nodes.split_first_mut() else {
+        return;
+    };
+    *node = BvhNode {
+        aabb,
+        sigma_max,
+        first,
+        count,
+        children: None,
+    };
+    if indices.len() <= input.leaf_max {
+        return;
+    }
+    let axis = principal_axis(input.points, indices);
+    let mid = indices.len() / 2;
+    let key = |i: &u32| input.points[*i as usize].coords.dot(&axis);
+    indices.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
+    let left_nodes = subtree_nodes(mid, input.leaf_max);
+    let (left_ids, right_ids) = (id + 1, id + 1 + left_nodes as u32);
+    node.children = Some([left_ids, right_ids]);
+    let (left, right) = below.split_at_mut(left_nodes);
+    let (left_idx, right_idx) = indices.split_at_mut(mid);
+    let right_first = first + mid as u32;
+    if count as usize >= PARALLEL_MIN_POINTS {
+        rayon::join(
+            || build_node(input, left, left_ids, left_idx, first),
+            || build_node(input, right, right_ids, right_idx, right_first),
         );
-        self.nodes[id as usize].children = Some([left, right]);
-        id
+    } else {
+        build_node(input, left, left_ids, left_idx, first);
+        build_node(input, right, right_ids, right_idx, right_first);
     }
 }
 

@@ -172,8 +172,8 @@ impl PointCloud {
     }
 
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
-        let sigma_max: Vec<Real> = covariances.iter().map(max_std).collect();
-        let sensor_sigma_min = covariances.iter().map(min_std).collect();
+        let sigma_max: Vec<Real> = covariances.par_iter().map(max_std).collect();
+        let sensor_sigma_min = covariances.par_iter().map(min_std).collect();
         Self {
             points,
             covariances,
@@ -198,7 +198,7 @@ impl PointCloud {
     ) -> Self {
         let mut c = Self::from_parts(points, sensor);
         c.sensor = Some(std::mem::replace(&mut c.covariances, total));
-        c.sigma_max = c.covariances.iter().map(max_std).collect();
+        c.sigma_max = c.covariances.par_iter().map(max_std).collect();
         c
     }
 
@@ -243,7 +243,7 @@ impl PointCloud {
         for (c, d) in self.covariances.iter_mut().zip(disc) {
             *c += d;
         }
-        self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.sigma_max = self.covariances.par_iter().map(max_std).collect();
         self.elements = OnceLock::new();
         Ok(self)
     }
@@ -268,7 +268,7 @@ impl PointCloud {
         for (c, d) in self.covariances.iter_mut().zip(disc) {
             *c += d;
         }
-        self.sigma_max = self.covariances.iter().map(max_std).collect();
+        self.sigma_max = self.covariances.par_iter().map(max_std).collect();
         self.elements = OnceLock::new();
         Ok(self)
     }
@@ -328,6 +328,24 @@ impl PointCloud {
     /// their farthest point). Computed on first call.
     pub fn spacing(&self) -> &[Real] {
         &self.spacing_data().per_point
+    }
+
+    /// The side of the square of surface each point stands for: the median of
+    /// [`PointCloud::spacing`] (`d_6`) times `sqrt(pi / 6)` (a surface density
+    /// of 6 points in a disc of radius `d_6`, `6 / (pi d_6^2)` points per square
+    /// metre). A regular grid of pitch `h` gives `h sqrt(2 pi / 6)`.
+    pub fn cell_side(&self) -> Real {
+        let mut s = self.spacing().to_vec();
+        let mid = s.len() / 2;
+        s.select_nth_unstable_by(mid, Real::total_cmp);
+        let median = if s.len() % 2 == 1 {
+            s[mid]
+        } else {
+            // The mean of the two middle values, as numpy's median.
+            let lower = s[..mid].iter().copied().fold(Real::NEG_INFINITY, Real::max);
+            0.5 * (lower + s[mid])
+        };
+        median * (std::f64::consts::PI / SPACING_NEIGHBOURS as Real).sqrt()
     }
 
     /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].

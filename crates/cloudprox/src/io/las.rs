@@ -24,6 +24,11 @@
 //! other panic to the hook that was there before. (A hook installed later by
 //! the program replaces it; a decoder panic then prints through that hook, and
 //! is still returned as an error.)
+//!
+//! The decoder also recurses without bound on some corrupt GPS time data, and
+//! a stack overflow cannot be caught: LAZ is decoded on a thread of its own
+//! whose stack use is checked on every read from the file (see
+//! `GuardedBytes`), so that the recursion ends in an [`Error::Format`].
 
 use std::cell::Cell;
 use std::io::Cursor;
@@ -365,15 +370,21 @@ fn check_layered_chunks(
 /// The LAZ chunk table: the crate sizes a buffer from its chunk count.
 fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Result<()> {
     let len = bytes.len() as u64;
-    let data_start = usize::try_from(data_start).map_err(|_| cur.error("offset too large"))?;
-    cur.seek(data_start)?;
-    let table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
-    let table_data = data_start as u64 + 8;
-    if table == -1 {
-        return Ok(()); // written by a streaming writer: the table is found at the end
-    }
-    if u64::try_from(table).map_or(true, |t| t <= table_data) {
-        return Ok(()); // no chunk table: the crate reads the points sequentially
+    let start = usize::try_from(data_start).map_err(|_| cur.error("offset too large"))?;
+    cur.seek(start)?;
+    let mut table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
+    let table_data = data_start + 8;
+    // As the crate does: an offset at or before the point data (-1 from a
+    // streaming writer, or any other) sends it to the file's last 8 bytes.
+    if u64::try_from(table).map_or(true, |t| t <= data_start) {
+        if len < table_data + 8 {
+            return Ok(()); // the crate fails to read it: a format error
+        }
+        cur.seek((len - 8) as usize)?;
+        table = i64::from_le_bytes(cur.take(8)?.try_into().unwrap_or([0; 8]));
+        if u64::try_from(table).map_or(true, |t| t <= data_start) {
+            return Ok(()); // no chunk table: the crate reads the points sequentially
+        }
     }
     let table = table.unsigned_abs();
     if table.checked_add(8).is_none_or(|e| e > len) {
@@ -383,11 +394,12 @@ fn check_chunk_table(bytes: &[u8], cur: &mut ByteCursor, data_start: u64) -> Res
     }
     cur.seek(table as usize + 4)?;
     let chunks = u64::from(cur.u32_le()?);
-    // Every chunk holds at least one byte of compressed points before the table.
-    if chunks > table - table_data {
+    // Every chunk holds at least one byte of compressed points before the
+    // table (a file without points lists one empty chunk).
+    let data = table.saturating_sub(table_data);
+    if chunks > data.max(1) {
         return Err(cur.error(format!(
-            "the chunk table lists {chunks} chunks but there are only {} bytes of point data",
-            table - table_data
+            "the chunk table lists {chunks} chunks but there are only {data} bytes of point data"
         )));
     }
     Ok(())
@@ -492,13 +504,113 @@ pub fn read_las(bytes: &[u8], name: &str) -> Result<CloudData> {
     let facts = check_header(bytes, name, format)?;
     // The crate is not ours: a panic inside it on a corrupt file becomes a
     // format error rather than unwinding into the caller, and prints nothing.
-    match quietly(|| read_points(bytes, name, format, &facts)) {
+    let decode = || match quietly(|| read_points(bytes, name, format, &facts)) {
         Ok(result) => result,
         Err(what) => Err(Error::format(
             name,
             format,
             format!("corrupt point data: the LAS/LAZ decoder failed ({what})"),
         )),
+    };
+    if !facts.compressed {
+        return decode();
+    }
+    // LAZ: on a thread of its own, whose stack the decoder's recursion is
+    // measured against (see `GuardedBytes`).
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("cloudprox-laz".into())
+            .stack_size(DECODER_STACK)
+            .spawn_scoped(scope, decode)
+            .map_err(|e| {
+                Error::format(
+                    name,
+                    format,
+                    format!("could not start the LAZ decoder's thread: {e}"),
+                )
+            })?
+            .join()
+            .unwrap_or_else(|_| {
+                Err(Error::format(
+                    name,
+                    format,
+                    "corrupt point data: the LAZ decoder failed",
+                ))
+            })
+    })
+}
+
+/// The stack of the LAZ decoder's thread (reserved address space; only the
+/// pages a decode touches are used).
+const DECODER_STACK: usize = 256 << 20;
+
+/// How much of [`DECODER_STACK`] the decoder may use before a read from the
+/// file is refused: the rest is the margin below.
+const DECODER_STACK_LIMIT: usize = 64 << 20;
+
+thread_local! {
+    /// The address of a local at the top of the decoder's frames, when this
+    /// thread is inside [`read_points`] (0 otherwise).
+    static STACK_BASE: Cell<usize> = const { Cell::new(0) };
+}
+
+/// The address of a local of the caller's frame: how deep the stack is.
+#[inline(never)]
+fn stack_position() -> usize {
+    let marker = 0u8;
+    std::ptr::from_ref(std::hint::black_box(&marker)).addr()
+}
+
+/// The file's bytes as the `las` crate reads them, with a check of the stack
+/// on every read.
+///
+/// The `laz` decoder (0.13, the latest release) decodes a GPS time that
+/// switches to another of its four sequences by calling itself
+/// (`las/gps.rs`, `decompress_with`, as LASzip does), as often as the
+/// arithmetic-coded data says: on corrupt data without bound, until the stack
+/// overflows, which aborts the process and cannot be caught. Its arithmetic
+/// decoder reads a byte from the file at least every 36 400 symbols (a
+/// symbol's probability is at most `1 - 5 / 2^15` in its adaptive models, and
+/// it reads a byte whenever the interval has shrunk by `2^8`), one symbol per
+/// level of that recursion. So a read that finds more than
+/// [`DECODER_STACK_LIMIT`] of the decoder thread's stack in use fails (an
+/// `io::Error` the decoder passes up, which unwinds the recursion), and the
+/// recursion cannot grow by more than 36 400 frames (192 MiB at 5 KiB a
+/// frame) before the next read checks again.
+#[derive(Debug)]
+struct GuardedBytes(Cursor<Vec<u8>>);
+
+impl std::io::Read for GuardedBytes {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let base = STACK_BASE.with(Cell::get);
+        if base != 0 && base.abs_diff(stack_position()) > DECODER_STACK_LIMIT {
+            return Err(std::io::Error::other(format!(
+                "the LAZ decoder recursed past {} MiB of stack (corrupt GPS time data)",
+                DECODER_STACK_LIMIT >> 20
+            )));
+        }
+        self.0.read(buf)
+    }
+}
+
+impl std::io::Seek for GuardedBytes {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.0.seek(pos)
+    }
+}
+
+/// Sets [`STACK_BASE`] for the duration of a decode.
+struct StackScope(usize);
+
+impl StackScope {
+    fn enter() -> Self {
+        StackScope(STACK_BASE.with(|b| b.replace(stack_position())))
+    }
+}
+
+impl Drop for StackScope {
+    fn drop(&mut self) {
+        STACK_BASE.with(|b| b.set(self.0));
     }
 }
 
@@ -510,7 +622,8 @@ fn read_points(
 ) -> Result<CloudData> {
     let crate_err =
         |what: &str, e: &las::Error| Error::format(name, format, format!("{what}: {e}"));
-    let mut reader = las::Reader::new(Cursor::new(bytes.to_vec())).map_err(|e| {
+    let _stack = StackScope::enter();
+    let mut reader = las::Reader::new(GuardedBytes(Cursor::new(bytes.to_vec()))).map_err(|e| {
         crate_err(
             "cannot read the header, its records or the LAZ chunk table",
             &e,
@@ -572,4 +685,54 @@ fn read_points(
         done += got;
     }
     Ok(builder.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+
+    #[test]
+    fn a_runaway_recursion_fails_its_read_before_the_stack_overflows() {
+        // Without the guard this overflows the stack and aborts the test run.
+        let depth = std::thread::Builder::new()
+            .stack_size(DECODER_STACK)
+            .spawn(|| {
+                let _stack = StackScope::enter();
+                let mut src = GuardedBytes(Cursor::new(vec![0u8; 1 << 20]));
+                let mut reached = 0;
+                let err = recurse_counting(&mut src, 0, &mut reached).unwrap_err();
+                assert!(err.to_string().contains("recursed past 64 MiB"), "{err}");
+                reached
+            })
+            .unwrap()
+            .join()
+            .unwrap();
+        // Stopped at the first read past the limit: 64 MiB of frames of at
+        // least 4 KiB is at most 16 384 levels (at least 8 000 if the compiler
+        // doubles the frame).
+        assert!((8_000..=17_000).contains(&depth), "{depth}");
+        // Outside a decode (no stack scope) reads are never refused.
+        let mut plain = GuardedBytes(Cursor::new(vec![7u8; 4]));
+        let mut b = [0u8; 4];
+        plain.read_exact(&mut b).unwrap();
+        assert_eq!(b, [7; 4]);
+    }
+
+    /// A recursion like the decoder's: a 4 KiB frame a level, a byte read
+    /// from the file every 1000 levels, no end but a failed read.
+    fn recurse_counting(
+        src: &mut GuardedBytes,
+        depth: usize,
+        reached: &mut usize,
+    ) -> std::io::Result<usize> {
+        *reached = depth;
+        let frame = std::hint::black_box([depth as u8; 4096]);
+        if depth % 1000 == 0 {
+            let mut b = [0u8; 1];
+            src.read_exact(&mut b)?;
+        }
+        let deeper = recurse_counting(src, depth + 1, reached)?;
+        Ok(deeper + usize::from(frame[depth % 4096] == 0))
+    }
 }

@@ -18,4 +18,4 @@ pub use covariance::{covariance_factor, max_std, min_std, validate_covariance};
 pub use discretization::{discretization_covariances, DiscretizationSettings};
 pub use noise::NoiseModel;
 pub use robust::RobustModel;
-pub use sensor::{DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};
+pub use sensor::{ray_covariances, DepthCamera, Lidar, SensorModel, StereoCamera, Viewpoint};

@@ -33,7 +33,7 @@ impl ExactProximity {
     }
 }
 
-fn as_shape(p: &ExactPart) -> &dyn Shape {
+pub(super) fn as_shape(p: &ExactPart) -> &dyn Shape {
     match p {
         ExactPart::Convex(c) => c,
         ExactPart::Mesh { mesh, .. } => mesh,

@@ -5,12 +5,17 @@
 //! a closed convex part becomes a convex polyhedron (exact GJK distance, EPA
 //! penetration depth), any other part a triangle mesh (exact distance and
 //! intersection; point containment through pseudo-normals when it is closed).
+//! [`exact_time_of_impact`] moves one object along a straight line until its
+//! signed distance to the other reaches a target (shape casting, then a search
+//! on the penetration depth for a negative target).
 
 #[allow(clippy::module_inception)]
 mod exact;
 mod exact_shape;
+mod time_of_impact;
 
 pub use exact::{
     exact_intersects, exact_intersects_many, exact_proximity, exact_proximity_many, ExactProximity,
 };
 pub use exact_shape::{ExactPart, ExactShape};
+pub use time_of_impact::{exact_time_of_impact, exact_time_of_impact_many, IMPACT_TOLERANCE};

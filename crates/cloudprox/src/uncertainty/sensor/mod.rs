@@ -228,3 +228,34 @@ pub(crate) fn check_param(name: &str, value: Real, zero_ok: bool) -> Result<()> 
         )))
     }
 }
+
+/// Covariances with fixed standard deviations along and across each point's
+/// viewing ray from `viewpoint`: `sigma_ray^2 u u^T + sigma_lat^2 (I - u u^T)`,
+/// the form every model of this module gives, with its laws left out (for a
+/// noise level set by hand, such as an experiment's anisotropic noise).
+///
+/// # Errors
+/// [`Error::InvalidInput`] for a negative or non-finite standard deviation, a
+/// bad viewpoint, a non-finite point, a point at the origin, or (axis known) a
+/// point not in front of the sensor; the message names the point.
+pub fn ray_covariances(
+    points: &[Point3],
+    viewpoint: &Viewpoint,
+    sigma_ray: Real,
+    sigma_lat: Real,
+) -> Result<Vec<Matrix3>> {
+    check_param("sigma_ray", sigma_ray, true)?;
+    check_param("sigma_lat", sigma_lat, true)?;
+    let vp = viewpoint.validated()?;
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            Ok(ray_covariance(
+                &ray_of(i, p, &vp)?.dir,
+                sigma_ray,
+                sigma_lat,
+            ))
+        })
+        .collect()
+}

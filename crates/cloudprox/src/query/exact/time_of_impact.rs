@@ -1,0 +1,401 @@
+//! Exact time of impact: how far an [`ExactShape`] moves along a straight line
+//! before its signed distance to another reaches a target.
+
+use nalgebra::Translation3;
+use parry3d_f64::query::{self, PointQuery, ShapeCastOptions};
+use parry3d_f64::shape::TriMesh;
+use rayon::prelude::*;
+
+use super::exact::{as_shape, exact_intersects, exact_proximity};
+use super::exact_shape::{ExactPart, ExactShape};
+use crate::cloud::validate_pose;
+use crate::error::{Error, Result};
+use crate::math::{Pose, Vector3};
+use crate::Real;
+
+/// Precision of a penetration target (metres): the search past contact stops
+/// when the signed distance is within this of the target.
+pub const IMPACT_TOLERANCE: Real = 1e-10;
+
+/// Most signed-distance evaluations of the search past contact.
+const MAX_STEPS: usize = 200;
+
+/// `pose` translated by `t` along the unit `direction`.
+fn moved(pose: &Pose, direction: &Vector3, t: Real) -> Pose {
+    Pose::from_parts(
+        Translation3::from(pose.translation.vector + direction * t),
+        pose.rotation,
+    )
+}
+
+/// The first travel (at most `max_travel`) along `direction` at which part `a`
+/// comes within `target` (>= 0) of part `b`. A convex part and a mesh: the
+/// part with more triangles is cast against the other (parry prunes the outer
+/// shape's hierarchy with the inner shape's whole box); two meshes: see
+/// [`cast_mesh_mesh`].
+fn cast_pair(
+    pa: &Pose,
+    a: &ExactPart,
+    direction: &Vector3,
+    pb: &Pose,
+    b: &ExactPart,
+    target: Real,
+    max_travel: Real,
+) -> Result<Option<Real>> {
+    let triangles = |p: &ExactPart| match p {
+        ExactPart::Convex(_) => 0,
+        ExactPart::Mesh { mesh, .. } => mesh.num_triangles(),
+    };
+    let options = ShapeCastOptions {
+        max_time_of_impact: max_travel,
+        target_distance: target,
+        stop_at_penetration: true,
+        compute_impact_geometry_on_penetration: false,
+    };
+    let zero = Vector3::zeros();
+    if let (ExactPart::Mesh { mesh: ma, .. }, ExactPart::Mesh { mesh: mb, .. }) = (a, b) {
+        return Ok(cast_mesh_mesh(pa, ma, direction, pb, mb, options));
+    }
+    let hit = if triangles(b) > triangles(a) {
+        // b moves by -direction relative to a: the same travel.
+        query::cast_shapes(
+            pb,
+            &-direction,
+            as_shape(b),
+            pa,
+            &zero,
+            as_shape(a),
+            options,
+        )
+    } else {
+        query::cast_shapes(pa, direction, as_shape(a), pb, &zero, as_shape(b), options)
+    }
+    .map_err(|_| Error::invalid("parry cannot cast this pair of parts"))?;
+    Ok(hit
+        .map(|h| h.time_of_impact.max(0.0))
+        .filter(|&t| t <= max_travel))
+}
+
+/// Two triangle meshes: each triangle of the one with fewer triangles is cast
+/// against the other's tree, the nearest first, each with the best travel so
+/// far as its reach (parry's own mesh-mesh cast prunes the
+/// outer tree with the inner mesh's whole box, and gives every inner cast the
+/// full reach: far slower for a gripper against a scanned surface).
+fn cast_mesh_mesh(
+    pa: &Pose,
+    a: &TriMesh,
+    direction: &Vector3,
+    pb: &Pose,
+    b: &TriMesh,
+    options: ShapeCastOptions,
+) -> Option<Real> {
+    // Cast the smaller mesh, moving by `dir` relative to the larger one.
+    let (ps, small, dir, pl, large) = if a.num_triangles() <= b.num_triangles() {
+        (pa, a, *direction, pb, b)
+    } else {
+        (pb, b, -direction, pa, a)
+    };
+    // Each triangle's key: the smallest distance of its corners to the other
+    // mesh at the start (point queries on its tree, cheap). A corner within
+    // the target means the start is; otherwise the nearest triangles go first,
+    // so that a hit comes early and shortens every later cast.
+    let corner: Vec<Real> = small
+        .vertices()
+        .iter()
+        .map(|v| large.distance_to_point(pl, &(ps * v), false))
+        .collect();
+    // With its longest edge: no point of the triangle is nearer than its
+    // nearest corner less that edge, and a move by `L` brings it at most `L`
+    // closer, so a triangle whose bound exceeds the target plus the best
+    // travel so far cannot hit first and is skipped.
+    let verts = small.vertices();
+    let mut order: Vec<(Real, Real, usize)> = small
+        .indices()
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let near = t
+                .iter()
+                .map(|&k| corner[k as usize])
+                .fold(Real::INFINITY, Real::min);
+            let [p, q, r] = t.map(|k| verts[k as usize]);
+            let edge = (p - q).norm().max((q - r).norm()).max((r - p).norm());
+            (near, edge, i)
+        })
+        .collect();
+    if order.iter().any(|&(d, _, _)| d <= options.target_distance) {
+        return Some(0.0);
+    }
+    order.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let zero = Vector3::zeros();
+    let mut best: Option<Real> = None;
+    for (near, edge, i) in order {
+        let reach = best.unwrap_or(options.max_time_of_impact);
+        if near - edge > options.target_distance + reach {
+            continue;
+        }
+        let tri = small.triangle(i as u32);
+        let hit = query::cast_shapes(
+            ps,
+            &dir,
+            &tri,
+            pl,
+            &zero,
+            large,
+            ShapeCastOptions {
+                max_time_of_impact: reach,
+                ..options
+            },
+        )
+        .ok()
+        .flatten()
+        .map(|h| h.time_of_impact.max(0.0))
+        .filter(|&t| t <= reach);
+        if let Some(t) = hit {
+            best = Some(t);
+            if t == 0.0 {
+                break;
+            }
+        }
+    }
+    best
+}
+
+/// The first travel at which the closest part pair comes within `target` (>= 0):
+/// pairs are taken in the order of their boxes' distance, which bounds their
+/// travel from below (a translation by `L` changes a distance by at most `L`).
+fn cast_shapes_to(
+    pose_a: &Pose,
+    a: &ExactShape,
+    direction: &Vector3,
+    pose_b: &Pose,
+    b: &ExactShape,
+    target: Real,
+    max_travel: Real,
+) -> Result<Option<Real>> {
+    let boxes_b: Vec<_> = b.aabbs.iter().map(|x| x.transformed(pose_b)).collect();
+    let mut pairs: Vec<(Real, usize, usize)> = Vec::new();
+    for (i, box_a) in a.aabbs.iter().enumerate() {
+        let box_a = box_a.transformed(pose_a);
+        for (j, box_b) in boxes_b.iter().enumerate() {
+            pairs.push(((box_a.distance(box_b) - target).max(0.0), i, j));
+        }
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut best: Option<Real> = None;
+    for (lower_bound, i, j) in pairs {
+        let reach = best.unwrap_or(max_travel);
+        if lower_bound > reach {
+            break;
+        }
+        let hit = cast_pair(
+            pose_a,
+            &a.parts[i],
+            direction,
+            pose_b,
+            &b.parts[j],
+            target,
+            reach,
+        )?;
+        if let Some(t) = hit {
+            best = Some(best.map_or(t, |x| x.min(t)));
+        }
+    }
+    Ok(best)
+}
+
+/// The signed distance of `a` moved by `t` (an error where the depth is unknown).
+fn signed_at(
+    pose_a: &Pose,
+    a: &ExactShape,
+    direction: &Vector3,
+    pose_b: &Pose,
+    b: &ExactShape,
+    t: Real,
+) -> Result<Real> {
+    let s = exact_proximity(&moved(pose_a, direction, t), a, pose_b, b).signed_distance();
+    if s.is_nan() {
+        return Err(Error::invalid(
+            "a negative target needs penetration depths, which are known only \
+             between convex parts (a non-convex part intersects)",
+        ));
+    }
+    Ok(s)
+}
+
+/// Past contact (travel `t0`): a travel where the signed distance `s` reaches
+/// `target` (< 0). `s` changes by at most `L` over a translation by `L`, so a
+/// step of `s - target` never passes a crossing (conservative advancement);
+/// each step also tries the secant's root, and once a pose at or below the
+/// target is found the crossing is bisected.
+#[allow(clippy::too_many_arguments)]
+fn search_past_contact(
+    pose_a: &Pose,
+    a: &ExactShape,
+    direction: &Vector3,
+    pose_b: &Pose,
+    b: &ExactShape,
+    target: Real,
+    t0: Real,
+    max_travel: Real,
+) -> Result<Option<Real>> {
+    let f = |t: Real| signed_at(pose_a, a, direction, pose_b, b, t).map(|s| s - target);
+    let (mut lo, mut f_lo) = (t0, f(t0)?);
+    let mut upper: Option<Real> = None;
+    let mut steps = 1;
+    while upper.is_none() && steps < MAX_STEPS {
+        if f_lo <= IMPACT_TOLERANCE {
+            return Ok(Some(lo));
+        }
+        let safe = lo + f_lo;
+        if safe > max_travel {
+            return Ok(None);
+        }
+        let f_safe = f(safe)?;
+        steps += 1;
+        if f_safe <= 0.0 {
+            upper = Some(safe);
+            break;
+        }
+        let slope = (f_lo - f_safe) / (safe - lo);
+        (lo, f_lo) = (safe, f_safe);
+        // The secant's root only serves as a bracket: a crossing between `lo`
+        // and it cannot be ruled out, so `lo` advances by safe steps alone.
+        if slope > 0.0 && f_safe > IMPACT_TOLERANCE {
+            let guess = (safe + f_safe / slope).min(max_travel);
+            let f_guess = f(guess)?;
+            steps += 1;
+            if f_guess <= 0.0 {
+                upper = Some(guess);
+            }
+        }
+    }
+    let Some(mut hi) = upper else {
+        return Ok(None);
+    };
+    while steps < MAX_STEPS && hi - lo > IMPACT_TOLERANCE {
+        let mid = 0.5 * (lo + hi);
+        let f_mid = f(mid)?;
+        steps += 1;
+        if f_mid <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+        if f_mid.abs() <= IMPACT_TOLERANCE {
+            return Ok(Some(mid));
+        }
+    }
+    Ok(Some(hi))
+}
+
+/// How far `a`, starting at `pose_a`, moves along `direction` (its orientation
+/// kept) before its signed distance to `b` at `pose_b` first reaches `target`
+/// (metres; the travel is in metres along the unit direction).
+///
+/// - `target >= 0`: the first travel at which the distance comes down to
+///   `target`, by parry's shape casting (GJK directional distance) over the part
+///   pairs: exact for contact between polyhedra, within GJK's relative
+///   tolerance (about 1e-7 of the travel) for a gap, which it casts with one
+///   shape rounded by the gap.
+/// - `target < 0`: a penetration depth of `-target`: the first contact as
+///   above, then a search along the line past it on the signed distance of
+///   [`exact_proximity`] (conservative advancement, secant steps, bisection;
+///   to within [`IMPACT_TOLERANCE`]). It is the first crossing unless the
+///   signed distance dips below the target and comes back between two
+///   evaluations.
+///
+/// Returns `Some(0.0)` when the objects start at or within the target (for
+/// `target >= 0`, when they start closer than it or intersecting, containment
+/// included), `None` when the target is not reached within `max_travel` (or,
+/// for a negative target, within 200 evaluations).
+///
+/// # Errors
+/// [`Error::InvalidInput`] if a pose is not finite (or its translation beyond
+/// the coordinate range), `direction` is not a finite non-zero vector,
+/// `target` is not finite, `max_travel` is NaN or negative, or `target < 0`
+/// while an intersecting part pair is not convex (its depth is unknown).
+pub fn exact_time_of_impact(
+    pose_a: &Pose,
+    a: &ExactShape,
+    direction: &Vector3,
+    pose_b: &Pose,
+    b: &ExactShape,
+    target: Real,
+    max_travel: Real,
+) -> Result<Option<Real>> {
+    validate_pose(pose_a, "pose_a")?;
+    validate_pose(pose_b, "pose_b")?;
+    let norm = direction.norm();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(Error::invalid(format!(
+            "direction {:?} is not a finite non-zero vector",
+            direction.as_slice()
+        )));
+    }
+    if !target.is_finite() {
+        return Err(Error::invalid(format!("target {target} is not finite")));
+    }
+    if max_travel.is_nan() || max_travel < 0.0 {
+        return Err(Error::invalid(format!(
+            "max_travel {max_travel} is not >= 0"
+        )));
+    }
+    let direction = direction / norm;
+    if exact_intersects(pose_a, a, pose_b, b) {
+        if target >= 0.0 {
+            return Ok(Some(0.0));
+        }
+        if signed_at(pose_a, a, &direction, pose_b, b, 0.0)? <= target {
+            return Ok(Some(0.0));
+        }
+        return search_past_contact(pose_a, a, &direction, pose_b, b, target, 0.0, max_travel);
+    }
+    let contact = cast_shapes_to(
+        pose_a,
+        a,
+        &direction,
+        pose_b,
+        b,
+        target.max(0.0),
+        max_travel,
+    )?;
+    match contact {
+        Some(t0) if target < 0.0 => {
+            search_past_contact(pose_a, a, &direction, pose_b, b, target, t0, max_travel)
+        }
+        other => Ok(other),
+    }
+}
+
+/// [`exact_time_of_impact`] for many starts of `a`, each with its direction
+/// and target, in parallel.
+///
+/// # Errors
+/// [`Error::Shape`] if `directions` or `targets` do not have one entry per
+/// pose; otherwise the first error of [`exact_time_of_impact`] (by pose index).
+pub fn exact_time_of_impact_many(
+    poses_a: &[Pose],
+    a: &ExactShape,
+    directions: &[Vector3],
+    pose_b: &Pose,
+    b: &ExactShape,
+    targets: &[Real],
+    max_travel: Real,
+) -> Result<Vec<Option<Real>>> {
+    for (what, got) in [("directions", directions.len()), ("targets", targets.len())] {
+        if got != poses_a.len() {
+            return Err(Error::Shape {
+                what: format!("{what} (one per pose)"),
+                expected: poses_a.len(),
+                got,
+            });
+        }
+    }
+    poses_a
+        .par_iter()
+        .zip(directions.par_iter())
+        .zip(targets.par_iter())
+        .map(|((p, d), &t)| exact_time_of_impact(p, a, d, pose_b, b, t, max_travel))
+        .collect()
+}
