@@ -144,6 +144,10 @@ pub(crate) fn collide_with_workspace(
     let mut inputs_a = vec![0.0; sa.len()];
     let mut inputs_b = vec![0.0; sb.len()];
     let mut regions = Vec::new();
+    // The samples given an input: every other input is 0, which changes no
+    // aggregate, so `P` reads these alone (a query against a cloud of 10^7
+    // points then does not pass over all of them).
+    let mut touched: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     let stop_early = request.decide_only
         && matches!(request.aggregation, Aggregation::Max | Aggregation::Surface);
     'regions: for component in near.regions {
@@ -266,6 +270,8 @@ pub(crate) fn collide_with_workspace(
             for (&i, &q) in ib.iter().zip(&qb) {
                 inputs_b[i as usize] = q;
             }
+            touched.0.extend_from_slice(&ia);
+            touched.1.extend_from_slice(&ib);
             let patch_probability = request.aggregation.aggregate(
                 core_values(indexed(&ia, &qa), &core.0)
                     .chain(core_values(indexed(&ib, &qb), &core.1)),
@@ -324,9 +330,15 @@ pub(crate) fn collide_with_workspace(
         }
     }
     stats.counters.patches = regions.len();
+    // In index order, as over every sample: a sum's order is kept, and the
+    // zeros left out add exactly nothing.
+    for t in [&mut touched.0, &mut touched.1] {
+        t.sort_unstable();
+        t.dedup();
+    }
     let probability = request.aggregation.aggregate(
-        core_values(inputs_a.iter().copied().enumerate(), &core.0)
-            .chain(core_values(inputs_b.iter().copied().enumerate(), &core.1)),
+        core_values(indexed_inputs(&touched.0, &inputs_a), &core.0)
+            .chain(core_values(indexed_inputs(&touched.1, &inputs_b), &core.1)),
     );
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
@@ -350,6 +362,14 @@ fn crossing_sds(reach: Real, collision: Real) -> Real {
 /// Patches are cut on a misfit only while both halves keep this many points of
 /// each cloud.
 const MIN_CUT_POINTS: usize = 16;
+
+/// `(sample index, input)` of the samples `idx`.
+fn indexed_inputs<'a>(
+    idx: &'a [u32],
+    inputs: &'a [Real],
+) -> impl Iterator<Item = (usize, Real)> + 'a {
+    idx.iter().map(|&i| (i as usize, inputs[i as usize]))
+}
 
 /// Median over a patch's points (`ia` of A, `ib` of B) of a per-point quantity.
 fn patch_median(ia: &[u32], of_a: &[Real], ib: &[u32], of_b: &[Real]) -> Real {
