@@ -1,21 +1,12 @@
 //! `exact_time_of_impact`: travel along a direction until a target signed
 //! distance, on cases with closed-form answers, and its refusals of bad input.
 
+mod common;
+
 use cloudprox::prelude::*;
 use cloudprox::query::exact::{exact_time_of_impact, exact_time_of_impact_many};
+use common::{at, cube, shape};
 use nalgebra::{Translation3, UnitQuaternion};
-
-fn cube(h: f64) -> Mesh {
-    Mesh::cuboid(h, h, h).unwrap()
-}
-
-fn shape(parts: &[Mesh]) -> ExactShape {
-    ExactShape::new(parts).unwrap()
-}
-
-fn at(x: f64, y: f64, z: f64) -> Pose {
-    Pose::translation(x, y, z)
-}
 
 /// A 0.1 m half-side cube at the origin and a wall (0.1 m half-thick, 10 m
 /// wide) centred at x = 1: faces 0.8 apart along x.

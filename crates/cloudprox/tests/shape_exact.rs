@@ -1,21 +1,12 @@
 //! Meshes, their sampling and exact mesh-vs-mesh proximity, on cases with known
 //! answers.
 
+mod common;
+
 use cloudprox::prelude::*;
 use cloudprox::query::exact::{exact_proximity_many, ExactPart};
+use common::{at, cube, shape};
 use nalgebra::{Translation3, UnitQuaternion};
-
-fn cube(h: f64) -> Mesh {
-    Mesh::cuboid(h, h, h).unwrap()
-}
-
-fn shape(parts: &[Mesh]) -> ExactShape {
-    ExactShape::new(parts).unwrap()
-}
-
-fn at(x: f64, y: f64, z: f64) -> Pose {
-    Pose::translation(x, y, z)
-}
 
 #[test]
 fn primitives_have_their_analytic_area_and_volume() {

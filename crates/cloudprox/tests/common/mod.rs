@@ -72,3 +72,18 @@ pub fn garbage(len: usize, seed: u32) -> Vec<u8> {
         })
         .collect()
 }
+
+/// A cube of half-side `h` at the origin.
+pub fn cube(h: f64) -> Mesh {
+    Mesh::cuboid(h, h, h).unwrap()
+}
+
+/// An exact shape of `parts`.
+pub fn shape(parts: &[Mesh]) -> ExactShape {
+    ExactShape::new(parts).unwrap()
+}
+
+/// A translation.
+pub fn at(x: f64, y: f64, z: f64) -> Pose {
+    Pose::translation(x, y, z)
+}
