@@ -225,3 +225,50 @@ fn barrier_method_agrees_with_clarabel() {
         }
     }
 }
+
+#[test]
+fn the_specialized_method_solves_large_patches_in_few_iterations() {
+    // Every point is a constraint of one solve (no working set): the optimum
+    // must match Clarabel's at 2000 points, anisotropic covariances, and the
+    // primal-dual method's iteration count must stay that of a small problem
+    // (a barrier method or a working set needed several hundred steps here).
+    for (seed, gap) in [(7u64, 0.05), (8, -0.05)] {
+        let (pts, covs, labels) = scene(2000, gap, seed, false);
+        let s = |solver| ClassifySettings {
+            surface: Surface::Quadric,
+            solver,
+            ..ClassifySettings::default()
+        };
+        let fb = train(&pts, &covs, &labels, &s(SocpSolver::Barrier)).unwrap();
+        let fc = train(&pts, &covs, &labels, &s(SocpSolver::Clarabel)).unwrap();
+        assert_eq!(fb.solver, SocpSolver::Barrier, "gap {gap}: fell back");
+        assert!(
+            fb.iterations <= 40,
+            "gap {gap}: {} iterations",
+            fb.iterations
+        );
+        let ob = objective(
+            &fb,
+            &fb.separator.w,
+            fb.separator.b,
+            &pts,
+            &covs,
+            &labels,
+            &s(SocpSolver::Barrier),
+        );
+        let oc = objective(
+            &fc,
+            &fc.separator.w,
+            fc.separator.b,
+            &pts,
+            &covs,
+            &labels,
+            &s(SocpSolver::Clarabel),
+        );
+        assert!(
+            (ob - oc).abs() <= 1e-5 * oc.abs().max(1.0),
+            "gap {gap}: specialized {ob} vs clarabel {oc}"
+        );
+        assert!(fb.slacks.iter().all(|&x| x >= 0.0) && fb.slacks.len() == pts.len());
+    }
+}

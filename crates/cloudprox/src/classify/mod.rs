@@ -11,9 +11,9 @@
 //! where `J_i` is the Jacobian of `phi` at `x_i`, so `J_i^T w` is the gradient of
 //! the surface `f(x) = w . phi(x) + b` and `|Sigma_i^(1/2) grad f|` its standard
 //! deviation at the point (the covariance pushed through the feature map). It is
-//! a second-order cone program, solved by a specialized barrier method whose
-//! Newton systems have only `dim + 1` unknowns ([`SocpSolver::Barrier`], the
-//! default), with Clarabel ([`SocpSolver::Clarabel`]) as the exact reference and
+//! a second-order cone program, solved by a specialized primal-dual
+//! interior-point method whose Newton systems have only `dim + 1` unknowns
+//! ([`SocpSolver::Barrier`], the default), with Clarabel ([`SocpSolver::Clarabel`]) as the exact reference and
 //! the fallback. Coordinates are normalized per
 //! problem (centred, divided by their RMS radius) and the covariances scaled by
 //! the same factor squared.
@@ -24,7 +24,7 @@
 //!   [`SolveStatus`] report the outcome as data (a failed solve is not an error:
 //!   it falls back to a documented plane).
 
-mod barrier;
+mod primal_dual;
 mod problem;
 mod separator;
 mod settings;

@@ -1,4 +1,13 @@
-//! Assembly of the robust SOCP in Clarabel's form `min 1/2 z'Pz + q'z, Az + s = b, s in K`.
+//! The robust SOCP's data: the points in normalized coordinates, the problem
+//! assembled in Clarabel's form `min 1/2 z'Pz + q'z, Az + s = b, s in K`, and
+//! its reduced form for the specialized method, one small cone per point.
+//!
+//! The problem (see the [module docs](crate::classify)) has `dim + 1 + n`
+//! unknowns `(w, b, xi)`, but each slack `xi_i` appears only in point `i`'s
+//! cone and in `xi_i >= 0`: for each point it suffices to keep
+//! `a_i = c_i (phi_i, 1)` and the three rows of `B_i = r L_i^T J_i^T` (padded
+//! with a zero for `b`), the cone being `(a_i . z + xi_i - 1, B_i z)`,
+//! `z = (w, b)` ([`ConeData`]).
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::SupportedConeT::{self, NonnegativeConeT, SecondOrderConeT};
@@ -171,4 +180,73 @@ pub(crate) fn assemble(
         cones,
         dim: d,
     }
+}
+
+/// The largest `dim + 1` of any surface (the quadric's 9 coefficients and `b`).
+pub(crate) const MAX_UNKNOWNS: usize = 10;
+
+/// One point's constraint: `a = c_i (phi_i, 1)` and the rows of `B_i`.
+#[derive(Clone, Copy)]
+pub(crate) struct ConeData {
+    pub a: [Real; MAX_UNKNOWNS],
+    pub b: [[Real; MAX_UNKNOWNS]; 3],
+}
+
+impl ConeData {
+    /// `(a . z, B z)`.
+    #[inline]
+    pub fn apply(&self, z: &[Real]) -> [Real; 4] {
+        let mut g = [0.0; 4];
+        for (k, &zk) in z.iter().enumerate().take(MAX_UNKNOWNS) {
+            g[0] += self.a[k] * zk;
+            g[1] += self.b[0][k] * zk;
+            g[2] += self.b[1][k] * zk;
+            g[3] += self.b[2][k] * zk;
+        }
+        g
+    }
+
+    /// `out += t_0 a + B^T t_(1:3)`.
+    #[inline]
+    pub fn add_transposed(&self, t: &[Real; 4], out: &mut [Real]) {
+        for (k, o) in out.iter_mut().enumerate().take(MAX_UNKNOWNS) {
+            *o +=
+                t[0] * self.a[k] + t[1] * self.b[0][k] + t[2] * self.b[1][k] + t[3] * self.b[2][k];
+        }
+    }
+}
+
+/// Each point's cone in the reduced form (see [`ConeData`]).
+pub(crate) fn cone_data(
+    norm: &Normalized,
+    labels: &[Real],
+    surface: Surface,
+    r: Real,
+) -> Vec<ConeData> {
+    let d = surface.dim();
+    let mut phi = [0.0; 9];
+    let mut jac = [Vector3::zeros(); 9];
+    norm.u
+        .iter()
+        .zip(labels)
+        .zip(&norm.factors)
+        .map(|((u, &c), l)| {
+            surface.features(u, &mut phi[..d], &mut jac[..d]);
+            let mut cone = ConeData {
+                a: [0.0; MAX_UNKNOWNS],
+                b: [[0.0; MAX_UNKNOWNS]; 3],
+            };
+            for k in 0..d {
+                cone.a[k] = c * phi[k];
+            }
+            cone.a[d] = c;
+            let lt = l.transpose();
+            for (row, b) in cone.b.iter_mut().enumerate() {
+                for k in 0..d {
+                    b[k] = r * lt.row(row).dot(&jac[k].transpose());
+                }
+            }
+            cone
+        })
+        .collect()
 }

@@ -1,9 +1,9 @@
-//! Solving the robust SOCP (the barrier method, or Clarabel as reference and
-//! fallback), and the outcome as data.
+//! Solving the robust SOCP (the specialized primal-dual method, or Clarabel as
+//! reference and fallback), and the outcome as data.
 
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
 
-use crate::classify::barrier::solve_barrier;
+use crate::classify::primal_dual::solve_reduced;
 use crate::classify::problem::{assemble, Normalized};
 use crate::classify::{ClassifySettings, Separator, SocpSolver};
 use crate::error::{Error, Result};
@@ -13,7 +13,8 @@ use crate::Real;
 /// How a classification ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SolveStatus {
-    /// The solver (barrier or Clarabel) converged to the requested tolerance.
+    /// The solver (the specialized method or Clarabel) converged to the requested
+    /// tolerance.
     Solved,
     /// Clarabel converged to its reduced tolerance.
     AlmostSolved,
@@ -43,7 +44,7 @@ pub struct Classification {
     pub status: SolveStatus,
     /// The solver that produced the separator (Clarabel for the fallback too).
     pub solver: SocpSolver,
-    /// Interior-point iterations (Newton steps for the barrier method).
+    /// Interior-point iterations.
     pub iterations: u32,
     /// Optimal slacks `xi_i` in the input order (empty on fallback).
     pub slacks: Vec<Real>,
@@ -86,7 +87,7 @@ pub fn train(
     let r = settings.robust_radius()?;
     let norm = Normalized::new(points, covs);
     if settings.solver == SocpSolver::Barrier {
-        if let Some(sol) = solve_barrier(
+        if let Some(sol) = solve_reduced(
             &norm,
             labels,
             settings.surface,
@@ -105,7 +106,7 @@ pub fn train(
                 },
                 status: SolveStatus::Solved,
                 solver: SocpSolver::Barrier,
-                iterations: sol.newton_steps,
+                iterations: sol.iterations,
                 slacks: sol.xi,
             });
         }
