@@ -228,10 +228,11 @@ fn barrier_method_agrees_with_clarabel() {
 
 #[test]
 fn the_specialized_method_solves_large_patches_in_few_iterations() {
-    // Every point is a constraint of one solve (no working set): the optimum
-    // must match Clarabel's at 2000 points, anisotropic covariances, and the
+    // Interleaved patches: nearly every constraint is active, so the working
+    // set gives way to the full problem at once. The optimum must match
+    // Clarabel's at 2000 points with anisotropic covariances, and the
     // primal-dual method's iteration count must stay that of a small problem
-    // (a barrier method or a working set needed several hundred steps here).
+    // (the barrier method it replaced needed several hundred steps here).
     for (seed, gap) in [(7u64, 0.05), (8, -0.05)] {
         let (pts, covs, labels) = scene(2000, gap, seed, false);
         let s = |solver| ClassifySettings {

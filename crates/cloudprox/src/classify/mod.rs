@@ -30,6 +30,7 @@ mod separator;
 mod settings;
 mod solve;
 mod surface;
+mod working_set;
 
 pub use separator::Separator;
 pub use settings::{ClassifySettings, ClassifySettingsBuilder, SocpSolver};

@@ -28,18 +28,16 @@
 //! `c (2 v_0 p - a)` to the `z, xi_i` column and `c (2 v_0^2 - 1) + y_i / s_i`
 //! (its half-line's scaling) to the `xi_i` diagonal.
 //!
-//! Every point is a constraint of the one solve: the iteration count hardly
-//! grows with the points (11-14 iterations from 100 to 1600 points of two
-//! facing patches), so solving on a growing working set of the constraints
-//! (the barrier method this replaced did) costs more rounds than it saves.
+//! The iteration count hardly grows with the points (11-14 iterations from
+//! 100 to 2000 points of two facing patches); which points it sees is
+//! [`super::working_set`]'s choice.
 //!
 //! Clarabel stays the exact reference: tests compare the two, and
 //! [`super::train`] falls back to Clarabel when this method does not converge.
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::classify::problem::{cone_data, ConeData, Normalized, MAX_UNKNOWNS};
-use crate::classify::Surface;
+use crate::classify::problem::{ConeData, MAX_UNKNOWNS};
 use crate::Real;
 
 /// Iteration limit (the method converges in far fewer).
@@ -199,23 +197,13 @@ pub(crate) struct Solution {
     pub iterations: u32,
 }
 
-/// Solves the robust SOCP of the normalized points `norm` with labels `labels`
-/// (`lambda` the slack weight, `r` the robust radius); `None` when the method
-/// does not converge.
-pub(crate) fn solve_reduced(
-    norm: &Normalized,
-    labels: &[Real],
-    surface: Surface,
+/// The primal-dual method on the cones `data` (surface dimension `d`).
+pub(crate) fn solve_primal_dual(
+    data: &[ConeData],
+    d: usize,
     lambda: Real,
-    r: Real,
     tol: Real,
 ) -> Option<Solution> {
-    let data = cone_data(norm, labels, surface, r);
-    solve_primal_dual(&data, surface.dim(), lambda, tol)
-}
-
-/// The primal-dual method on the cones `data` (surface dimension `d`).
-fn solve_primal_dual(data: &[ConeData], d: usize, lambda: Real, tol: Real) -> Option<Solution> {
     let n = data.len();
     let m = d + 1;
     let nu = (2 * n) as Real;
@@ -238,6 +226,7 @@ fn solve_primal_dual(data: &[ConeData], d: usize, lambda: Real, tol: Real) -> Op
     let mut delta = vec![0.0; n];
     let mut hcol = vec![0.0; n * m];
     let mut s_mat = DMatrix::<Real>::zeros(m, m);
+    let (mut aff, mut cor) = (Direction::new(n, m), Direction::new(n, m));
 
     for iter in 0..MAX_ITER {
         // Residuals: r_s = s - (G x - h), r_d = P x + q - G^T y.
@@ -314,107 +303,93 @@ fn solve_primal_dual(data: &[ConeData], d: usize, lambda: Real, tol: Real) -> Op
             }
         }
         let chol = s_mat.clone().cholesky()?;
-        let lam: Vec<Cone> = (0..n).map(|i| scal[i].apply(&yc[i])).collect();
-        let lamn: Vec<Real> = (0..n).map(|i| (sn[i] * yn[i]).sqrt()).collect();
 
-        // The Newton direction for the complementarity targets `rc` (cones) and
-        // `rcn` (half-lines): W^-1 ds + W dy = lambda \ rc.
-        let solve_dir = |rc: &[Cone], rcn: &[Real]| -> Option<Direction> {
-            // t = W^-2 (W (lambda \ rc) + r_s)
-            let mut tc = vec![[0.0; 4]; n];
-            let mut tn = vec![0.0; n];
+        // The Newton direction whose scaled complementarity is
+        // `W^-1 ds + W dy = lambda \ rc`, given `wq = W (lambda \ rc)` per cone
+        // and `wqn = rc / y` per half-line, with the largest step that keeps
+        // `s` and `y` in their cones.
+        let solve_dir = |wq: &[Cone], wqn: &[Real], dir: &mut Direction| -> Option<Real> {
+            // t = W^-2 (wq + r_s), and the reduced right-hand side.
             let mut rhs_z = DVector::<Real>::zeros(m);
-            let mut rhs_xi = vec![0.0; n];
             for k in 0..m {
                 rhs_z[k] = -rz[k];
             }
             for i in 0..n {
-                let wq = scal[i].apply(&jdiv(&lam[i], &rc[i]));
                 let u = [
-                    wq[0] + rs[i][0],
-                    wq[1] + rs[i][1],
-                    wq[2] + rs[i][2],
-                    wq[3] + rs[i][3],
+                    wq[i][0] + rs[i][0],
+                    wq[i][1] + rs[i][1],
+                    wq[i][2] + rs[i][2],
+                    wq[i][3] + rs[i][3],
                 ];
                 let t = scal[i].apply_inv_sq(&u);
-                tc[i] = t;
-                // half-line: W = sqrt(s / y), W (rc / lambda) = rc / y
-                tn[i] = yn[i] / sn[i] * (rcn[i] / yn[i] + rsn[i]);
+                dir.tc[i] = t;
+                let tn = yn[i] / sn[i] * (wqn[i] + rsn[i]);
+                dir.tn[i] = tn;
                 data[i].add_transposed(&t, rhs_z.as_mut_slice());
-                rhs_xi[i] = -rxi[i] + t[0] + tn[i];
-                let hi = &hcol[i * m..(i + 1) * m];
-                let f = rhs_xi[i] / delta[i];
-                for k in 0..m {
-                    rhs_z[k] -= hi[k] * f;
+                let rhs_xi = -rxi[i] + t[0] + tn;
+                dir.rhs_xi[i] = rhs_xi;
+                let f = rhs_xi / delta[i];
+                for (r, h) in rhs_z.iter_mut().zip(&hcol[i * m..(i + 1) * m]) {
+                    *r -= h * f;
                 }
             }
             let dz = chol.solve(&rhs_z);
-            let mut dir = Direction {
-                dz: dz.as_slice().to_vec(),
-                dxi: vec![0.0; n],
-                dsc: vec![[0.0; 4]; n],
-                dyc: vec![[0.0; 4]; n],
-                dsn: vec![0.0; n],
-                dyn_: vec![0.0; n],
-            };
+            dir.dz.copy_from_slice(dz.as_slice());
+            let mut alpha: Real = 1.0 / STEP_FRACTION;
             for i in 0..n {
                 let hi = &hcol[i * m..(i + 1) * m];
                 let hdz: Real = hi.iter().zip(&dir.dz).map(|(a, b)| a * b).sum();
-                let dxi = (rhs_xi[i] - hdz) / delta[i];
+                let dxi = (dir.rhs_xi[i] - hdz) / delta[i];
                 dir.dxi[i] = dxi;
                 let g = data[i].apply(&dir.dz);
                 let gdx = [g[0] + dxi, g[1], g[2], g[3]];
                 let mg = scal[i].apply_inv_sq(&gdx);
-                for k in 0..4 {
-                    dir.dyc[i][k] = tc[i][k] - mg[k];
-                    dir.dsc[i][k] = gdx[k] - rs[i][k];
-                }
-                dir.dyn_[i] = tn[i] - yn[i] / sn[i] * dxi;
-                dir.dsn[i] = dxi - rsn[i];
+                let t = &dir.tc[i];
+                let dy = [t[0] - mg[0], t[1] - mg[1], t[2] - mg[2], t[3] - mg[3]];
+                let r = &rs[i];
+                let ds = [gdx[0] - r[0], gdx[1] - r[1], gdx[2] - r[2], gdx[3] - r[3]];
+                let dyn_ = dir.tn[i] - yn[i] / sn[i] * dxi;
+                let dsn = dxi - rsn[i];
+                alpha = cone_step(&sc[i], &ds, alpha);
+                alpha = cone_step(&yc[i], &dy, alpha);
+                alpha = half_line_step(sn[i], dsn, alpha);
+                alpha = half_line_step(yn[i], dyn_, alpha);
+                dir.dsc[i] = ds;
+                dir.dyc[i] = dy;
+                dir.dsn[i] = dsn;
+                dir.dyn_[i] = dyn_;
             }
-            dir.is_finite().then_some(dir)
-        };
-        let max_step = |dir: &Direction| -> Real {
-            let mut alpha: Real = 1.0 / STEP_FRACTION;
-            for i in 0..n {
-                alpha = cone_step(&sc[i], &dir.dsc[i], alpha);
-                alpha = cone_step(&yc[i], &dir.dyc[i], alpha);
-                alpha = half_line_step(sn[i], dir.dsn[i], alpha);
-                alpha = half_line_step(yn[i], dir.dyn_[i], alpha);
-            }
-            alpha
+            dir.is_finite().then_some(alpha)
         };
 
-        // Predictor: the affine direction (target lambda o lambda -> 0).
-        let rc: Vec<Cone> = lam.iter().map(|l| jprod(l, l).map(|x| -x)).collect();
-        let rcn: Vec<Real> = lamn.iter().map(|l| -l * l).collect();
-        let aff = solve_dir(&rc, &rcn)?;
-        let alpha_aff = max_step(&aff).min(1.0);
+        // Predictor: the affine direction (target lambda o lambda -> 0, so
+        // lambda \ rc = -lambda and W (lambda \ rc) = -s).
+        let wq: Vec<Cone> = sc.iter().map(|x| x.map(|v| -v)).collect();
+        let wqn: Vec<Real> = sn.iter().map(|v| -v).collect();
+        let alpha_aff = solve_dir(&wq, &wqn, &mut aff)?.min(1.0);
         let sigma = (1.0 - alpha_aff).powi(3);
 
         // Corrector: centring plus Mehrotra's second-order term.
-        let rc: Vec<Cone> = (0..n)
-            .map(|i| {
-                let ds = scal[i].apply_inv(&aff.dsc[i]);
-                let dy = scal[i].apply(&aff.dyc[i]);
-                let corr = jprod(&ds, &dy);
-                let ll = jprod(&lam[i], &lam[i]);
-                [
-                    sigma * mu - ll[0] - corr[0],
-                    -ll[1] - corr[1],
-                    -ll[2] - corr[2],
-                    -ll[3] - corr[3],
-                ]
-            })
-            .collect();
-        let rcn: Vec<Real> = (0..n)
-            .map(|i| {
-                let corr = aff.dsn[i] * aff.dyn_[i];
-                sigma * mu - lamn[i] * lamn[i] - corr
-            })
-            .collect();
-        let dir = solve_dir(&rc, &rcn)?;
-        let alpha = (STEP_FRACTION * max_step(&dir)).min(1.0);
+        let mut wq = wq;
+        let mut wqn = wqn;
+        for i in 0..n {
+            let lam = scal[i].apply(&yc[i]);
+            let ds = scal[i].apply_inv(&aff.dsc[i]);
+            let dy = scal[i].apply(&aff.dyc[i]);
+            let corr = jprod(&ds, &dy);
+            let ll = jprod(&lam, &lam);
+            let rc = [
+                sigma * mu - ll[0] - corr[0],
+                -ll[1] - corr[1],
+                -ll[2] - corr[2],
+                -ll[3] - corr[3],
+            ];
+            wq[i] = scal[i].apply(&jdiv(&lam, &rc));
+            let corr_n = aff.dsn[i] * aff.dyn_[i];
+            wqn[i] = (sigma * mu - sn[i] * yn[i] - corr_n) / yn[i];
+        }
+        let alpha = (STEP_FRACTION * solve_dir(&wq, &wqn, &mut cor)?).min(1.0);
+        let dir = &cor;
         for k in 0..m {
             z[k] += alpha * dir.dz[k];
         }
@@ -432,18 +407,15 @@ fn solve_primal_dual(data: &[ConeData], d: usize, lambda: Real, tol: Real) -> Op
 }
 
 fn finite_solution(z: &[Real], xi: &[Real], d: usize, iterations: u32) -> Option<Solution> {
-    z.iter()
-        .chain(xi)
-        .all(|x| x.is_finite())
-        .then(|| Solution {
-            w: z[..d].to_vec(),
-            b: z[d],
-            xi: xi.iter().map(|x| x.max(0.0)).collect(),
-            iterations,
-        })
+    z.iter().chain(xi).all(|x| x.is_finite()).then(|| Solution {
+        w: z[..d].to_vec(),
+        b: z[d],
+        xi: xi.iter().map(|x| x.max(0.0)).collect(),
+        iterations,
+    })
 }
 
-/// One Newton direction of every variable.
+/// One Newton direction of every variable, with its scratch.
 struct Direction {
     dz: Vec<Real>,
     dxi: Vec<Real>,
@@ -451,9 +423,26 @@ struct Direction {
     dyc: Vec<Cone>,
     dsn: Vec<Real>,
     dyn_: Vec<Real>,
+    tc: Vec<Cone>,
+    tn: Vec<Real>,
+    rhs_xi: Vec<Real>,
 }
 
 impl Direction {
+    fn new(n: usize, m: usize) -> Self {
+        Self {
+            dz: vec![0.0; m],
+            dxi: vec![0.0; n],
+            dsc: vec![[0.0; 4]; n],
+            dyc: vec![[0.0; 4]; n],
+            dsn: vec![0.0; n],
+            dyn_: vec![0.0; n],
+            tc: vec![[0.0; 4]; n],
+            tn: vec![0.0; n],
+            rhs_xi: vec![0.0; n],
+        }
+    }
+
     fn is_finite(&self) -> bool {
         self.dz.iter().chain(&self.dxi).all(|x| x.is_finite())
             && self

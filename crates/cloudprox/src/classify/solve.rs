@@ -3,8 +3,8 @@
 
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
 
-use crate::classify::primal_dual::solve_reduced;
 use crate::classify::problem::{assemble, Normalized};
+use crate::classify::working_set::solve_reduced;
 use crate::classify::{ClassifySettings, Separator, SocpSolver};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose, Vector3};

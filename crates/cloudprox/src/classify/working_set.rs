@@ -1,0 +1,184 @@
+//! Which constraints the interior-point method sees: a working set.
+//!
+//! Points far on their own side satisfy their constraint with zero slack and do
+//! not shape the optimum. The problem is solved first on a working set (the
+//! points of each cloud nearest the other cloud), every other point's
+//! constraint is checked at that solution
+//! (`c_i f(x_i) - 1 >= r |Sigma_i^(1/2) grad f|`), and every violated one is
+//! added until none is. Solving on a subset is a relaxation of the full
+//! problem, and a relaxation's optimum that is feasible for the full problem
+//! (with zero slacks elsewhere) is the full problem's optimum: the answer is
+//! exact. Normalization is the full set's throughout.
+//!
+//! The primal-dual method's iteration count hardly grows with the points, and
+//! each round starts afresh, so a round adds *every* violated constraint (the
+//! barrier method this replaced added at most as many as the set held, and
+//! needed up to eight rounds).
+
+use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
+use crate::classify::primal_dual::{solve_primal_dual, Solution};
+use crate::classify::problem::{cone_data, ConeData, Normalized};
+use crate::classify::Surface;
+use crate::math::Point3;
+use crate::Real;
+
+/// Most rounds of the working set before solving with every point.
+const WORKING_SET_ROUNDS: usize = 4;
+/// Points of each cloud in the first working set.
+const WORKING_SET_START: usize = 24;
+
+/// Solves the robust SOCP of the normalized points `norm` with labels `labels`
+/// (`lambda` the slack weight, `r` the robust radius) on a working set of its
+/// constraints; `None` when the method does not converge.
+pub(crate) fn solve_reduced(
+    norm: &Normalized,
+    labels: &[Real],
+    surface: Surface,
+    lambda: Real,
+    r: Real,
+    tol: Real,
+) -> Option<Solution> {
+    let n = norm.u.len();
+    let d = surface.dim();
+    let data = cone_data(norm, labels, surface, r);
+    if n <= 4 * WORKING_SET_START {
+        return solve_primal_dual(&data, d, lambda, tol);
+    }
+    let mut in_set = initial_working_set(norm, labels);
+    let mut iterations = 0;
+    for _ in 0..WORKING_SET_ROUNDS {
+        if 2 * in_set.iter().filter(|&&x| x).count() > n {
+            break; // as costly as the full problem: solve that
+        }
+        let idx: Vec<usize> = (0..n).filter(|&i| in_set[i]).collect();
+        let subset: Vec<ConeData> = idx.iter().map(|&i| data[i]).collect();
+        let sol = solve_primal_dual(&subset, d, lambda, tol)?;
+        iterations += sol.iterations;
+        let mut z = sol.w.clone();
+        z.push(sol.b);
+        let mut violated = false;
+        for i in 0..n {
+            if in_set[i] {
+                continue;
+            }
+            let g = data[i].apply(&z);
+            let u = g[0] - 1.0;
+            let viol = (g[1] * g[1] + g[2] * g[2] + g[3] * g[3]).sqrt() - u;
+            if viol > 1e-9 * (1.0 + u.abs()) {
+                in_set[i] = true;
+                violated = true;
+            }
+        }
+        if !violated {
+            let mut xi = vec![0.0; n];
+            for (k, &i) in idx.iter().enumerate() {
+                xi[i] = sol.xi[k];
+            }
+            return Some(Solution {
+                xi,
+                iterations,
+                ..sol
+            });
+        }
+    }
+    let sol = solve_primal_dual(&data, d, lambda, tol)?;
+    Some(Solution {
+        iterations: sol.iterations + iterations,
+        ..sol
+    })
+}
+
+/// Above this many points the nearest opposite point is found with a
+/// hierarchy over each cloud's points instead of by testing every pair.
+const WORKING_SET_TREE_MIN: usize = 512;
+
+/// The squared distance from each point to the nearest point of the other
+/// label (infinite when there is none).
+fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
+    let n = labels.len();
+    if n <= WORKING_SET_TREE_MIN {
+        return (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| labels[j] != labels[i])
+                    .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                    .fold(Real::INFINITY, Real::min)
+            })
+            .collect();
+    }
+    // One hierarchy per label, each queried by the other label's points.
+    let mut d2 = vec![Real::INFINITY; n];
+    let mut ws = BvhWorkspace::default();
+    let mut out = Vec::with_capacity(1);
+    for label in [1.0, -1.0] {
+        let (own, other): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == label);
+        let points: Vec<Point3> = other.iter().map(|&j| Point3::from(norm.u[j])).collect();
+        let Ok(tree) = Bvh::build(&points, &vec![0.0; points.len()], &BvhSettings::default())
+        else {
+            continue; // no point of the other label
+        };
+        for i in own {
+            tree.nearest_k(&points, &Point3::from(norm.u[i]), 1, &mut ws, &mut out);
+            if let Some(&(d, _)) = out.first() {
+                d2[i] = d;
+            }
+        }
+    }
+    d2
+}
+
+/// The `WORKING_SET_START` points of each cloud nearest any point of the other.
+fn initial_working_set(norm: &Normalized, labels: &[Real]) -> Vec<bool> {
+    let n = labels.len();
+    let mut nearest: Vec<(Real, usize)> = nearest_opposite(norm, labels)
+        .into_iter()
+        .enumerate()
+        .map(|(i, d2)| (d2, i))
+        .collect();
+    nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut in_set = vec![false; n];
+    for label in [1.0, -1.0] {
+        for &(_, i) in nearest
+            .iter()
+            .filter(|(_, i)| labels[*i] == label)
+            .take(WORKING_SET_START)
+        {
+            in_set[i] = true;
+        }
+    }
+    in_set
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Matrix3;
+    use crate::sample::{add_noise, sphere};
+
+    #[test]
+    fn the_nearest_opposite_point_from_the_hierarchies_is_the_brute_forces() {
+        // Two interpenetrating noisy spheres, above the size where the
+        // hierarchies take over; and one label alone (no opposite point).
+        let a = add_noise(&sphere(&Point3::origin(), 0.1, 700), 0.002, 1);
+        let b = add_noise(&sphere(&Point3::new(0.15, 0.0, 0.0), 0.1, 500), 0.002, 2);
+        let points: Vec<Point3> = a.iter().chain(&b).copied().collect();
+        let labels: Vec<Real> = (0..points.len())
+            .map(|i| if i < a.len() { 1.0 } else { -1.0 })
+            .collect();
+        let covs = vec![Matrix3::identity() * 4e-6; points.len()];
+        let norm = Normalized::new(&points, &covs);
+        assert!(points.len() > WORKING_SET_TREE_MIN);
+        let fast = nearest_opposite(&norm, &labels);
+        for (i, &d2) in fast.iter().enumerate() {
+            let brute = (0..points.len())
+                .filter(|&j| labels[j] != labels[i])
+                .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                .fold(Real::INFINITY, Real::min);
+            assert_eq!(d2, brute, "point {i}");
+        }
+        let alone = vec![1.0; points.len()];
+        assert!(nearest_opposite(&norm, &alone)
+            .iter()
+            .all(|d| d.is_infinite()));
+    }
+}
