@@ -10,16 +10,14 @@ use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 /// The paper's per-point model (this file's subject; the surface elements,
 /// the default, are tested in `collide_elements.rs`) with `surface`.
 fn request(surface: Surface) -> CollisionRequest {
-    CollisionRequest::builder()
-        .model(QueryModel::Points)
-        .classify(
-            ClassifySettings::builder()
-                .surface(surface)
-                .build()
-                .unwrap(),
-        )
-        .build()
-        .unwrap()
+    CollisionRequest {
+        model: QueryModel::Points,
+        classify: ClassifySettings {
+            surface,
+            ..ClassifySettings::default()
+        },
+        ..CollisionRequest::default()
+    }
 }
 
 /// The query with both clouds' points moved by `t` (B's also by `pb`) and
@@ -202,18 +200,16 @@ fn the_classifier_is_equivariant_under_rotations_of_the_data() {
     let (a, b) = spheres(300);
     let t = Pose::new(Vector3::new(0.3, -1.2, 0.7), Vector3::new(0.4, -0.9, 2.1));
     for surface in [Surface::Quadric, Surface::Linear] {
-        let req = CollisionRequest::builder()
-            .model(QueryModel::Points)
-            .classify(
-                ClassifySettings::builder()
-                    .surface(surface)
-                    .build()
-                    .unwrap(),
-            )
-            .use_hierarchy(false)
-            .region_max_points(10_000)
-            .build()
-            .unwrap();
+        let req = CollisionRequest {
+            model: QueryModel::Points,
+            classify: ClassifySettings {
+                surface,
+                ..ClassifySettings::default()
+            },
+            use_hierarchy: false,
+            region_max_points: 10_000,
+            ..CollisionRequest::default()
+        };
         for gap in [-2.0, 1.0, 3.0] {
             let pb = sphere_pose(gap * SIGMA);
             let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();

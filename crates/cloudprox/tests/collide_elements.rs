@@ -10,10 +10,10 @@ use cloudprox::sample::{add_noise, NormalRng};
 use common::{sphere_pose, spheres, SIGMA};
 
 fn elements() -> CollisionRequest {
-    CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .build()
-        .unwrap()
+    CollisionRequest {
+        model: QueryModel::Elements,
+        ..CollisionRequest::default()
+    }
 }
 
 /// A slab: two noisy square faces of `k x k` points at spacing `h`, the face
@@ -168,11 +168,11 @@ fn rigid_motion_and_swapping_change_nothing() {
 #[test]
 fn hierarchy_agrees_with_brute_force() {
     let (a, b) = spheres(1500);
-    let brute = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .use_hierarchy(false)
-        .build()
-        .unwrap();
+    let brute = CollisionRequest {
+        model: QueryModel::Elements,
+        use_hierarchy: false,
+        ..CollisionRequest::default()
+    };
     for gap in [-2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
         let pb = sphere_pose(gap * SIGMA);
         let fast = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
@@ -194,12 +194,15 @@ fn hierarchy_agrees_with_brute_force() {
 fn decide_only_gives_the_full_querys_state() {
     let (a, b) = spheres(3000);
     for model in [QueryModel::Elements, QueryModel::Points] {
-        let full = CollisionRequest::builder().model(model).build().unwrap();
-        let quick = CollisionRequest::builder()
-            .model(model)
-            .decide_only(true)
-            .build()
-            .unwrap();
+        let full = CollisionRequest {
+            model,
+            ..CollisionRequest::default()
+        };
+        let quick = CollisionRequest {
+            model,
+            decide_only: true,
+            ..CollisionRequest::default()
+        };
         let mut crossings = 0;
         for gap in [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 20.0] {
             let pb = sphere_pose(gap * SIGMA);
@@ -224,11 +227,11 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     // cross along a ring, which the hierarchies find before any near set; a
     // sigma apart and beyond nothing crosses, and the query goes on as before.
     let (a, b) = spheres(10000);
-    let quick = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .build()
-        .unwrap();
+    let quick = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        ..CollisionRequest::default()
+    };
     for gap in [-6.0, -3.0, -2.0] {
         let q = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &quick).unwrap();
         assert_eq!(q.stats.counters.surface_crossings, 1, "gap {gap}");
@@ -256,12 +259,15 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     assert_eq!(r.state, CollisionState::Collision);
     // A collision threshold above the reach's confidence asks more of the
     // crossing: both probes then read beyond the threshold's quantile.
-    let strict = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .thresholds(1.0 - 1e-9, 0.1)
-        .build()
-        .unwrap();
+    let strict = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        thresholds: Thresholds {
+            collision: 1.0 - 1e-9,
+            free: 0.1,
+        },
+        ..CollisionRequest::default()
+    };
     let q = collide(
         &Pose::identity(),
         &a,
@@ -281,11 +287,11 @@ fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
     let sigma = 0.0005;
     let a = slab(30, 0.004, (0.2, 0.0), -0.05, sigma, 1);
     let tilted_back = slab(30, 0.004, (0.0, 0.0), 0.05, sigma, 2);
-    let quick = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .build()
-        .unwrap();
+    let quick = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        ..CollisionRequest::default()
+    };
     let q = collide_at_height(&a, &tilted_back, 0.0, &quick);
     assert_eq!(q.stats.counters.surface_crossings, 1);
     assert_eq!(q.state, CollisionState::Collision);
@@ -347,10 +353,10 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
     // noise's reach of the fitted surfaces: the element hulls (or, failing
     // them, each patch's facing pairs) decide the pair free.
     let (a, b) = spheres(3000);
-    let points = CollisionRequest::builder()
-        .model(QueryModel::Points)
-        .build()
-        .unwrap();
+    let points = CollisionRequest {
+        model: QueryModel::Points,
+        ..CollisionRequest::default()
+    };
     let mut pruned = 0;
     for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
         let pose = sphere_pose(gap * SIGMA);
@@ -460,11 +466,7 @@ proptest! {
     fn element_hierarchy_agrees_with_brute_force(
         (a, b, pose_b, gap) in sphere_scenes(300..1500, -3.0..14.0),
     ) {
-        let brute = CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .use_hierarchy(false)
-            .build()
-            .unwrap();
+        let brute = CollisionRequest { model: QueryModel::Elements, use_hierarchy: false, ..CollisionRequest::default() };
         let h = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose_b, &b, &brute).unwrap();
         let (ph, pb) = (h.probability, bf.probability);
@@ -485,11 +487,7 @@ proptest! {
     fn decide_only_agrees_with_the_full_query(
         (a, b, pose_b, gap) in sphere_scenes(300..3000, -6.0..6.0),
     ) {
-        let quick = CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .decide_only(true)
-            .build()
-            .unwrap();
+        let quick = CollisionRequest { model: QueryModel::Elements, decide_only: true, ..CollisionRequest::default() };
         let r = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
         let q = collide(&Pose::identity(), &a, &pose_b, &b, &quick).unwrap();
         prop_assert_eq!(

@@ -83,7 +83,10 @@ fn broad_phase_changes_the_cost_not_the_answer() {
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 3);
     for model in [QueryModel::Elements, QueryModel::Points] {
         let with = RobotRequest {
-            collide: CollisionRequest::builder().model(model).build().unwrap(),
+            collide: CollisionRequest {
+                model,
+                ..CollisionRequest::default()
+            },
             ..RobotRequest::default()
         };
         let without = RobotRequest {
@@ -122,10 +125,10 @@ fn the_elements_model_reads_contact_and_freedom_at_a_wall() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 9);
     let req = RobotRequest {
-        collide: CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .build()
-            .unwrap(),
+        collide: CollisionRequest {
+            model: QueryModel::Elements,
+            ..CollisionRequest::default()
+        },
         ..RobotRequest::default()
     };
     let hit = collide_robot(

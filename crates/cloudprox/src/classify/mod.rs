@@ -32,6 +32,6 @@ mod solve;
 mod surface;
 
 pub use separator::Separator;
-pub use settings::{ClassifySettings, ClassifySettingsBuilder, SocpSolver};
+pub use settings::{ClassifySettings, SocpSolver};
 pub use solve::{train, Classification, SolveStatus};
 pub use surface::Surface;

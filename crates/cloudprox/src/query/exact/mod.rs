@@ -14,9 +14,9 @@ mod exact;
 mod exact_shape;
 mod time_of_impact;
 
+pub(crate) use exact::intersects;
 pub use exact::{
     exact_intersects, exact_intersects_many, exact_proximity, exact_proximity_many, ExactProximity,
 };
-pub(crate) use exact::intersects;
 pub use exact_shape::{ExactPart, ExactShape};
 pub use time_of_impact::{exact_time_of_impact, exact_time_of_impact_many, IMPACT_TOLERANCE};
