@@ -90,10 +90,10 @@ def test_result_fields(sweep, spheres) -> None:
         for k, v in r.stats.to_dict().items()
         if k not in ("pruned_bound", "time_seconds")
     )
-    assert r.stats.patches == len(r.regions) > 0
-    assert r.stats.points_classified == sum(len(g.indices_a) + len(g.indices_b) for g in r.regions)
+    assert r.stats.patches == len(r.patches) > 0
+    assert r.stats.points_classified == sum(len(g.indices_a) + len(g.indices_b) for g in r.patches)
     assert "CollisionResult(probability=" in repr(r)
-    for region in r.regions:
+    for region in r.patches:
         assert region.indices_a.dtype == np.int64 and region.indices_b.dtype == np.int64
         assert region.point.shape == (3,) and region.normal.shape == (3,)
         assert np.linalg.norm(region.normal) == pytest.approx(1.0)
@@ -104,13 +104,13 @@ def test_result_fields(sweep, spheres) -> None:
         assert region.iterations >= 1 or region.status == "fallback"
         assert 0.0 <= region.probability <= 1.0
         assert isinstance(region.separation, float) and isinstance(region.component, int)
-        assert "ContactRegion(" in repr(region)
-    # The regions list is fresh, its elements are the same objects.
-    assert r.regions is not r.regions and r.regions[0] is r.regions[0]
+        assert "ContactPatch(" in repr(region)
+    # The patches list is fresh, its elements are the same objects.
+    assert r.patches is not r.patches and r.patches[0] is r.patches[0]
 
 
 def min_separation(r: cp.CollisionResult) -> float:
-    return min(g.separation for g in r.regions)
+    return min(g.separation for g in r.patches)
 
 
 def test_separation_has_the_sign_of_the_gap(sweep) -> None:
@@ -130,7 +130,7 @@ def test_per_point_probabilities_match_closed_form(spheres, sphere_points) -> No
     world_b = sphere_points[1] + pose_b[:3, 3]
     covs_a, covs_b = a.covariances, b.covariances  # pure translation: unrotated
     seen_a = np.zeros(len(a), dtype=bool)
-    for region in r.regions:
+    for region in r.patches:
         for idx, pts, covs, label, probs, seen in (
             (region.indices_a, world_a, covs_a, 1.0, r.probabilities_a, seen_a),
             (region.indices_b, world_b, covs_b, -1.0, r.probabilities_b, None),
@@ -158,7 +158,7 @@ def test_closed_form_with_anisotropic_covariances() -> None:
     b = cp.PointCloud(plate + rng.normal(0.0, 1e-3, plate.shape), sigma=0.002)
     r = cp.collide(a, b, pose_b=from_translation((0.0, 0.0, 0.006)), surface="linear")
     pa, pb = a.points, b.points + np.array([0.0, 0.0, 0.006])
-    for region in r.regions:
+    for region in r.patches:
         f, g = region.evaluate(pa[region.indices_a])
         std = np.sqrt(np.einsum("mi,ij,mj->m", g, cov, g))
         np.testing.assert_allclose(
@@ -237,7 +237,7 @@ def test_collide_many_equals_a_loop(spheres) -> None:
         assert r.state == one.state
         np.testing.assert_array_equal(r.probabilities_a, one.probabilities_a)
         np.testing.assert_array_equal(r.probabilities_b, one.probabilities_b)
-        assert len(r.regions) == len(one.regions)
+        assert len(r.patches) == len(one.patches)
     assert cp.collide_many(a, b, np.zeros((0, 4, 4))) == []
 
 
@@ -253,17 +253,17 @@ def test_options_take_effect(spheres) -> None:
     independent = cp.collide(a, b, pose_b=pose_b, aggregation="independent", model="points")
     assert base.probability <= independent.probability <= union.probability
     linear = cp.collide(a, b, pose_b=pose_b, surface="linear", model="points")
-    assert all(r.surface == "linear" for r in linear.regions)
+    assert all(r.surface == "linear" for r in linear.patches)
     strict = cp.collide(
         a, b, pose_b=pose_b, threshold_collision=0.5, threshold_free=0.0, model="points"
     )
     assert strict.probability == base.probability
     assert strict.state == ("collision" if base.probability >= 0.5 else "contact")
     small = cp.collide(a, b, pose_b=pose_b, region_max_points=40, model="points")
-    assert len(small.regions) > len(base.regions)
+    assert len(small.patches) > len(base.patches)
 
     def mean_size(r: cp.CollisionResult) -> float:
-        return float(np.mean([len(g.indices_a) + len(g.indices_b) for g in r.regions]))
+        return float(np.mean([len(g.indices_a) + len(g.indices_b) for g in r.patches]))
 
     assert mean_size(small) <= 40 < mean_size(base)
     # The brute force tests every point pair with the same near rule: one region,
@@ -360,7 +360,7 @@ def test_elements_model_classifies_tens_of_samples_and_reports_every_point(spher
     assert 0 < el.stats.points_classified < pts.stats.points_classified
     # Per-point probabilities are Eq. 3 of every point of the elements in the
     # region, against the region's surface: the same points the region lists.
-    region = el.regions[0]
+    region = el.patches[0]
     assert len(region.indices_a) > 0
     assert el.probabilities_a[region.indices_a].max() > 0.0
     outside = np.setdiff1d(np.arange(len(el.probabilities_a)), region.indices_a)

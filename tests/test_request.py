@@ -171,7 +171,7 @@ def _same(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
     assert r.probability == s.probability and r.state == s.state
     np.testing.assert_array_equal(r.probabilities_a, s.probabilities_a)
     np.testing.assert_array_equal(r.probabilities_b, s.probabilities_b)
-    assert len(r.regions) == len(s.regions)
+    assert len(r.patches) == len(s.patches)
 
 
 def test_collide_with_a_request_equals_the_keywords(spheres) -> None:
@@ -181,7 +181,7 @@ def test_collide_with_a_request_equals_the_keywords(spheres) -> None:
     request = cp.CollisionRequest(**options)
     by_request = cp.collide(a, b, pose_b=pose, request=request)
     _same(by_request, cp.collide(a, b, pose_b=pose, **options))
-    assert all(g.surface == "linear" for g in by_request.regions)
+    assert all(g.surface == "linear" for g in by_request.patches)
     # Keywords override the request's fields.
     _same(
         cp.collide(a, b, pose_b=pose, request=request.replace(surface="quadric"), surface="linear"),
@@ -238,7 +238,7 @@ def test_query_stats_are_typed(spheres) -> None:
     r = cp.collide(a, b, pose_b=sphere_gap_pose(2.0))
     stats = r.stats
     assert isinstance(stats, cp.QueryStats) and stats == r.stats
-    assert stats.patches == len(r.regions) and stats.time_seconds > 0.0
+    assert stats.patches == len(r.patches) and stats.time_seconds > 0.0
     assert isinstance(stats.points_classified, int) and isinstance(stats.pruned_bound, float)
     d = stats.to_dict()
     assert json.loads(json.dumps(d)) == d

@@ -128,8 +128,8 @@ def test_a_link_pushed_into_a_wall_collides(arm: cp.Robot) -> None:
     assert links["base"].result is None
     full = links["link3"].result
     assert full is not None and full.probability == links["link3"].probability
-    assert hit.regions and all(name == "link3" for name, _ in hit.regions if _.probability > 0.9)
-    for _, region in hit.regions:
+    assert hit.patches and all(name == "link3" for name, _ in hit.patches if _.probability > 0.9)
+    for _, region in hit.patches:
         assert abs(region.point[0] - 0.40) < 0.03
     assert hit.self_collisions == []
     assert hit.stats.links_with_geometry == 6

@@ -24,7 +24,7 @@ __all__ = [
     "CloudproxError",
     "CollisionRequest",
     "CollisionResult",
-    "ContactRegion",
+    "ContactPatch",
     "DepthCamera",
     "ExactShape",
     "FormatError",
@@ -120,7 +120,7 @@ class SolverError(CloudproxError, RuntimeError):
     """A solver failed in a way that cannot be reported as data (reserved).
 
     A solve that does not converge is not an error: it falls back to a plane and
-    is reported in ``ContactRegion.status`` and ``CollisionResult.stats``.
+    is reported in ``ContactPatch.status`` and ``CollisionResult.stats``.
     """
 
 @final
@@ -245,7 +245,7 @@ class PointCloud:
     def __len__(self) -> int: ...
 
 @final
-class ContactRegion:
+class ContactPatch:
     """One patch of a near region with its own separating surface (world frame).
 
     The surface ``f`` is positive on cloud A's side and negative on cloud B's.
@@ -340,7 +340,7 @@ class CollisionResult:
         :func:`cloudprox.view.collision_scene`. Returns the file written.
         """
     @property
-    def regions(self) -> list[ContactRegion]:
+    def patches(self) -> list[ContactPatch]:
         """The classified patches of the near regions."""
     @property
     def stats(self) -> QueryStats:
@@ -361,7 +361,7 @@ class QueryStats:
         """Connected near regions."""
     @property
     def patches(self) -> int:
-        """Patches classified (``len(result.regions)``)."""
+        """Patches classified (``len(result.patches)``)."""
     @property
     def misfit_cuts(self) -> int:
         """Patches cut in two because one surface misfit them."""
@@ -382,7 +382,7 @@ class QueryStats:
         """Patches where the barrier method gave way to Clarabel."""
     @property
     def solver_fallbacks(self) -> int:
-        """Patches whose solve fell back to a plane (``ContactRegion.status == "fallback"``)."""
+        """Patches whose solve fell back to a plane (``ContactPatch.status == "fallback"``)."""
     @property
     def pruned_bound(self) -> float:
         """Upper bound on the probability that any pruned point is on the wrong side."""
@@ -837,7 +837,7 @@ def collide(
     Returns
     -------
     CollisionResult
-        ``P``, the state, per-point probabilities, regions and statistics.
+        ``P``, the state, per-point probabilities, patches and statistics.
 
     Raises
     ------
@@ -1623,8 +1623,8 @@ class RobotCollisionResult:
     def links(self) -> dict[str, LinkCollision]:
         """Per link with geometry, by name (URDF order)."""
     @property
-    def regions(self) -> list[tuple[str, ContactRegion]]:
-        """Contact regions of every queried link, as ``(link name, region)``."""
+    def patches(self) -> list[tuple[str, ContactPatch]]:
+        """Contact patches of every queried link, as ``(link name, patch)``."""
     @property
     def self_collisions(self) -> list[tuple[str, str]]:
         """Pairs of non-adjacent links that intersect; not part of ``probability``."""

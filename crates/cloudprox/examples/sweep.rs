@@ -74,7 +74,7 @@ fn main() {
             res.stats.counters.patches,
             res.stats.counters.points_classified,
             res.stats.time_seconds * 1e3,
-            res.regions
+            res.patches
                 .iter()
                 .map(|r| r.separation)
                 .fold(f64::INFINITY, f64::min)

@@ -80,8 +80,8 @@ pub mod prelude {
     pub use crate::probability::{Aggregation, CollisionState, Thresholds};
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
-        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult,
-        ContactRegion, MeshSampling, QueryModel, QueryStats,
+        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
+        MeshSampling, QueryModel, QueryStats,
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{

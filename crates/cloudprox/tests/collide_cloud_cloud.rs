@@ -101,7 +101,7 @@ fn states_follow_thresholds() {
     let far = collide(&Pose::identity(), &a, &sphere_pose(20.0 * SIGMA), &b, &req).unwrap();
     assert_eq!(far.state, CollisionState::Free);
     assert_eq!(far.probability, 0.0);
-    assert!(far.regions.is_empty(), "{:?}", far.stats);
+    assert!(far.patches.is_empty(), "{:?}", far.stats);
     assert!(far.stats.counters.pruned_bound < 1e-2, "{:?}", far.stats);
 }
 
@@ -143,8 +143,8 @@ fn per_point_probabilities_are_the_gaussian_cdf_of_the_plane_distance() {
         &request(Surface::Linear),
     )
     .unwrap();
-    assert!(!r.regions.is_empty());
-    for reg in &r.regions {
+    assert!(!r.patches.is_empty());
+    for reg in &r.patches {
         // The plane in its training frame: n . x + d = 0 with n = w / scale.
         let sep = &reg.separator;
         let n = Vector3::new(sep.w[0], sep.w[1], sep.w[2]) / sep.scale;
@@ -183,8 +183,8 @@ fn moving_both_clouds_rigidly_changes_nothing() {
             .map(|(x, y)| (x - y).abs());
         let dmax = dp.fold(0.0, f64::max);
         assert!(dmax < 1e-4, "gap {gap}: per-point difference {dmax}");
-        assert_eq!(r0.regions.len(), r1.regions.len());
-        for (g0, g1) in r0.regions.iter().zip(&r1.regions) {
+        assert_eq!(r0.patches.len(), r1.patches.len());
+        for (g0, g1) in r0.patches.iter().zip(&r1.patches) {
             assert!(((t * g0.point) - g1.point).norm() < 1e-6);
             assert!(((t * g0.normal) - g1.normal).norm() < 1e-5);
             assert!((g0.separation - g1.separation).abs() < 1e-6);
@@ -239,7 +239,7 @@ fn swapping_the_clouds_gives_the_same_probability() {
             .zip(&ba.probabilities_b)
             .map(|(x, y)| (x - y).abs());
         assert!(d.fold(0.0, f64::max) < 1e-5);
-        for (ra, rb) in ab.regions.iter().zip(&ba.regions) {
+        for (ra, rb) in ab.patches.iter().zip(&ba.patches) {
             assert!(
                 (ra.normal + rb.normal).norm() < 1e-5,
                 "normals point from A to B"
@@ -297,7 +297,7 @@ fn separation_estimate_tracks_the_exact_gap() {
     for gap in [-0.005, 0.0, 0.005, 0.01, 0.02] {
         let pose_b = Pose::translation(0.0, 0.0, 0.06 + gap);
         let r = collide(&Pose::identity(), &a, &pose_b, &b, &req).unwrap();
-        if r.regions.is_empty() {
+        if r.patches.is_empty() {
             // Beyond the noise's reach there is no near region to measure in.
             assert!(
                 gap > 6.0 * SIGMA && r.state == CollisionState::Free,
@@ -306,7 +306,7 @@ fn separation_estimate_tracks_the_exact_gap() {
             continue;
         }
         let sep = r
-            .regions
+            .patches
             .iter()
             .map(|g| g.separation)
             .fold(f64::INFINITY, f64::min);

@@ -177,7 +177,7 @@ fn hierarchy_agrees_with_brute_force() {
         let pb = sphere_pose(gap * SIGMA);
         let fast = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
         let slow = collide(&Pose::identity(), &a, &pb, &b, &brute).unwrap();
-        if fast.regions.len() <= 1 && slow.regions.len() <= 1 {
+        if fast.patches.len() <= 1 && slow.patches.len() <= 1 {
             assert!(
                 (fast.probability - slow.probability).abs() < 1e-6,
                 "gap {gap}: {} vs {}",
@@ -236,7 +236,7 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
         let q = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &quick).unwrap();
         assert_eq!(q.stats.counters.surface_crossings, 1, "gap {gap}");
         assert_eq!(q.state, CollisionState::Collision, "gap {gap}");
-        assert!(q.regions.is_empty() && q.stats.counters.points_classified == 0);
+        assert!(q.patches.is_empty() && q.stats.counters.points_classified == 0);
         // The crossing's bound at the noise's reach: 1 - 2 Phi(-z).
         let z = -normal_quantile(0.5 * quick.prune_epsilon);
         assert!((q.probability - (1.0 - 2.0 * normal_cdf(-z))).abs() < 1e-12);
@@ -307,8 +307,8 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     let (a, b) = spheres(3000);
     let pb = sphere_pose(SIGMA);
     let r = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
-    assert_eq!(r.regions.len(), 1);
-    let region = &r.regions[0];
+    assert_eq!(r.patches.len(), 1);
+    let region = &r.patches[0];
     assert!(!region.indices_a.is_empty() && !region.indices_b.is_empty());
     for &i in &region.indices_a {
         let x = a.points()[i as usize];
@@ -369,7 +369,7 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
             continue;
         }
         pruned += 1;
-        assert!(r.regions.is_empty(), "gap {gap}");
+        assert!(r.patches.is_empty(), "gap {gap}");
         assert_eq!(r.probability, 0.0);
         assert_eq!(r.state, CollisionState::Free);
         assert!(r
@@ -385,7 +385,7 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
         "{:?}",
         near.stats
     );
-    assert!(!near.regions.is_empty());
+    assert!(!near.patches.is_empty());
 }
 
 /// Two noisy spheres of `na`, `nb` points (radii `ra`, `rb`, noise `sigma`,

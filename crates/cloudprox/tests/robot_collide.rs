@@ -51,7 +51,7 @@ fn a_link_pushed_into_a_wall_collides_and_the_rest_is_free() {
     }
     // Regions come with the link they belong to, in the world frame, at the wall.
     let link3 = hit.links.iter().find(|e| e.link == 3).unwrap();
-    let regions = &link3.result.as_ref().unwrap().regions;
+    let regions = &link3.result.as_ref().unwrap().patches;
     assert!(!regions.is_empty());
     assert!(regions.iter().all(|g| (g.point.x - 0.40).abs() < 0.03));
     assert!(hit.self_collisions.is_empty());
