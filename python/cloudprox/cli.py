@@ -818,7 +818,7 @@ def _add_query_arguments(
     sensor.add_argument(
         "--preset",
         choices=["khoshelham-2012", "nguyen-2012"],
-        help="depth camera: published fit (default khoshelham-2012: 1.425e-3 z^2)",
+        help="depth camera: published fit (default: the core's, khoshelham-2012)",
     )
     sensor.add_argument("--origin", metavar="X,Y,Z", help="sensor origin in the cloud's frame")
     sensor.add_argument(
