@@ -138,7 +138,7 @@ def test_bench_json(capsys) -> None:
     configs = {r["config"] for r in doc["rows"]}
     assert configs == {"apart", "near", "interpenetrating"}
     for r in doc["rows"]:
-        assert r["median_ms"] >= 0.0
+        assert 0.0 < r["median_ms"] < 60e3
         if r["engine"] == "cloudprox":
             assert r["ratio_to_cloudprox"] == pytest.approx(1.0)
 

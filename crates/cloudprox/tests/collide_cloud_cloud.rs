@@ -316,3 +316,131 @@ fn separation_estimate_tracks_the_exact_gap() {
         );
     }
 }
+
+/// Eq. 3 with each point's own full covariance: `p_i = Phi(-y_i f(x_i) /
+/// sqrt(g^T Sigma_i g))`, on plates noisier across the gap than along it (A
+/// anisotropic, B isotropic). Moved from the Python suite.
+#[test]
+fn per_point_probabilities_use_each_points_full_covariance() {
+    let grid: Vec<Point3> = (0..144)
+        .map(|k| Point3::new(0.01 * f64::from(k / 12), 0.01 * f64::from(k % 12), 0.0))
+        .collect();
+    let cov = Matrix3::from_diagonal(&Vector3::new(4e-6, 1e-6, 9e-6));
+    let a = PointCloud::from_covariances(
+        cloudprox::sample::add_noise(&grid, 1e-3, 1),
+        vec![cov; grid.len()],
+    )
+    .unwrap();
+    let b = PointCloud::from_sigma(cloudprox::sample::add_noise(&grid, 1e-3, 2), 0.002).unwrap();
+    let pose_b = Pose::translation(0.0, 0.0, 0.006);
+    let r = collide(
+        &Pose::identity(),
+        &a,
+        &pose_b,
+        &b,
+        &request(Surface::Linear),
+    )
+    .unwrap();
+    assert!(!r.patches.is_empty());
+    let mut checked = 0;
+    for patch in &r.patches {
+        for (indices, side, probabilities, label) in [
+            (&patch.indices_a, 0, &r.probabilities_a, 1.0),
+            (&patch.indices_b, 1, &r.probabilities_b, -1.0),
+        ] {
+            for &i in indices {
+                let i = i as usize;
+                let (x, sigma) = if side == 0 {
+                    (a.points()[i], cov)
+                } else {
+                    (pose_b * b.points()[i], Matrix3::identity() * 4e-6)
+                };
+                let (f, g) = patch.separator.value_and_gradient(&x);
+                let std = (g.transpose() * sigma * g)[(0, 0)].sqrt();
+                let want = normal_cdf(-label * f / std);
+                assert!(
+                    (probabilities[i] - want).abs() <= 1e-9 * want.max(1e-6),
+                    "side {side} point {i}: {} vs {want}",
+                    probabilities[i]
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 0);
+}
+
+/// Without noise the state is exact: apart is `P = 0`, overlapping `P = 1`.
+/// Moved from the Python suite.
+#[test]
+fn clouds_without_noise_are_decided_exactly() {
+    let pts = cloudprox::sample::sphere(&Point3::origin(), 0.1, 300);
+    let a = PointCloud::from_sigma(pts.clone(), 0.0).unwrap();
+    let b = PointCloud::from_sigma(pts, 0.0).unwrap();
+    let req = CollisionRequest::default();
+    let far = collide(
+        &Pose::identity(),
+        &a,
+        &Pose::translation(0.25, 0.0, 0.0),
+        &b,
+        &req,
+    )
+    .unwrap();
+    assert_eq!((far.probability, far.state), (0.0, CollisionState::Free));
+    let deep = collide(
+        &Pose::identity(),
+        &a,
+        &Pose::translation(0.1, 0.0, 0.0),
+        &b,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(
+        (deep.probability, deep.state),
+        (1.0, CollisionState::Collision)
+    );
+}
+
+/// Two 10 cm spheres overlapping by half (1 mm noise): the neighbourhood
+/// means of the `surface` aggregation cancel at the crossing, yet every
+/// aggregation of the points model and the elements model read a collision.
+/// Moved from the Python suite.
+#[test]
+fn deep_interpenetration_is_a_collision_for_every_aggregation_and_model() {
+    let pts = cloudprox::sample::sphere(&Point3::origin(), 0.1, 2000);
+    let noisy = |seed| {
+        PointCloud::from_sigma(cloudprox::sample::add_noise(&pts, 0.001, seed), 0.001).unwrap()
+    };
+    let (a, b) = (noisy(1), noisy(2));
+    let points = |aggregation| CollisionRequest {
+        model: QueryModel::Points,
+        aggregation,
+        ..CollisionRequest::default()
+    };
+    let elements = CollisionRequest {
+        model: QueryModel::Elements,
+        ..CollisionRequest::default()
+    };
+    for req in [
+        points(Aggregation::Max),
+        points(Aggregation::Surface),
+        elements,
+    ] {
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &Pose::translation(0.1, 0.0, 0.0),
+            &b,
+            &req,
+        )
+        .unwrap();
+        assert_eq!(
+            r.state,
+            CollisionState::Collision,
+            "{:?} {:?}: P = {}",
+            req.model,
+            req.aggregation,
+            r.probability
+        );
+    }
+}

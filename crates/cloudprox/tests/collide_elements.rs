@@ -326,7 +326,17 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     }
     // The region holds tens of samples, not thousands of points.
     assert!(r.stats.counters.points_classified < 400, "{:?}", r.stats);
-    let _ = normal_cdf(0.0);
+    // Every point of the patch's elements is reported, none outside it.
+    let inside: std::collections::HashSet<u32> = region.indices_a.iter().copied().collect();
+    for (i, &p) in r.probabilities_a.iter().enumerate() {
+        if !inside.contains(&(i as u32)) {
+            assert_eq!(p, 0.0, "point {i} outside the patch");
+        }
+    }
+    assert!(region
+        .indices_a
+        .iter()
+        .any(|&i| r.probabilities_a[i as usize] > 0.0));
 }
 
 #[test]
