@@ -623,7 +623,7 @@ struct ExactInput {
 }
 
 /// Most points the `exact` target lets `collide_mesh_cloud` sample a mesh into.
-const MAX_MESH_SAMPLE: f64 = 4096.0;
+const MAX_MESH_SAMPLE: f64 = 1024.0;
 
 /// Exact mesh-vs-mesh proximity on small arbitrary meshes, and the mesh-vs-cloud
 /// query (`collide_mesh_cloud`) with the default request.
