@@ -61,9 +61,9 @@ def test_collide_json(capsys, npy_files, b: str, state: str) -> None:
     assert doc["state"] == state
     assert 0.0 <= doc["probability"] <= 1.0
     assert set(doc["stats"]) >= {"points_classified", "time_seconds", "patches"}
-    for region in doc["regions"]:
-        assert len(region["point"]) == 3 and len(region["normal"]) == 3
-        assert isinstance(region["separation"], float)
+    for patch in doc["patches"]:
+        assert len(patch["point"]) == 3 and len(patch["normal"]) == 3
+        assert isinstance(patch["separation"], float)
 
 
 def test_collide_with_pose_and_options(capsys, npy_files) -> None:
@@ -74,7 +74,7 @@ def test_collide_with_pose_and_options(capsys, npy_files) -> None:
     assert code == 0
     doc = json.loads(out)
     assert doc["state"] == "free"
-    assert all(r["surface"] == "linear" for r in doc["regions"])
+    assert all(r["surface"] == "linear" for r in doc["patches"])
     code, out, _ = run(
         capsys,
         *args,
@@ -138,7 +138,7 @@ def test_bench_json(capsys) -> None:
     configs = {r["config"] for r in doc["rows"]}
     assert configs == {"apart", "near", "interpenetrating"}
     for r in doc["rows"]:
-        assert r["median_ms"] >= 0.0
+        assert 0.0 < r["median_ms"] < 60e3
         if r["engine"] == "cloudprox":
             assert r["ratio_to_cloudprox"] == pytest.approx(1.0)
 

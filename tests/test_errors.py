@@ -176,7 +176,7 @@ def test_bad_sampler_input() -> None:
 def test_evaluate_rejects_bad_points(spheres) -> None:
     a, b = spheres
     r = cp.collide(a, b, pose_b=from_translation((0.2, 0.0, 0.0)))
-    region = r.regions[0]
+    region = r.patches[0]
     with pytest.raises(InvalidInputError, match=r"x must have shape \(n, 3\)"):
         region.evaluate(np.zeros((4, 2)))
     f, g = region.evaluate(np.zeros((0, 3)))

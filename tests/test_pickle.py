@@ -20,8 +20,8 @@ def assert_same_result(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
     assert r.probability == s.probability and r.state == s.state
     np.testing.assert_array_equal(r.probabilities_a, s.probabilities_a)
     np.testing.assert_array_equal(r.probabilities_b, s.probabilities_b)
-    assert len(r.regions) == len(s.regions)
-    for x, y in zip(r.regions, s.regions, strict=False):
+    assert len(r.patches) == len(s.patches)
+    for x, y in zip(r.patches, s.patches, strict=False):
         assert (x.component, x.separation, x.probability, x.surface, x.status, x.iterations) == (
             y.component,
             y.separation,
@@ -93,19 +93,19 @@ def test_result_and_region_roundtrip() -> None:
     a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
     b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
     result = cp.collide(a, b, pose_b=from_translation((0.199, 0.0, 0.0)))
-    assert result.regions
+    assert result.patches
     back = roundtrip(result)
     assert_same_result(result, back)
     assert back.stats == result.stats
     assert back.points_a is None and result.points_a is not None
     x = np.random.default_rng(0).normal(0.1, 0.05, (50, 3))
-    for r, s in zip(result.regions, back.regions, strict=False):
+    for r, s in zip(result.patches, back.patches, strict=False):
         f, g = r.evaluate(x)
         f2, g2 = s.evaluate(x)
         np.testing.assert_array_equal(f, f2)
         np.testing.assert_array_equal(g, g2)
-    region = roundtrip(result.regions[0])
-    np.testing.assert_array_equal(region.evaluate(x)[0], result.regions[0].evaluate(x)[0])
+    region = roundtrip(result.patches[0])
+    np.testing.assert_array_equal(region.evaluate(x)[0], result.patches[0].evaluate(x)[0])
 
 
 def test_robot_and_batch_roundtrip(tmp_path) -> None:

@@ -35,26 +35,18 @@ CHANGED: dict[str, Any] = {
 
 
 def test_defaults_are_the_rust_defaults() -> None:
+    # The values are the Rust `Default`s (`CollisionRequest::default()`), tested
+    # there and written nowhere in Python: every option has one, of its type.
     r = cp.CollisionRequest()
-    # The Rust `Default`s (`CollisionRequest::default()`, `ClassifySettings::default()`).
-    assert (r.surface, r.aggregation, r.robust_model, r.solver, r.model) == (
-        "quadric",
-        "max",
-        "gaussian",
-        "barrier",
-        "points",
-    )
-    assert (r.threshold_collision, r.threshold_free, r.prune_epsilon) == (0.9, 0.1, 1e-3)
-    assert (r.region_max_points, r.near_context, r.slack_weight, r.robust_eta) == (
-        2000,
-        2.0,
-        100.0,
-        0.9,
-    )
-    assert r.use_hierarchy is True and r.decide_only is False
-    assert isinstance(r.region_max_points, int)
+    d = r.to_dict()
+    assert set(d) == set(CHANGED)
+    for name, value in CHANGED.items():
+        assert type(d[name]) is type(value), name
+    for name, choices in cp.CollisionRequest.choices().items():
+        assert d[name] in choices, name
     # None means "not given": the default.
     assert cp.CollisionRequest(surface=None, slack_weight=None) == r
+    assert cp.CollisionRequest(**d) == r
 
 
 def test_every_option_is_read_back() -> None:
@@ -171,7 +163,7 @@ def _same(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
     assert r.probability == s.probability and r.state == s.state
     np.testing.assert_array_equal(r.probabilities_a, s.probabilities_a)
     np.testing.assert_array_equal(r.probabilities_b, s.probabilities_b)
-    assert len(r.regions) == len(s.regions)
+    assert len(r.patches) == len(s.patches)
 
 
 def test_collide_with_a_request_equals_the_keywords(spheres) -> None:
@@ -181,7 +173,7 @@ def test_collide_with_a_request_equals_the_keywords(spheres) -> None:
     request = cp.CollisionRequest(**options)
     by_request = cp.collide(a, b, pose_b=pose, request=request)
     _same(by_request, cp.collide(a, b, pose_b=pose, **options))
-    assert all(g.surface == "linear" for g in by_request.regions)
+    assert all(g.surface == "linear" for g in by_request.patches)
     # Keywords override the request's fields.
     _same(
         cp.collide(a, b, pose_b=pose, request=request.replace(surface="quadric"), surface="linear"),
@@ -238,7 +230,7 @@ def test_query_stats_are_typed(spheres) -> None:
     r = cp.collide(a, b, pose_b=sphere_gap_pose(2.0))
     stats = r.stats
     assert isinstance(stats, cp.QueryStats) and stats == r.stats
-    assert stats.patches == len(r.regions) and stats.time_seconds > 0.0
+    assert stats.patches == len(r.patches) and stats.time_seconds > 0.0
     assert isinstance(stats.points_classified, int) and isinstance(stats.pruned_bound, float)
     d = stats.to_dict()
     assert json.loads(json.dumps(d)) == d

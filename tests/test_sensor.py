@@ -1,4 +1,5 @@
-"""Sensor noise models from Python: formulas, PointCloud(sensor=...), bad input."""
+"""Sensor noise models from Python: outputs, defaults from the core, PointCloud(sensor=...),
+bad input (the formulas are tested in Rust, ``uncertainty_sensor.rs``)."""
 
 from __future__ import annotations
 
@@ -9,44 +10,56 @@ import cloudprox as cp
 from cloudprox.pose import from_translation
 
 
-def test_depth_camera_default_is_khoshelham_on_the_axis() -> None:
-    cam = cp.DepthCamera()
+def test_model_outputs_are_float64_arrays_of_the_documented_shapes() -> None:
+    # The formulas and the defaults' values are tested in Rust
+    # (crates/cloudprox/tests/uncertainty_sensor.rs); here: what crosses the binding.
     z = np.array([0.5, 1.0, 2.0, 5.0])
-    np.testing.assert_allclose(cam.sigma_axial(z), 1.425e-3 * z**2, rtol=1e-12)
-    np.testing.assert_allclose(cam.sigma_lateral(z), 0.8 * z / 580.0, rtol=1e-12)
     pts = np.c_[np.zeros_like(z), np.zeros_like(z), z]
-    cov = cam.covariances(pts, sensor_pose=np.eye(4))
-    np.testing.assert_allclose(cov[:, 2, 2], (1.425e-3 * z**2) ** 2, rtol=1e-12)
-    np.testing.assert_allclose(cov[:, 0, 0], (0.8 * z / 580.0) ** 2, rtol=1e-12)
+    for model in (cp.DepthCamera(), cp.StereoCamera(), cp.Lidar()):
+        cov = model.covariances(pts, sensor_pose=np.eye(4))
+        assert cov.shape == (4, 3, 3) and cov.dtype == np.float64, model
+        assert cov.flags.c_contiguous
+        # The same covariances seen from the origin point as from the identity pose.
+        np.testing.assert_array_equal(cov, model.covariances(pts, origin=[0.0, 0.0, 0.0]))
+    for model in (cp.DepthCamera(), cp.StereoCamera()):
+        for law in (model.sigma_axial, model.sigma_lateral):
+            out = law(z.reshape(2, 2))  # flattened
+            assert out.shape == (4,) and out.dtype == np.float64
+            np.testing.assert_array_equal(out, law(list(z)))
+    cam = cp.DepthCamera()
+    assert cam.depth_step(z).shape == cam.noise_correlation(z).shape == (4,)
 
 
 def test_unset_parameters_are_the_cores_defaults() -> None:
-    # None (the signature's default) is the Rust Default, written once there.
-    kh, cam = cp.DepthCamera.khoshelham_2012(), cp.DepthCamera(focal_px=600.0)
-    for name in ("axial_offset", "axial_quadratic", "axial_depth0", "sigma_px", "baseline_m"):
-        assert getattr(cam, name) == getattr(kh, name), name
-    assert cam.disparity_step_px == kh.disparity_step_px == 0.125 and cam.focal_px == 600.0
-    st = cp.StereoCamera(sigma_px=None)
-    assert (st.focal_px, st.baseline, st.sigma_disparity_px, st.sigma_px) == (
-        430.0,
-        0.05,
-        0.08,
-        0.5,
-    )
-    assert cp.Lidar().sigma_range == 0.01
-    assert cp.Lidar(sigma_range=0.02).sigma_angle == cp.Lidar().sigma_angle
-
-
-def test_presets_and_stereo_and_lidar_formulas() -> None:
-    assert cp.DepthCamera.nguyen_2012().sigma_axial([0.4])[0] == pytest.approx(0.0012)
-    st = cp.StereoCamera(focal_px=500.0, baseline=0.1, sigma_disparity_px=0.2)
-    assert st.sigma_axial([4.0])[0] == pytest.approx(16.0 * 0.2 / 50.0)
-    lidar = cp.Lidar(sigma_range=0.02, sigma_angle=0.001)
-    u = np.array([0.0, 0.6, 0.8])
-    cov = lidar.covariances([5.0 * u], origin=[0.0, 0.0, 0.0])[0]
-    assert u @ cov @ u == pytest.approx(0.02**2)
-    v = np.array([1.0, 0.0, 0.0])
-    assert v @ cov @ v == pytest.approx((5.0 * 0.001) ** 2)
+    # None (the signature's default) is the Rust Default, written once there:
+    # setting one parameter leaves every other at the default model's value.
+    fields = {
+        cp.DepthCamera: (
+            "axial_offset",
+            "axial_quadratic",
+            "axial_depth0",
+            "focal_px",
+            "sigma_px",
+            "baseline_m",
+            "disparity_step_px",
+        ),
+        cp.StereoCamera: ("focal_px", "baseline", "sigma_disparity_px", "sigma_px"),
+        cp.Lidar: ("sigma_range", "sigma_angle"),
+    }
+    for cls, names in fields.items():
+        default = cls()
+        for name in names:
+            value = 2.0 * getattr(default, name) + 1.0
+            one = cls(**{name: value})
+            assert getattr(one, name) == value, (cls, name)
+            for other in names:
+                if other != name:
+                    assert getattr(one, other) == getattr(default, other), (cls, name, other)
+            assert getattr(cls(**{name: None}), name) == getattr(default, name)
+    # The documented default depth camera is the Khoshelham preset.
+    kh = cp.DepthCamera.khoshelham_2012()
+    assert all(getattr(kh, n) == getattr(cp.DepthCamera(), n) for n in fields[cp.DepthCamera])
+    assert cp.DepthCamera.nguyen_2012().axial_offset != kh.axial_offset
 
 
 def test_point_cloud_from_a_sensor_uses_the_model() -> None:

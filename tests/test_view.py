@@ -131,7 +131,7 @@ def test_html_screenshot_shows_the_probabilities(tmp_path, spheres_near) -> None
     names = [str(o["name"]) for o in _k3d_objects(text)]
     assert "left: 1500 of 1500 points with p < 0.001" not in names  # some are hot
     assert any(n.startswith("left: ") and "with p ≥ 0.001" in n for n in names)
-    assert any(n.startswith("contact regions (") for n in names)
+    assert any(n.startswith("contact patches (") for n in names)
     pixels = screenshot(html, tmp_path / "near.png")
     area = _plot_area(pixels)
     # The colliding caps are hot, their rims cold; both spheres keep their colours.
@@ -187,7 +187,7 @@ def test_html_turns_zooms_and_hovers(tmp_path, spheres_near) -> None:
         region = browser.eval(
             "(function(){var w=cloudproxK3D.getWorld(),c=w.camera,o=Object.values(w.ObjectsById)"
             ".find(function(x){return (w.ObjectsListJson[x.K3DIdentifier]||{}).name"
-            "&&w.ObjectsListJson[x.K3DIdentifier].name.indexOf('contact regions')===0});"
+            "&&w.ObjectsListJson[x.K3DIdentifier].name.indexOf('contact patches')===0});"
             "var p=o.geometry.attributes.position,v=o.position.clone();"
             "v.set(p.getX(0),p.getY(0),p.getZ(0)).applyMatrix4(o.matrixWorld).project(c);"
             "var r=w.targetDOMNode.getBoundingClientRect();"
@@ -269,7 +269,7 @@ def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
     assert len(np.unique(cells[shown], axis=0)) == len(shown)
     assert len(np.unique(cells[quiet], axis=0)) == len(shown)
     assert 0.5 * view.QUIET_CELLS**2 < len(shown) < 0.6 * len(wall)
-    # The points of a contact region are drawn even where the cell has another.
+    # The points of a contact patch are drawn even where the cell has another.
     dropped = np.setdiff1d(quiet, shown)[:50]
     with_contact = view.PointLayer(
         "wall", layer.points, prob, layer.color, contact=np.concatenate([dropped, [3]])
@@ -314,14 +314,14 @@ def test_scene_of_a_result(spheres_near) -> None:
     np.testing.assert_array_equal(
         scene.points[0].probabilities, result.probabilities_a.astype(np.float32)
     )
-    assert len(scene.regions) == len(result.regions) >= 1
+    assert len(scene.regions) == len(result.patches) >= 1
     assert sorted(r.probability for r in scene.regions)[-1] == max(
-        r.probability for r in result.regions
+        r.probability for r in result.patches
     )
     with_surface = [r for r in scene.regions if r.surface is not None]
     assert 1 <= len(with_surface) <= 2
     # The separating surface passes through f = 0 (it is where f vanishes).
-    best = max(result.regions, key=lambda r: r.probability)
+    best = max(result.patches, key=lambda r: r.probability)
     vertices, faces = view.separating_surface(best, 0.02)
     f, _ = best.evaluate(vertices)
     assert np.max(np.abs(f)) < 1e-6 and faces.max() == len(vertices) - 1
@@ -352,7 +352,7 @@ def test_bad_inputs_give_clear_errors(spheres_near, monkeypatch) -> None:
     with pytest.raises(ValueError, match=r"side A: points of shape \(10, 3\) do not match"):
         view.collision_scene(result, points_a=a.points[:10])
     with pytest.raises(ValueError, match="half_size must be finite and > 0"):
-        view.separating_surface(result.regions[0], 0.0)
+        view.separating_surface(result.patches[0], 0.0)
     box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
     with_mesh = cp.collide(box, a, pose_a=from_translation((0.14, 0.0, 0.0)))
     with pytest.raises(ValueError, match=r"a pose must have shape \(4, 4\)"):
@@ -401,7 +401,7 @@ def test_rerun_recording_reads_back(tmp_path, spheres_near) -> None:
         r, g, bl = (int(colors[top]) >> s & 0xFF for s in (24, 16, 8))
         assert r > 200 and g > 150 and bl < 120, (r, g, bl)
     origins = np.array(columns["/regions"]["Arrows3D:origins"][0].as_py())
-    assert len(origins) == len(result.regions)
+    assert len(origins) == len(result.patches)
     text = columns["/summary"]["TextDocument:text"][0].as_py()
     assert f"state: {result.state}" in str(text)
 

@@ -14,14 +14,15 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use arbitrary::{Arbitrary, Unstructured};
 
 use cloudprox::classify::{ClassifySettings, SocpSolver, Surface};
-use cloudprox::cloud::{pose_from_matrix, PointCloud, MAX_COORDINATE};
+use cloudprox::cloud::{pose_from_matrix, PointCloud};
 use cloudprox::io::{
     las, npy, obj, off, pcd, ply, pointcloud2, stl, xyz, CloudData, Encoding, MeshData,
 };
 use cloudprox::math::{Matrix3, Matrix4, Point3, Pose, Vector3};
 use cloudprox::probability::{Aggregation, Thresholds};
 use cloudprox::query::collide::{
-    collide as collide_query, collide_mesh_cloud, CollisionRequest, MeshSampling, QueryModel,
+    collide as collide_query, collide_mesh_cloud, mesh_sampling_spacing, CollisionRequest,
+    MeshSampling, QueryModel,
 };
 use cloudprox::query::exact::{exact_intersects, exact_proximity, ExactShape};
 use cloudprox::robot::Robot;
@@ -588,18 +589,23 @@ struct MeshInput {
 }
 
 impl MeshInput {
+    /// The mesh, or `None` where cloudprox rejects it. Face indices are taken
+    /// modulo the vertex count (most of them otherwise point past the last
+    /// vertex, and almost no input would reach the exact queries); repeated
+    /// indices (degenerate faces) still reach `Mesh::new`.
     fn build(&self) -> Option<Mesh> {
-        let vertices = self
+        let vertices: Vec<Point3> = self
             .vertices
             .iter()
             .take(32)
             .map(|v| Point3::new(v[0].value(), v[1].value(), v[2].value()))
             .collect();
+        let n = u32::try_from(vertices.len()).ok()?.max(1);
         let faces = self
             .faces
             .iter()
             .take(32)
-            .map(|f| f.map(u32::from))
+            .map(|f| f.map(|i| u32::from(i) % n))
             .collect();
         Mesh::new(vertices, faces).ok()
     }
@@ -616,25 +622,20 @@ struct ExactInput {
     spacing: Opt<Num>,
 }
 
+/// Most points the `exact` target lets `collide_mesh_cloud` sample a mesh into.
+const MAX_MESH_SAMPLE: f64 = 1024.0;
+
 /// Exact mesh-vs-mesh proximity on small arbitrary meshes, and the mesh-vs-cloud
 /// query (`collide_mesh_cloud`) with the default request.
 pub fn exact(data: &[u8]) {
     let Ok(input) = ExactInput::arbitrary_take_rest(Unstructured::new(data)) else {
         return;
     };
-    // `exact_proximity` has no error channel: its poses must be valid (finite,
-    // within `MAX_COORDINATE`; what `pose_from_matrix` and `collide` check).
-    let valid = |p: &Pose| {
-        p.translation.vector.iter().all(|c| c.is_finite())
-            && p.translation.vector.amax() <= MAX_COORDINATE
-            && p.rotation.coords.iter().all(|c| c.is_finite())
-    };
+    // Any pose, NaN and overflowing ones included: the exact queries and
+    // `collide_mesh_cloud` check their poses and reject bad ones.
     let (Some(pose_a), Some(pose_b)) = (input.pose_a.build(), input.pose_b.build()) else {
         return;
     };
-    if !(valid(&pose_a) && valid(&pose_b)) {
-        return;
-    }
     let (Some(a), Some(b)) = (input.a.build(), input.b.build()) else {
         return;
     };
@@ -647,8 +648,9 @@ pub fn exact(data: &[u8]) {
         }
     };
     if let (Ok(sa), Ok(sb)) = (shape(&a), shape(&b)) {
-        let p = exact_proximity(&pose_a, &sa, &pose_b, &sb);
-        let _ = p.signed_distance();
+        if let Ok(p) = exact_proximity(&pose_a, &sa, &pose_b, &sb) {
+            let _ = p.signed_distance();
+        }
         let _ = exact_intersects(&pose_a, &sa, &pose_b, &sb);
     }
     if let Some(cloud) = input.cloud.build() {
@@ -659,6 +661,17 @@ pub fn exact(data: &[u8]) {
             },
             seed: 7,
         };
+        // One input's work is bounded, as the readers' is by their input size:
+        // a mesh sampled into more than `MAX_MESH_SAMPLE` points is left out
+        // (the query's cost grows with the sample, not its correctness; a
+        // spacing that is not finite and positive still reaches the query).
+        let spacing = sampling
+            .spacing
+            .unwrap_or_else(|| mesh_sampling_spacing(&cloud));
+        let samples = a.area() / (spacing * spacing);
+        if spacing.is_finite() && spacing > 0.0 && (samples.is_nan() || samples > MAX_MESH_SAMPLE) {
+            return;
+        }
         let _ = collide_mesh_cloud(
             &pose_a,
             &a,

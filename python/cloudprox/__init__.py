@@ -22,7 +22,7 @@ from cloudprox import filters, io, pose, synthetic
 from cloudprox._native import (
     CollisionRequest,
     CollisionResult,
-    ContactRegion,
+    ContactPatch,
     DepthCamera,
     ExactShape,
     Lidar,
@@ -64,7 +64,7 @@ __all__ = [
     "CloudproxError",
     "CollisionRequest",
     "CollisionResult",
-    "ContactRegion",
+    "ContactPatch",
     "DegenerateFacesWarning",
     "DepthCamera",
     "ExactShape",

@@ -24,7 +24,7 @@ __all__ = [
     "CloudproxError",
     "CollisionRequest",
     "CollisionResult",
-    "ContactRegion",
+    "ContactPatch",
     "DepthCamera",
     "ExactShape",
     "FormatError",
@@ -96,6 +96,12 @@ _ModelName = Literal["elements", "points"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
 _SolverName = Literal["barrier", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
+_CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
+_MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
+_EncodingName = Literal[
+    "ascii", "binary", "binary_little_endian", "binary_big_endian", "binary_compressed"
+]
+_MergeName = Literal["mean", "independent"]
 
 class CloudproxError(Exception):
     """Base class of every exception raised by cloudprox."""
@@ -120,7 +126,7 @@ class SolverError(CloudproxError, RuntimeError):
     """A solver failed in a way that cannot be reported as data (reserved).
 
     A solve that does not converge is not an error: it falls back to a plane and
-    is reported in ``ContactRegion.status`` and ``CollisionResult.stats``.
+    is reported in ``ContactPatch.status`` and ``CollisionResult.stats``.
     """
 
 @final
@@ -159,7 +165,8 @@ class PointCloud:
         Add the discretization covariance estimated from each point's ``k``
         nearest neighbours (Gaussian weights of scale ``2 d_k``).
     k : int, optional
-        Number of neighbours for ``discretization`` (Rust default: 10; ``>= 2``);
+        Number of neighbours for ``discretization`` (``>= 2``; default: the
+        core's, ``DiscretizationSettings::default()`` in Rust);
         only allowed with ``discretization=True``.
     noise_correlation : float, optional
         Correlation ``rho`` in ``[0, 1]`` of the sensor noise between the points
@@ -245,7 +252,7 @@ class PointCloud:
     def __len__(self) -> int: ...
 
 @final
-class ContactRegion:
+class ContactPatch:
     """One patch of a near region with its own separating surface (world frame).
 
     The surface ``f`` is positive on cloud A's side and negative on cloud B's.
@@ -340,7 +347,7 @@ class CollisionResult:
         :func:`cloudprox.view.collision_scene`. Returns the file written.
         """
     @property
-    def regions(self) -> list[ContactRegion]:
+    def patches(self) -> list[ContactPatch]:
         """The classified patches of the near regions."""
     @property
     def stats(self) -> QueryStats:
@@ -361,7 +368,7 @@ class QueryStats:
         """Connected near regions."""
     @property
     def patches(self) -> int:
-        """Patches classified (``len(result.regions)``)."""
+        """Patches classified (``len(result.patches)``)."""
     @property
     def misfit_cuts(self) -> int:
         """Patches cut in two because one surface misfit them."""
@@ -382,7 +389,7 @@ class QueryStats:
         """Patches where the barrier method gave way to Clarabel."""
     @property
     def solver_fallbacks(self) -> int:
-        """Patches whose solve fell back to a plane (``ContactRegion.status == "fallback"``)."""
+        """Patches whose solve fell back to a plane (``ContactPatch.status == "fallback"``)."""
     @property
     def pruned_bound(self) -> float:
         """Upper bound on the probability that any pruned point is on the wrong side."""
@@ -649,7 +656,9 @@ class CollisionRequest:
     Accepted by :func:`collide`, :func:`collide_many`, :func:`collide_robot`,
     :func:`collide_robot_many` and :func:`check_motion` as ``request=``. Every
     option is keyword-only; one left out (or ``None``) takes the Rust core's
-    default, so ``CollisionRequest()`` shows the defaults. Unknown enum names,
+    default (``CollisionRequest::default()``, documented on each field of the
+    Rust struct), so ``repr(CollisionRequest())`` and
+    ``CollisionRequest().to_dict()`` show the defaults; none is written here. Unknown enum names,
     values out of their domain and thresholds out of order raise
     :class:`InvalidInputError` naming the option (and the valid names).
     Requests are frozen (compare equal option by option, hash and pickle);
@@ -658,9 +667,9 @@ class CollisionRequest:
     Parameters
     ----------
     surface : {"quadric", "linear"}, optional
-        Family of the separating surface (default ``"quadric"``).
+        Family of the separating surface.
     aggregation : {"max", "surface", "union", "independent"}, optional
-        How per-point probabilities become ``P`` (default ``"max"``): the
+        How per-point probabilities become ``P`` the
         paper's ``max``, ``union`` (``min(1, sum p_i)``) and ``independent``
         (``1 - prod(1 - p_i)``) of the per-point probabilities, or ``surface``:
         the largest probability that the surface around a point (the point and
@@ -669,34 +678,34 @@ class CollisionRequest:
         (see the README). Only points within the noise's reach of the other
         cloud count.
     threshold_collision : float, optional
-        ``P >= threshold_collision`` is ``"collision"`` (default 0.9).
+        ``P >= threshold_collision`` is ``"collision"``.
     threshold_free : float, optional
-        ``P <= threshold_free`` is ``"free"`` (default 0.1). Must satisfy
+        ``P <= threshold_free`` is ``"free"``. Must satisfy
         ``0 <= threshold_free <= 0.5 <= threshold_collision <= 1``.
     prune_epsilon : float, optional
-        Node pairs whose crossing bound is below this are pruned (default 1e-3).
+        Node pairs whose crossing bound is below this are pruned.
     region_max_points : int, optional
-        Near regions larger than this are split into patches (default 2000, ``>= 8``):
+        Near regions larger than this are split into patches (``>= 8``):
         a bound on the cost of one solve. Regions are also cut where one surface
         misfits (``QueryStats.misfit_cuts``).
     near_context : float, optional
         Context kept around the near points, in sampling spacings (each point's
-        distance to its 6th nearest neighbour; default 2, ``>= 0.5``).
+        distance to its 6th nearest neighbour; ``>= 0.5``).
     slack_weight : float, optional
         Weight of the slack term of the classifier against ``|w|^2 / 2``
-        (``lambda`` in the formulas; default 100, close to a hard margin).
+        (``lambda`` in the formulas; the default is close to a hard margin).
     robust_eta : float, optional
-        Confidence of each point's chance constraint, in ``[0.5, 1)`` (default 0.9).
+        Confidence of each point's chance constraint, in ``[0.5, 1)``.
     robust_model : {"gaussian", "chebyshev"}, optional
-        Distribution assumption of the robustness radius (default ``"gaussian"``).
+        Distribution assumption of the robustness radius.
     solver : {"barrier", "clarabel"}, optional
         SOCP solver: the specialized log-barrier method (falls back to Clarabel if
-        it does not converge) or Clarabel alone (default ``"barrier"``).
+        it does not converge) or Clarabel alone.
     use_hierarchy : bool, optional
         ``False`` finds the near points by testing every point pair and classifies
-        them in one region (the brute-force reference; default ``True``).
+        them in one region (the brute-force reference).
     model : {"points", "elements"}, optional
-        What is classified (default ``"points"``): every point (the paper's
+        What is classified: every point (the paper's
         method), or the cloud's *surface elements*: groups of points that fit a
         smooth surface within their noise, built once per cloud, each standing
         for its fitted surface with the covariance of the fit. With
@@ -705,7 +714,7 @@ class CollisionRequest:
         samples at any noise level; per-point probabilities are still Eq. 3 of
         each point. ``aggregation="surface"`` belongs to ``"points"``.
     decide_only : bool, optional
-        Return as soon as the state is decided (default ``False``): no per-point
+        Return as soon as the state is decided: no per-point
         probabilities or separation estimates (NaN), and with ``max`` the query
         stops at the first patch that reaches ``threshold_collision``. The state
         is that of the full query.
@@ -837,7 +846,7 @@ def collide(
     Returns
     -------
     CollisionResult
-        ``P``, the state, per-point probabilities, regions and statistics.
+        ``P``, the state, per-point probabilities, patches and statistics.
 
     Raises
     ------
@@ -1082,12 +1091,12 @@ class DepthCamera:
 
     Axial (depth) standard deviation ``axial_offset + axial_quadratic (z -
     axial_depth0)^2``, stretched along the viewing ray by ``range / depth``;
-    lateral ``sigma_px z / focal_px``. The defaults are Khoshelham & Elberink
-    (Sensors 2012): ``sigma_z = 1.425e-3 z^2`` (1.4 mm at 1 m, 3.6 cm at 5 m),
-    focal length 580 px, lateral 0.8 px (Nguyen et al. 2012).
+    lateral ``sigma_px z / focal_px``.
 
-    Every parameter left ``None`` takes the core's default (``DepthCamera::default()``
-    in Rust, the Khoshelham values: 0, 1.425e-3, 0, 580 px, 0.8 px, 0.075 m, 1/8 px).
+    Every parameter left ``None`` takes the core's default
+    (``DepthCamera::default()`` in Rust: Khoshelham & Elberink, Sensors 2012, for
+    the axial law, Nguyen et al. 2012 for the lateral one, a Kinect v1's
+    baseline and disparity step); the properties read the values.
 
     Parameters
     ----------
@@ -1098,9 +1107,9 @@ class DepthCamera:
     sigma_px : float
         Lateral standard deviation in pixels (``>= 0``).
     baseline_m : float
-        Projector-camera baseline in metres (``> 0``; Kinect v1: 0.075).
+        Projector-camera baseline in metres (``> 0``).
     disparity_step_px : float
-        Resolution of the measured disparity in pixels (``>= 0``; Kinect v1: 1/8).
+        Resolution of the measured disparity in pixels (``>= 0``).
         Depth comes in steps of ``z^2 disparity_step_px / (focal_px baseline_m)``;
         that share of the error (variance ``step^2 / 12``) is common to
         neighbouring points of a surface and does not average away: a cloud seen
@@ -1161,9 +1170,9 @@ class StereoCamera:
 
     Depth standard deviation ``z^2 sigma_disparity_px / (focal_px baseline)``
     (first-order propagation of ``z = f B / d``), stretched along the ray;
-    lateral ``sigma_px z / focal_px``. Defaults: a RealSense D435-like camera
-    (430 px, 50 mm, 0.08 px subpixel disparity noise, 0.5 px lateral): every
-    parameter left ``None`` takes the core's ``StereoCamera::default()``.
+    lateral ``sigma_px z / focal_px``. Every parameter left ``None`` takes the
+    core's ``StereoCamera::default()`` (a RealSense D435-like camera); the
+    properties read the values.
     """
 
     def __new__(
@@ -1198,10 +1207,10 @@ class StereoCamera:
 class Lidar:
     """Laser range finder noise model.
 
-    ``sigma_range`` along the ray, ``range * sigma_angle`` across it. Defaults:
-    Hokuyo UTM-30LX (accuracy +-30 mm taken as 3 sigma: 10 mm; angular resolution
-    0.25 deg, quantization standard deviation 0.25 deg / sqrt(12)): a parameter
-    left ``None`` takes the core's ``Lidar::default()``.
+    ``sigma_range`` along the ray, ``range * sigma_angle`` across it. A
+    parameter left ``None`` takes the core's ``Lidar::default()`` (a Hokuyo
+    UTM-30LX: its accuracy taken as 3 sigma, its angular resolution's
+    quantization); the properties read the values.
     """
 
     def __new__(
@@ -1321,21 +1330,21 @@ class CloudFile:
         """
     def __len__(self) -> int: ...
 
-def read_point_cloud(path: str, format: str = "auto") -> CloudFile:
+def read_point_cloud(path: str, format: _CloudFormatName = "auto") -> CloudFile:
     """Read a point-cloud file (see :func:`cloudprox.io.read_point_cloud`)."""
 
 def write_point_cloud(
     path: str,
     cloud: object,
-    format: str = "auto",
+    format: _CloudFormatName = "auto",
     *,
-    encoding: str | None = None,
+    encoding: _EncodingName | None = None,
     write_ascii: bool = False,
     compressed: bool = False,
 ) -> None:
     """Write a point cloud (see :func:`cloudprox.io.write_point_cloud`)."""
 
-def read_mesh(path: str | os.PathLike[str], format: str = "auto") -> Mesh:
+def read_mesh(path: str | os.PathLike[str], format: _MeshFormatName = "auto") -> Mesh:
     """Read a triangle mesh (STL ascii/binary, OBJ, PLY, OFF).
 
     Polygons are split into fans of triangles and STL vertices are welded.
@@ -1350,15 +1359,17 @@ def read_mesh(path: str | os.PathLike[str], format: str = "auto") -> Mesh:
         If its content is corrupt, truncated or unsupported.
     """
 
-def _read_mesh_counted(path: str | os.PathLike[str], format: str = "auto") -> tuple[Mesh, int]:
+def _read_mesh_counted(
+    path: str | os.PathLike[str], format: _MeshFormatName = "auto"
+) -> tuple[Mesh, int]:
     """:func:`read_mesh` without the warning: the mesh and the number of faces dropped."""
 
 def write_mesh(
     path: str,
     mesh: Mesh,
-    format: str = "auto",
+    format: _MeshFormatName = "auto",
     *,
-    encoding: str | None = None,
+    encoding: _EncodingName | None = None,
     write_ascii: bool = False,
 ) -> None:
     """Write a mesh file (see :func:`cloudprox.io.write_mesh`)."""
@@ -1391,7 +1402,7 @@ def voxel_downsample(
     points: npt.ArrayLike,
     voxel_size: float,
     covariances: npt.ArrayLike | None = None,
-    merge: str = "mean",
+    merge: _MergeName = "mean",
 ) -> Voxels:
     """One point per occupied voxel (see :mod:`cloudprox.filters`)."""
 
@@ -1458,7 +1469,7 @@ class ScanStep:
     ) -> ScanStep:
         """Keep the points inside the box ``[min, max]`` (outside with ``invert``)."""
     @staticmethod
-    def voxel(size: float, merge: str = "mean") -> ScanStep:
+    def voxel(size: float, merge: _MergeName = "mean") -> ScanStep:
         """One point per occupied voxel of side ``size``, covariances merged."""
     @staticmethod
     def outliers(k: int | None = None, std_ratio: float | None = None) -> ScanStep:
@@ -1509,7 +1520,9 @@ def scan_to_cloud(
     ``discretization=False``. The GIL is released while it runs.
     """
 
-def parse_mesh(data: bytes, format: str, name: str = "<bytes>") -> Mesh:
+def parse_mesh(
+    data: bytes, format: Literal["stl", "obj", "ply", "off"], name: str = "<bytes>"
+) -> Mesh:
     """Read a triangle mesh from bytes in memory (e.g. a member of a zip archive).
 
     As :func:`read_mesh`; ``format`` must be given (``"stl"``, ``"obj"``,
@@ -1586,7 +1599,7 @@ class Robot:
     ) -> SelfFilter:
         """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame).
 
-        ``padding=None`` is the core's ``SELF_FILTER_DEFAULT_PADDING`` (0.01 m).
+        ``padding=None`` is the core's ``SELF_FILTER_DEFAULT_PADDING``.
         """
 
 @final
@@ -1623,8 +1636,8 @@ class RobotCollisionResult:
     def links(self) -> dict[str, LinkCollision]:
         """Per link with geometry, by name (URDF order)."""
     @property
-    def regions(self) -> list[tuple[str, ContactRegion]]:
-        """Contact regions of every queried link, as ``(link name, region)``."""
+    def patches(self) -> list[tuple[str, ContactPatch]]:
+        """Contact patches of every queried link, as ``(link name, patch)``."""
     @property
     def self_collisions(self) -> list[tuple[str, str]]:
         """Pairs of non-adjacent links that intersect; not part of ``probability``."""

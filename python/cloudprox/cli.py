@@ -72,14 +72,14 @@ def result_to_dict(result: CollisionResult) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``probability``, ``state``, ``regions`` (each with ``component``,
+        ``probability``, ``state``, ``patches`` (each with ``component``,
         ``points_a``, ``points_b``, ``point``, ``normal``, ``separation``,
         ``probability``, ``surface``, ``status``, ``iterations``) and ``stats``.
     """
     return {
         "probability": result.probability,
         "state": result.state,
-        "regions": [
+        "patches": [
             {
                 "component": r.component,
                 "points_a": len(r.indices_a),
@@ -92,7 +92,7 @@ def result_to_dict(result: CollisionResult) -> dict[str, Any]:
                 "status": r.status,
                 "iterations": r.iterations,
             }
-            for r in result.regions
+            for r in result.patches
         ],
         "stats": {
             k: (_finite(v) if isinstance(v, float) else v)
@@ -136,7 +136,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     )
 
     table = Table(title="Piano against the room at exact gaps")
-    for col in ("gap mm", "gap/sigma", "nearest", "P", "state", "regions", "ms"):
+    for col in ("gap mm", "gap/sigma", "nearest", "P", "state", "patches", "ms"):
         table.add_column(col, justify="left" if col in ("nearest", "state") else "right")
     gaps = [g * s for g in DEMO_GAPS_SIGMA] + [DEMO_FAR_GAP]
     runs = []
@@ -154,7 +154,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             nearest,
             f"{result.probability:.3g}",
             f"[{style}]{result.state}[/{style}]",
-            str(len(result.regions)),
+            str(len(result.patches)),
             f"{1e3 * result.stats.time_seconds:.1f}",
         )
     console.print(table)
@@ -281,13 +281,13 @@ def _cmd_collide(args: argparse.Namespace) -> int:
             )
     console.print(
         f"P = {result.probability:.6g}   state: [{style}]{result.state}[/{style}]   "
-        f"regions: {len(result.regions)}   time: {1e3 * result.stats.time_seconds:.2f} ms"
+        f"patches: {len(result.patches)}   time: {1e3 * result.stats.time_seconds:.2f} ms"
     )
-    for k, r in enumerate(result.regions):
+    for k, r in enumerate(result.patches):
         point = ", ".join(f"{x:+.4f}" for x in r.point)
         normal = ", ".join(f"{x:+.3f}" for x in r.normal)
         console.print(
-            f"  region {k}: P = {r.probability:.3g}, separation {1e3 * r.separation:+.2f} mm, "
+            f"  patch {k}: P = {r.probability:.3g}, separation {1e3 * r.separation:+.2f} mm, "
             f"point ({point}), normal ({normal}), points {len(r.indices_a)}+{len(r.indices_b)}, "
             f"{r.surface} surface, {r.status}"
         )
@@ -818,7 +818,7 @@ def _add_query_arguments(
     sensor.add_argument(
         "--preset",
         choices=["khoshelham-2012", "nguyen-2012"],
-        help="depth camera: published fit (default khoshelham-2012: 1.425e-3 z^2)",
+        help="depth camera: published fit (default: the core's, khoshelham-2012)",
     )
     sensor.add_argument("--origin", metavar="X,Y,Z", help="sensor origin in the cloud's frame")
     sensor.add_argument(
@@ -915,7 +915,7 @@ def _add_view_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=5,
         metavar="N",
-        help="separating surfaces of the N most probable regions in the view, hidden until "
+        help="separating surfaces of the N most probable patches in the view, hidden until "
         "shown in the view's panel (default: %(default)s)",
     )
     group.add_argument(

@@ -10,7 +10,7 @@ re-exported here::
         └── SolverError           also a RuntimeError: reserved for solver failures
 
 A solve that does not converge is *not* an error: it falls back to a plane and is
-reported as data (``ContactRegion.status == "fallback"`` and
+reported as data (``ContactPatch.status == "fallback"`` and
 ``CollisionResult.stats.solver_fallbacks``). Missing files raise the builtin
 ``FileNotFoundError``.
 

@@ -22,9 +22,9 @@ ascending), so that points, covariances and pixels can be subset alike::
     points, covs = points[keep], covs[keep]
 
 Parameters left ``None`` take the Rust core's defaults (written once, there):
-``SOR_DEFAULT_K`` (20) and ``SOR_DEFAULT_STD_RATIO`` (2.0) for the outlier filter,
-a 10 degree angle, a window of 1 and ``k = 8`` for the shadow filter, a 1 cm
-padding for the self filter. Bad parameters raise
+``SOR_DEFAULT_K`` and ``SOR_DEFAULT_STD_RATIO`` (exported here) for the outlier
+filter, ``ShadowSettings::default()`` for the shadow filter and
+``SELF_FILTER_DEFAULT_PADDING`` for the self filter. Bad parameters raise
 :class:`cloudprox.InvalidInputError` naming them.
 """
 

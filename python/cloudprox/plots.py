@@ -67,7 +67,7 @@ def contact_bounds(
         pa[np.asarray(result.probabilities_a) >= quiet_below],
         pb[np.asarray(result.probabilities_b) >= quiet_below],
     ]
-    loud += [np.asarray(r.point, dtype=float)[None] for r in result.regions]
+    loud += [np.asarray(r.point, dtype=float)[None] for r in result.patches]
     near = np.concatenate([x for x in loud if len(x)] or [np.zeros((0, 3))])
     near = near[np.all(np.isfinite(near), axis=1)]
     if not len(near):
@@ -187,7 +187,7 @@ def _draw(
                 linewidths=0.3,
                 label=f"{label}: {len(loud)} with $p_i \\geq$ {quiet_below:g}",
             )
-    for region in result.regions:
+    for region in result.patches:
         if np.any(region.point < lo) or np.any(region.point > hi):
             continue
         ax.quiver(*region.point, *(0.1 * region.normal), color="tab:green", linewidth=1.0)

@@ -2,7 +2,7 @@
 
 A view holds both sides of a query (clouds, or a mesh and a cloud, or a robot at
 its configuration and a scene), every point coloured by its collision probability
-on a colour bar, the contact regions with their normals and separations, and the
+on a colour bar, the contact patches with their normals and separations, and the
 separating surface of the most probable regions (hidden at first). The HTML file
 (:func:`write_html`) is drawn by k3d (three.js, its JavaScript inlined: it opens
 without a server or the internet, fast even without a GPU: every point is one
@@ -46,7 +46,7 @@ import numpy.typing as npt
 from cloudprox._native import Mesh, PointCloud
 
 if TYPE_CHECKING:
-    from cloudprox._native import CollisionResult, ContactRegion, Robot, RobotCollisionResult
+    from cloudprox._native import CollisionResult, ContactPatch, Robot, RobotCollisionResult
 
 __all__ = [
     "MeshLayer",
@@ -68,7 +68,7 @@ __all__ = [
 COLORSCALE = "Plasma"
 #: Colours of the two sides' points below ``quiet_below`` (side A, side B).
 SIDE_COLORS = ("#2ca58d", "#8d99ae")
-#: Colour of the contact regions' points and normals.
+#: Colour of the contact patches' points and normals.
 REGION_COLOR = "#d62728"
 
 
@@ -102,7 +102,7 @@ class PointLayer:
         Whether the points below ``quiet_below`` are drawn (a mesh side's samples
         are not: the mesh is).
     contact : ndarray of int
-        Indices of the points in a contact region: drawn even when thinned.
+        Indices of the points in a contact patch: drawn even when thinned.
     """
 
     name: str
@@ -132,7 +132,7 @@ class MeshLayer:
 
 @dataclass(frozen=True)
 class RegionMark:
-    """One contact region: where, which way, how far apart, how probable.
+    """One contact patch: where, which way, how far apart, how probable.
 
     ``surface`` is the region's separating surface as a small triangle mesh
     ``(vertices, faces)`` around ``point``, or ``None``.
@@ -178,7 +178,7 @@ def _world(points: npt.ArrayLike, pose: npt.ArrayLike | None) -> np.ndarray:
 
 
 def separating_surface(
-    region: ContactRegion,
+    region: ContactPatch,
     half_size: float,
     resolution: int = 16,
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -190,7 +190,7 @@ def separating_surface(
 
     Parameters
     ----------
-    region : ContactRegion
+    region : ContactPatch
         The region.
     half_size : float
         Half the side of the square (metres, > 0).
@@ -239,7 +239,7 @@ def separating_surface(
 
 
 def _region_marks(
-    regions: Sequence[tuple[str, ContactRegion]],
+    regions: Sequence[tuple[str, ContactPatch]],
     world_a: np.ndarray | None,
     world_b: np.ndarray | None,
     surfaces: int,
@@ -279,7 +279,7 @@ def _region_marks(
     return marks
 
 
-def _contact_indices(regions: Sequence[ContactRegion], side: str, n: int) -> np.ndarray:
+def _contact_indices(regions: Sequence[ContactPatch], side: str, n: int) -> np.ndarray:
     """Collect the indices (sorted, unique, < n) of one side's points in ``regions``."""
     parts = [np.asarray(getattr(r, f"indices_{side}"), dtype=np.int64) for r in regions]
     idx = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
@@ -361,7 +361,7 @@ def collision_scene(
     labels : tuple of str, default ("A", "B")
         Names of the two sides.
     surfaces : int, default 5
-        How many regions (the most probable) carry their separating surface.
+        How many patches (the most probable) carry their separating surface.
     quiet_below : float, default 1e-3
         Points with a smaller probability are drawn small, in their side's colour.
     title : str, optional
@@ -397,19 +397,19 @@ def collision_scene(
                 probabilities=np.nan_to_num(prob[k]).astype(np.float32),
                 color=SIDE_COLORS[k],
                 show_quiet=not is_mesh,
-                contact=_contact_indices(result.regions, "ab"[k], len(prob[k])),
+                contact=_contact_indices(result.patches, "ab"[k], len(prob[k])),
             )
         )
     head = f"{title}<br>" if title else ""
     scene = Scene(
         title=f"{head}{labels[0]} vs {labels[1]}: P = {result.probability:.4g}, "
-        f"state: {result.state}, {len(result.regions)} regions",
+        f"state: {result.state}, {len(result.patches)} patches",
         points=layers,
         meshes=meshes,
         quiet_below=quiet_below,
     )
     marks = _region_marks(
-        [(f"region {k}", r) for k, r in enumerate(result.regions)],
+        [(f"patch {k}", r) for k, r in enumerate(result.patches)],
         world[0],
         world[1],
         surfaces,
@@ -493,7 +493,7 @@ def robot_scene(
             points=np.asarray(cloud.points, dtype=np.float32),
             probabilities=worst.astype(np.float32),
             color=SIDE_COLORS[1],
-            contact=_contact_indices([r for _, r in result.regions], "b", n),
+            contact=_contact_indices([r for _, r in result.patches], "b", n),
         )
     ]
     selfc = (
@@ -511,7 +511,7 @@ def robot_scene(
     )
     cloud_points = np.asarray(cloud.points, dtype=np.float64)
     marks = _region_marks(
-        [(name, r) for name, r in result.regions], None, cloud_points, surfaces, scene.extent()
+        [(name, r) for name, r in result.patches], None, cloud_points, surfaces, scene.extent()
     )
     return Scene(scene.title, layers, meshes, marks, quiet_below)
 
@@ -690,7 +690,7 @@ def to_figure(scene: Scene, *, all_points: bool = True) -> Any:
                 z=zs,
                 mode="lines",
                 line={"color": REGION_COLOR, "width": 5},
-                name="region normals (A → B)",
+                name="patch normals (A → B)",
                 hoverinfo="skip",
             )
         )
@@ -708,7 +708,7 @@ def to_figure(scene: Scene, *, all_points: bool = True) -> Any:
                 z=pts[:, 2],
                 mode="markers",
                 marker={"size": 5, "color": REGION_COLOR, "symbol": "diamond"},
-                name=f"contact regions ({len(scene.regions)})",
+                name=f"contact patches ({len(scene.regions)})",
                 hovertext=text,
                 hovertemplate="%{hovertext}<extra></extra>",
             )
@@ -836,7 +836,7 @@ _PLOTLY_DRAWN = (
 QUIET_CELLS = 400
 #: Pixel sizes of the drawn points (below and above ``quiet_below``, regions).
 POINT_PIXELS = (2.0, 5.0, 11.0)
-#: How many contact regions (the most probable) carry a text label in the view.
+#: How many contact patches (the most probable) carry a text label in the view.
 REGION_LABELS = 3
 
 
@@ -845,7 +845,7 @@ def _quiet_shown(layer: PointLayer, quiet_below: float, cell: float | None) -> n
 
     The first point (in the layer's order) of each occupied cell is kept, so the
     choice is deterministic and the drawn density is at most one a cell; the
-    points of the contact regions (``layer.contact``) are kept besides.
+    points of the contact patches (``layer.contact``) are kept besides.
     """
     is_quiet = np.asarray(layer.probabilities) < quiet_below
     quiet = np.flatnonzero(is_quiet)
@@ -1000,9 +1000,9 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
     Every point with ``p >= quiet_below`` is drawn, coloured on the plasma scale
     and larger; the others in their side's colour, thinned (unless
     ``all_points``) to one a cell of ``extent / QUIET_CELLS`` (the density a
-    screen shows of the whole scene), the points of contact regions kept; the
+    screen shows of the whole scene), the points of contact patches kept; the
     legend says how many are drawn. The
-    contact regions are red markers with their normals (hover a marker for P,
+    contact patches are red markers with their normals (hover a marker for P,
     separation, normal), the separating surfaces start hidden (the panel's
     Objects folder shows them), mesh sides and robot links are surfaces.
 
@@ -1110,7 +1110,7 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
     if marks:
         focus = _focus(scene)
         length = 0.08 * extent if focus is None else max(0.4 * focus[1], 0.005 * extent)
-        name = f"contact regions ({len(marks)})"
+        name = f"contact patches ({len(marks)})"
         plot += k3d.points(
             np.array([r.point for r in marks], dtype=np.float32),
             color=_packed(REGION_COLOR),
@@ -1131,7 +1131,7 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
             color=_packed(REGION_COLOR),
             head_size=length,  # k3d's arrow head: a cone 0.2 head_size long
             line_width=0.06 * length,
-            name="region normals (A → B)",
+            name="patch normals (A → B)",
         )
         # The most probable regions carry a label (all of them a hover text).
         for r in sorted(marks, key=lambda r: -r.probability)[:REGION_LABELS]:
@@ -1145,7 +1145,7 @@ def to_k3d(scene: Scene, *, all_points: bool = False) -> Any:
                 name=f"label of {r.label}",
             )
         legend.append(
-            f"<span style='color:{REGION_COLOR}'>&#9670;</span> {len(marks)} contact regions "
+            f"<span style='color:{REGION_COLOR}'>&#9670;</span> {len(marks)} contact patches "
             "with normals (A → B) and separations: hover a marker"
         )
     for r in scene.regions:

@@ -46,7 +46,7 @@ thresholds out of order and unknown option names. Subclass of both ``CloudproxEr
 
 const SOLVER_ERROR_DOC: &str = "A solver failed in a way that cannot be reported as data.\n\n\
 Reserved: a solve that does not converge is not an error (it falls back to a plane and is\n\
-reported in ``ContactRegion.status`` and ``CollisionResult.stats``). Subclass of both\n\
+reported in ``ContactPatch.status`` and ``CollisionResult.stats``). Subclass of both\n\
 ``CloudproxError`` and ``RuntimeError``.";
 
 /// A subclass of `CloudproxError` and `builtin`, living in `cloudprox._native`.

@@ -10,7 +10,7 @@
 //! | `cloud.rs` | `PointCloud` |
 //! | `request.rs` | `CollisionRequest`: the query options |
 //! | `collide.rs` | `collide`, `collide_many` |
-//! | `result.rs` | `CollisionResult`, `ContactRegion`, `QueryStats` |
+//! | `result.rs` | `CollisionResult`, `ContactPatch`, `QueryStats` |
 //! | `filter.rs` | sensor-cloud filters: crop box, voxel, outliers, shadow, self |
 //! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
 //! | `mesh.rs` | `Mesh`, `ExactShape`, exact mesh-vs-mesh queries |
@@ -54,7 +54,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     error::register(m)?;
     m.add_class::<cloud::PyPointCloud>()?;
     m.add_class::<result::PyCollisionResult>()?;
-    m.add_class::<result::PyContactRegion>()?;
+    m.add_class::<result::PyContactPatch>()?;
     m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
     m.add_class::<request::PyCollisionRequest>()?;

@@ -440,7 +440,7 @@ pub fn exact_proximity<'py>(
     let pa = pose_from(py, pose_a, "pose_a")?;
     let pb = pose_from(py, pose_b, "pose_b")?;
     let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
-    let inner = run_detached(py, move || Ok(core_exact(&pa, &sa, &pb, &sb)))?;
+    let inner = run_detached(py, move || core_exact(&pa, &sa, &pb, &sb))?;
     Ok(PyProximity { inner })
 }
 
@@ -543,7 +543,7 @@ pub fn exact_proximity_many_py(
     let poses = poses_from(poses_a, "poses_a")?;
     let pb = pose_from(py, pose_b, "pose_b")?;
     let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
-    let inner = run_detached(py, move || Ok(exact_proximity_many(&poses, &sa, &pb, &sb)))?;
+    let inner = run_detached(py, move || exact_proximity_many(&poses, &sa, &pb, &sb))?;
     Ok(PyProximityBatch { inner })
 }
 
@@ -562,7 +562,7 @@ pub fn exact_intersects_many_py<'py>(
     let poses = poses_from(poses_a, "poses_a")?;
     let pb = pose_from(py, pose_b, "pose_b")?;
     let (sa, sb) = (Arc::clone(&a.get().inner), Arc::clone(&b.get().inner));
-    let hits = run_detached(py, move || Ok(exact_intersects_many(&poses, &sa, &pb, &sb)))?;
+    let hits = run_detached(py, move || exact_intersects_many(&poses, &sa, &pb, &sb))?;
     Ok(PyArray1::from_vec(py, hits))
 }
 

@@ -1,4 +1,4 @@
-//! `CollisionResult`, `ContactRegion` and `QueryStats`: the answer of a query,
+//! `CollisionResult`, `ContactPatch` and `QueryStats`: the answer of a query,
 //! as plain data.
 
 use std::sync::Arc;
@@ -7,7 +7,7 @@ use cloudprox::classify::{Separator, SolveStatus, Surface};
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
 use cloudprox::math::{Point3, Vector3};
-use cloudprox::query::{CollisionResult, ContactRegion, QueryCounters, QueryStats};
+use cloudprox::query::{CollisionResult, ContactPatch, QueryCounters, QueryStats};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -55,8 +55,8 @@ pub(crate) fn state_name(py: Python<'_>, s: &str) -> PyResult<&'static str> {
 /// scale and frame (see [`crate::cloud::pose_to_7`]).
 type SeparatorState = (String, Vec<f64>, f64, [f64; 3], f64, [f64; 7]);
 
-/// The pickled form of a `ContactRegion`.
-type RegionState = (
+/// The pickled form of a `ContactPatch`.
+type PatchState = (
     u32,
     Vec<u32>,
     Vec<u32>,
@@ -70,16 +70,9 @@ type RegionState = (
 );
 
 /// The pickled form of a `CollisionResult` (without the clouds it was computed on).
-type ResultState = (
-    f64,
-    String,
-    Vec<f64>,
-    Vec<f64>,
-    Vec<RegionState>,
-    StatsState,
-);
+type ResultState = (f64, String, Vec<f64>, Vec<f64>, Vec<PatchState>, StatsState);
 
-fn region_to_state(r: &ContactRegion) -> RegionState {
+fn patch_to_state(r: &ContactPatch) -> PatchState {
     let sep = &r.separator;
     (
         r.component,
@@ -104,11 +97,11 @@ fn region_to_state(r: &ContactRegion) -> RegionState {
 
 fn surface_from(py: Python<'_>, name: &str) -> PyResult<Surface> {
     Surface::from_name(name).ok_or_else(|| {
-        crate::error::invalid_input(py, format!("unknown surface '{name}' in a pickled region"))
+        crate::error::invalid_input(py, format!("unknown surface '{name}' in a pickled patch"))
     })
 }
 
-fn region_from_state(py: Python<'_>, s: RegionState) -> PyResult<ContactRegion> {
+fn patch_from_state(py: Python<'_>, s: PatchState) -> PyResult<ContactPatch> {
     let (
         component,
         indices_a,
@@ -130,11 +123,11 @@ fn region_from_state(py: Python<'_>, s: RegionState) -> PyResult<ContactRegion> 
         other => {
             return Err(crate::error::invalid_input(
                 py,
-                format!("unknown solve status '{other}' in a pickled region"),
+                format!("unknown solve status '{other}' in a pickled patch"),
             ))
         }
     };
-    Ok(ContactRegion {
+    Ok(ContactPatch {
         component,
         indices_a,
         indices_b,
@@ -168,7 +161,7 @@ stats_class! {
         leaf_pairs: usize,
         /// Connected near regions.
         near_regions: usize,
-        /// Patches classified (``len(result.regions)``).
+        /// Patches classified (``len(result.patches)``).
         patches: usize,
         /// Patches cut in two because their surface put a point beyond the noise's
         /// reach of the other cloud on the wrong side.
@@ -187,7 +180,7 @@ stats_class! {
         /// Patches where the barrier method did not converge and Clarabel was used.
         barrier_fallbacks: usize,
         /// Patches whose solve fell back to the mean-difference plane
-        /// (``ContactRegion.status == "fallback"``).
+        /// (``ContactPatch.status == "fallback"``).
         solver_fallbacks: usize,
         /// Upper bound on the probability that any pruned point is on the wrong
         /// side (pruned points get ``p_i = 0``); below ``prune_epsilon`` per pair.
@@ -196,20 +189,20 @@ stats_class! {
 }
 
 /// One patch of a near region with its own separating surface (world frame).
-#[pyclass(name = "ContactRegion", frozen, module = "cloudprox._native")]
-pub struct PyContactRegion {
-    inner: ContactRegion,
+#[pyclass(name = "ContactPatch", frozen, module = "cloudprox._native")]
+pub struct PyContactPatch {
+    inner: ContactPatch,
 }
 
-impl PyContactRegion {
-    /// Wraps a core region (the robot queries' regions).
-    pub(crate) fn wrap(inner: ContactRegion) -> Self {
+impl PyContactPatch {
+    /// Wraps a core patch (the robot queries' patches).
+    pub(crate) fn wrap(inner: ContactPatch) -> Self {
         Self { inner }
     }
 }
 
 #[pymethods]
-impl PyContactRegion {
+impl PyContactPatch {
     /// Index of the connected near region this patch belongs to.
     #[getter]
     fn component(&self) -> u32 {
@@ -284,25 +277,25 @@ impl PyContactRegion {
     }
 
     /// Pickle support: every field, the separating surface included.
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (RegionState,))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (PatchState,))> {
         Ok((
             slf.getattr("_from_state")?,
-            (region_to_state(&slf.get().inner),),
+            (patch_to_state(&slf.get().inner),),
         ))
     }
 
-    /// Rebuilds a pickled region (see `__reduce__`).
+    /// Rebuilds a pickled patch (see `__reduce__`).
     #[staticmethod]
-    fn _from_state(py: Python<'_>, state: RegionState) -> PyResult<Self> {
+    fn _from_state(py: Python<'_>, state: PatchState) -> PyResult<Self> {
         Ok(Self {
-            inner: region_from_state(py, state)?,
+            inner: patch_from_state(py, state)?,
         })
     }
 
     fn __repr__(&self) -> String {
         let r = &self.inner;
         format!(
-            "ContactRegion(component={}, points=({}, {}), probability={}, separation={}, \
+            "ContactPatch(component={}, points=({}, {}), probability={}, separation={}, \
              surface='{}', status='{}')",
             r.component,
             r.indices_a.len(),
@@ -316,14 +309,14 @@ impl PyContactRegion {
 }
 
 /// The answer of `collide`: `P`, the state, per-point probabilities, the contact
-/// regions and statistics.
+/// patches and statistics.
 #[pyclass(name = "CollisionResult", frozen, module = "cloudprox._native")]
 pub struct PyCollisionResult {
     probability: f64,
     state: &'static str,
     probabilities_a: Vec<f64>,
     probabilities_b: Vec<f64>,
-    regions: Vec<Py<PyContactRegion>>,
+    patches: Vec<Py<PyContactPatch>>,
     stats: QueryStats,
     sides: Option<QueriedSides>,
 }
@@ -342,19 +335,19 @@ pub struct QueriedSides {
 }
 
 impl PyCollisionResult {
-    /// Wraps a core result (creates the region objects once).
+    /// Wraps a core result (creates the patch objects once).
     pub fn new(py: Python<'_>, r: CollisionResult) -> PyResult<Self> {
-        let regions = r
-            .regions
+        let patches = r
+            .patches
             .into_iter()
-            .map(|inner| Py::new(py, PyContactRegion { inner }))
+            .map(|inner| Py::new(py, PyContactPatch { inner }))
             .collect::<PyResult<Vec<_>>>()?;
         Ok(Self {
             probability: r.probability,
             state: r.state.name(),
             probabilities_a: r.probabilities_a,
             probabilities_b: r.probabilities_b,
-            regions,
+            patches,
             stats: r.stats,
             sides: None,
         })
@@ -441,22 +434,22 @@ impl PyCollisionResult {
         show.call(PyTuple::new(py, [slf.clone().into_any(), path])?, options)
     }
 
-    /// Pickle support: `P`, the state, the per-point probabilities, the regions
+    /// Pickle support: `P`, the state, the per-point probabilities, the patches
     /// and the statistics; not the clouds (`points_a` and `points_b` are `None`
     /// once unpickled).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ResultState,))> {
         let me = slf.get();
-        let regions = me
-            .regions
+        let patches = me
+            .patches
             .iter()
-            .map(|r| region_to_state(&r.get().inner))
+            .map(|r| patch_to_state(&r.get().inner))
             .collect();
         let state = (
             me.probability,
             me.state.to_string(),
             me.probabilities_a.clone(),
             me.probabilities_b.clone(),
-            regions,
+            patches,
             PyQueryStats::state_of(&me.stats),
         );
         Ok((slf.getattr("_from_state")?, (state,)))
@@ -465,26 +458,26 @@ impl PyCollisionResult {
     /// Rebuilds a pickled result (see `__reduce__`).
     #[staticmethod]
     fn _from_state(py: Python<'_>, state: ResultState) -> PyResult<Self> {
-        let (probability, state_text, probabilities_a, probabilities_b, regions, stats) = state;
-        let regions = regions
+        let (probability, state_text, probabilities_a, probabilities_b, patches, stats) = state;
+        let patches = patches
             .into_iter()
-            .map(|r| Py::new(py, PyContactRegion::wrap(region_from_state(py, r)?)))
+            .map(|r| Py::new(py, PyContactPatch::wrap(patch_from_state(py, r)?)))
             .collect::<PyResult<Vec<_>>>()?;
         Ok(Self {
             probability,
             state: state_name(py, &state_text)?,
             probabilities_a,
             probabilities_b,
-            regions,
+            patches,
             stats: PyQueryStats::from_state(stats),
             sides: None,
         })
     }
 
-    /// The classified patches (a new list of the same region objects each time).
+    /// The classified patches (a new list of the same patch objects each time).
     #[getter]
-    fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        PyList::new(py, self.regions.iter().map(|r| r.clone_ref(py)))
+    fn patches<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.patches.iter().map(|r| r.clone_ref(py)))
     }
 
     /// Counters and timings of the query (a new `QueryStats` each time).
@@ -495,10 +488,10 @@ impl PyCollisionResult {
 
     fn __repr__(&self) -> String {
         format!(
-            "CollisionResult(probability={}, state='{}', regions={}, points=({}, {}))",
+            "CollisionResult(probability={}, state='{}', patches={}, points=({}, {}))",
             fmt_g(self.probability),
             self.state,
-            self.regions.len(),
+            self.patches.len(),
             self.probabilities_a.len(),
             self.probabilities_b.len()
         )

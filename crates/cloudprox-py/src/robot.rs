@@ -19,7 +19,7 @@ use crate::error::{invalid_input, run_detached, CoreResultExt};
 use crate::filter::PySelfFilter;
 use crate::mesh::PyMesh;
 use crate::request::{request_from, PyCollisionRequest};
-use crate::result::{PyCollisionResult, PyContactRegion};
+use crate::result::{PyCollisionResult, PyContactPatch};
 
 /// The keywords of `collide_robot` that are not request options.
 const ROBOT_KEYWORDS: [&str; 4] = ["request", "mesh_spacing", "broad_phase", "self_collision"];
@@ -502,20 +502,20 @@ impl PyRobotCollisionResult {
         Ok(d)
     }
 
-    /// The contact regions of every queried link, as `(link name, ContactRegion)`.
+    /// The contact patches of every queried link, as `(link name, ContactPatch)`.
     #[getter]
-    fn regions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    fn patches<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let mut out = Vec::new();
         for l in &self.links {
             let l = l.get();
             if let Some(r) = &l.inner.result {
-                for g in &r.regions {
-                    let region = Py::new(py, PyContactRegion::wrap(g.clone()))?;
+                for g in &r.patches {
+                    let patch = Py::new(py, PyContactPatch::wrap(g.clone()))?;
                     out.push(PyTuple::new(
                         py,
                         [
                             l.name.clone().into_pyobject(py)?.into_any(),
-                            region.into_bound(py).into_any(),
+                            patch.into_bound(py).into_any(),
                         ],
                     )?);
                 }

@@ -30,11 +30,11 @@ fn bench_classify(c: &mut Criterion) {
     group.sample_size(20);
     for surface in [Surface::Linear, Surface::Quadric] {
         for solver in [SocpSolver::Barrier, SocpSolver::Clarabel] {
-            let s = ClassifySettings::builder()
-                .surface(surface)
-                .solver(solver)
-                .build()
-                .unwrap();
+            let s = ClassifySettings {
+                surface,
+                solver,
+                ..ClassifySettings::default()
+            };
             for n in [100, 200, 400, 800, 1600] {
                 let (p, cv, l) = patches(n);
                 let id = format!("{}_{}", surface.name(), solver.name());

@@ -28,16 +28,14 @@ fn bench_points(c: &mut Criterion) {
     group.sample_size(20);
     for (name, gap) in GAPS {
         for surface in [Surface::Quadric, Surface::Linear] {
-            let req = CollisionRequest::builder()
-                .model(QueryModel::Points)
-                .classify(
-                    ClassifySettings::builder()
-                        .surface(surface)
-                        .build()
-                        .unwrap(),
-                )
-                .build()
-                .unwrap();
+            let req = CollisionRequest {
+                model: QueryModel::Points,
+                classify: ClassifySettings {
+                    surface,
+                    ..ClassifySettings::default()
+                },
+                ..CollisionRequest::default()
+            };
             let pose = common::pose_at(gap);
             group.bench_function(format!("{name}/{}", surface.name()), |bch| {
                 bch.iter(|| black_box(collide(&Pose::identity(), &a, &pose, &b, &req).unwrap()));
@@ -55,11 +53,11 @@ fn bench_elements(c: &mut Criterion) {
         // Built once per cloud (not part of a query).
         let _ = (a.elements().samples().bvh(), b.elements().samples().bvh());
         for decide_only in [false, true] {
-            let req = CollisionRequest::builder()
-                .model(QueryModel::Elements)
-                .decide_only(decide_only)
-                .build()
-                .unwrap();
+            let req = CollisionRequest {
+                model: QueryModel::Elements,
+                decide_only,
+                ..CollisionRequest::default()
+            };
             for (name, gap) in GAPS {
                 let pose = common::pose_at_noise(gap, sigma);
                 let tag = if decide_only { "/decide_only" } else { "" };

@@ -20,12 +20,12 @@ fn main() -> Result<()> {
             "gap {gap_mm:>5.1} mm: P = {:.4} ({}), {} region(s), {:.2} ms",
             r.probability,
             r.state.name(),
-            r.regions.len(),
+            r.patches.len(),
             r.stats.time_seconds * 1e3
         );
         // The patch where the surfaces come closest (or interpenetrate deepest).
         let deepest = r
-            .regions
+            .patches
             .iter()
             .min_by(|x, y| x.separation.total_cmp(&y.separation));
         if let Some(region) = deepest {

@@ -24,25 +24,23 @@ fn main() {
             .and_then(|v| v.parse().ok())
             .unwrap_or(d)
     };
-    let request = CollisionRequest::builder()
-        .classify(
-            ClassifySettings::builder()
-                .surface(surface)
-                .slack_weight(env("SLACK_WEIGHT", 100.0))
-                .robust_eta(env("ETA", 0.9))
-                .build()
-                .unwrap(),
-        )
-        .region_max_points(env("RMAX", 2000.0) as usize)
-        .near_context(env("CTX", 2.0))
-        .model(
-            std::env::var("MODEL")
-                .ok()
-                .and_then(|m| QueryModel::from_name(&m))
-                .unwrap_or_default(),
-        )
-        .build()
-        .unwrap();
+    let defaults = CollisionRequest::default();
+    let request = CollisionRequest {
+        classify: ClassifySettings {
+            surface,
+            slack_weight: env("SLACK_WEIGHT", defaults.classify.slack_weight),
+            robust_eta: env("ETA", defaults.classify.robust_eta),
+            ..defaults.classify
+        },
+        region_max_points: env("RMAX", defaults.region_max_points as f64) as usize,
+        near_context: env("CTX", defaults.near_context),
+        model: std::env::var("MODEL")
+            .ok()
+            .and_then(|m| QueryModel::from_name(&m))
+            .unwrap_or_default(),
+        ..defaults
+    };
+    request.validate().unwrap();
     let disc = env("DISC", 0.0) > 0.0;
     let make = |p: Vec<Point3>| {
         let c = PointCloud::from_sigma(p, sigma).unwrap();
@@ -76,7 +74,7 @@ fn main() {
             res.stats.counters.patches,
             res.stats.counters.points_classified,
             res.stats.time_seconds * 1e3,
-            res.regions
+            res.patches
                 .iter()
                 .map(|r| r.separation)
                 .fold(f64::INFINITY, f64::min)

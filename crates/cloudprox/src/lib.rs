@@ -73,15 +73,15 @@ pub use math::Real;
 
 /// The names most programs need, in one import.
 pub mod prelude {
-    pub use crate::classify::{ClassifySettings, ClassifySettingsBuilder, Surface};
+    pub use crate::classify::{ClassifySettings, Surface};
     pub use crate::cloud::PointCloud;
     pub use crate::error::{Error, Result};
     pub use crate::math::{Matrix3, Point3, Pose, Vector3};
     pub use crate::probability::{Aggregation, CollisionState, Thresholds};
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
-        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
-        CollisionResult, ContactRegion, MeshSampling, QueryModel, QueryStats,
+        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
+        MeshSampling, QueryModel, QueryStats,
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{

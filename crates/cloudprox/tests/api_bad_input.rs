@@ -44,23 +44,35 @@ fn bad_noise() {
 
 #[test]
 fn bad_requests() {
-    let e = msg(CollisionRequest::builder().thresholds(0.3, 0.6).build());
+    let request = |change: fn(&mut CollisionRequest)| {
+        let mut r = CollisionRequest::default();
+        change(&mut r);
+        msg(r.validate())
+    };
+    let e = request(|r| {
+        r.thresholds = Thresholds {
+            collision: 0.3,
+            free: 0.6,
+        }
+    });
     assert!(
         e.contains("threshold_free") && e.contains("threshold_collision"),
         "{e}"
     );
-    assert!(msg(CollisionRequest::builder().thresholds(0.9, 0.6).build()).contains("threshold"));
-    assert!(msg(CollisionRequest::builder().prune_epsilon(-1.0).build()).contains("prune_epsilon"));
-    assert!(
-        msg(CollisionRequest::builder().prune_epsilon(f64::NAN).build()).contains("prune_epsilon")
-    );
-    assert!(
-        msg(CollisionRequest::builder().region_max_points(2).build()).contains("region_max_points")
-    );
-    assert!(msg(ClassifySettings::builder().slack_weight(0.0).build()).contains("slack_weight"));
-    assert!(msg(ClassifySettings::builder().robust_eta(1.0).build()).contains("robust_eta"));
-    assert!(msg(ClassifySettings::builder().solver_tol(0.0).build()).contains("solver_tol"));
-    assert!(msg(ClassifySettings::builder().solver_max_iter(0).build()).contains("solver_max_iter"));
+    assert!(request(|r| r.thresholds.free = 0.6).contains("threshold"));
+    assert!(request(|r| r.prune_epsilon = -1.0).contains("prune_epsilon"));
+    assert!(request(|r| r.prune_epsilon = f64::NAN).contains("prune_epsilon"));
+    assert!(request(|r| r.region_max_points = 2).contains("region_max_points"));
+    assert!(request(|r| r.near_context = 0.1).contains("near_context"));
+    let settings = |change: fn(&mut ClassifySettings)| {
+        let mut s = ClassifySettings::default();
+        change(&mut s);
+        msg(s.validate())
+    };
+    assert!(settings(|s| s.slack_weight = 0.0).contains("slack_weight"));
+    assert!(settings(|s| s.robust_eta = 1.0).contains("robust_eta"));
+    assert!(settings(|s| s.solver_tol = 0.0).contains("solver_tol"));
+    assert!(settings(|s| s.solver_max_iter = 0).contains("solver_max_iter"));
     // A request assembled by hand is validated by the query too.
     let mut req = CollisionRequest::default();
     req.thresholds.free = 0.7;
@@ -74,6 +86,39 @@ fn bad_requests() {
         &req
     ))
     .contains("threshold"));
+    // So is every other entry point that takes a request or settings.
+    let cube = Mesh::cuboid(0.1, 0.1, 0.1).unwrap();
+    let id = Pose::identity();
+    let sampling = MeshSampling::default();
+    let e = msg(collide_mesh_cloud(&id, &cube, &id, &a, &req, &sampling));
+    assert!(e.contains("threshold"), "{e}");
+    for spacing in [0.0, -1.0, f64::NAN] {
+        let bad = MeshSampling {
+            spacing: Some(spacing),
+            ..sampling
+        };
+        let e = msg(collide_mesh_cloud(
+            &id,
+            &cube,
+            &id,
+            &a,
+            &CollisionRequest::default(),
+            &bad,
+        ));
+        assert!(e.contains("spacing"), "{e}");
+    }
+    let bad = ClassifySettings {
+        robust_eta: 0.2,
+        ..ClassifySettings::default()
+    };
+    let labels = [1.0, 1.0, -1.0, -1.0, -1.0];
+    let e = msg(cloudprox::classify::train(
+        a.points(),
+        a.covariances(),
+        &labels,
+        &bad,
+    ));
+    assert!(e.contains("robust_eta"), "{e}");
 }
 
 #[test]

@@ -66,13 +66,13 @@ fn check(surface: Surface, isotropic: bool, gap: f64, seed: u64) {
 
 fn check_with(surface: Surface, isotropic: bool, gap: f64, seed: u64, solver: SocpSolver) {
     let (pts, covs, labels) = scene(120, gap, seed, isotropic);
-    let settings = ClassifySettings::builder()
-        .solver(solver)
-        .surface(surface)
-        .robust_model(RobustModel::Gaussian)
-        .robust_eta(0.9)
-        .build()
-        .unwrap();
+    let settings = ClassifySettings {
+        solver,
+        surface,
+        robust_model: RobustModel::Gaussian,
+        robust_eta: 0.9,
+        ..ClassifySettings::default()
+    };
     let fit = train(&pts, &covs, &labels, &settings).unwrap();
     assert!(
         matches!(fit.status, SolveStatus::Solved | SolveStatus::AlmostSolved),
@@ -134,10 +134,10 @@ fn a_separable_set_is_separated_with_zero_slack() {
     // Far apart: every constraint holds with xi = 0 and every point is on its side.
     let (pts, covs, labels) = scene(60, 1.0, 9, true);
     for surface in [Surface::Linear, Surface::Quadric] {
-        let s = ClassifySettings::builder()
-            .surface(surface)
-            .build()
-            .unwrap();
+        let s = ClassifySettings {
+            surface,
+            ..ClassifySettings::default()
+        };
         let fit = train(&pts, &covs, &labels, &s).unwrap();
         assert!(fit.slacks.iter().all(|&x| x < 1e-6), "{surface:?}");
         for (x, &c) in pts.iter().zip(&labels) {
@@ -170,12 +170,10 @@ fn barrier_method_agrees_with_clarabel() {
             for isotropic in [true, false] {
                 let seed = 100 + 10 * k as u64 + j as u64;
                 let (pts, covs, labels) = scene(150, gap, seed, isotropic);
-                let s = |solver| {
-                    ClassifySettings::builder()
-                        .surface(surface)
-                        .solver(solver)
-                        .build()
-                        .unwrap()
+                let s = |solver| ClassifySettings {
+                    surface,
+                    solver,
+                    ..ClassifySettings::default()
                 };
                 let fb = train(&pts, &covs, &labels, &s(SocpSolver::Barrier)).unwrap();
                 let fc = train(&pts, &covs, &labels, &s(SocpSolver::Clarabel)).unwrap();

@@ -10,16 +10,14 @@ use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 /// The paper's per-point model (this file's subject; the surface elements,
 /// the default, are tested in `collide_elements.rs`) with `surface`.
 fn request(surface: Surface) -> CollisionRequest {
-    CollisionRequest::builder()
-        .model(QueryModel::Points)
-        .classify(
-            ClassifySettings::builder()
-                .surface(surface)
-                .build()
-                .unwrap(),
-        )
-        .build()
-        .unwrap()
+    CollisionRequest {
+        model: QueryModel::Points,
+        classify: ClassifySettings {
+            surface,
+            ..ClassifySettings::default()
+        },
+        ..CollisionRequest::default()
+    }
 }
 
 /// The query with both clouds' points moved by `t` (B's also by `pb`) and
@@ -103,7 +101,7 @@ fn states_follow_thresholds() {
     let far = collide(&Pose::identity(), &a, &sphere_pose(20.0 * SIGMA), &b, &req).unwrap();
     assert_eq!(far.state, CollisionState::Free);
     assert_eq!(far.probability, 0.0);
-    assert!(far.regions.is_empty(), "{:?}", far.stats);
+    assert!(far.patches.is_empty(), "{:?}", far.stats);
     assert!(far.stats.counters.pruned_bound < 1e-2, "{:?}", far.stats);
 }
 
@@ -145,8 +143,8 @@ fn per_point_probabilities_are_the_gaussian_cdf_of_the_plane_distance() {
         &request(Surface::Linear),
     )
     .unwrap();
-    assert!(!r.regions.is_empty());
-    for reg in &r.regions {
+    assert!(!r.patches.is_empty());
+    for reg in &r.patches {
         // The plane in its training frame: n . x + d = 0 with n = w / scale.
         let sep = &reg.separator;
         let n = Vector3::new(sep.w[0], sep.w[1], sep.w[2]) / sep.scale;
@@ -185,8 +183,8 @@ fn moving_both_clouds_rigidly_changes_nothing() {
             .map(|(x, y)| (x - y).abs());
         let dmax = dp.fold(0.0, f64::max);
         assert!(dmax < 1e-4, "gap {gap}: per-point difference {dmax}");
-        assert_eq!(r0.regions.len(), r1.regions.len());
-        for (g0, g1) in r0.regions.iter().zip(&r1.regions) {
+        assert_eq!(r0.patches.len(), r1.patches.len());
+        for (g0, g1) in r0.patches.iter().zip(&r1.patches) {
             assert!(((t * g0.point) - g1.point).norm() < 1e-6);
             assert!(((t * g0.normal) - g1.normal).norm() < 1e-5);
             assert!((g0.separation - g1.separation).abs() < 1e-6);
@@ -202,18 +200,16 @@ fn the_classifier_is_equivariant_under_rotations_of_the_data() {
     let (a, b) = spheres(300);
     let t = Pose::new(Vector3::new(0.3, -1.2, 0.7), Vector3::new(0.4, -0.9, 2.1));
     for surface in [Surface::Quadric, Surface::Linear] {
-        let req = CollisionRequest::builder()
-            .model(QueryModel::Points)
-            .classify(
-                ClassifySettings::builder()
-                    .surface(surface)
-                    .build()
-                    .unwrap(),
-            )
-            .use_hierarchy(false)
-            .region_max_points(10_000)
-            .build()
-            .unwrap();
+        let req = CollisionRequest {
+            model: QueryModel::Points,
+            classify: ClassifySettings {
+                surface,
+                ..ClassifySettings::default()
+            },
+            use_hierarchy: false,
+            region_max_points: 10_000,
+            ..CollisionRequest::default()
+        };
         for gap in [-2.0, 1.0, 3.0] {
             let pb = sphere_pose(gap * SIGMA);
             let r0 = collide(&Pose::identity(), &a, &pb, &b, &req).unwrap();
@@ -243,7 +239,7 @@ fn swapping_the_clouds_gives_the_same_probability() {
             .zip(&ba.probabilities_b)
             .map(|(x, y)| (x - y).abs());
         assert!(d.fold(0.0, f64::max) < 1e-5);
-        for (ra, rb) in ab.regions.iter().zip(&ba.regions) {
+        for (ra, rb) in ab.patches.iter().zip(&ba.patches) {
             assert!(
                 (ra.normal + rb.normal).norm() < 1e-5,
                 "normals point from A to B"
@@ -301,7 +297,7 @@ fn separation_estimate_tracks_the_exact_gap() {
     for gap in [-0.005, 0.0, 0.005, 0.01, 0.02] {
         let pose_b = Pose::translation(0.0, 0.0, 0.06 + gap);
         let r = collide(&Pose::identity(), &a, &pose_b, &b, &req).unwrap();
-        if r.regions.is_empty() {
+        if r.patches.is_empty() {
             // Beyond the noise's reach there is no near region to measure in.
             assert!(
                 gap > 6.0 * SIGMA && r.state == CollisionState::Free,
@@ -310,13 +306,141 @@ fn separation_estimate_tracks_the_exact_gap() {
             continue;
         }
         let sep = r
-            .regions
+            .patches
             .iter()
             .map(|g| g.separation)
             .fold(f64::INFINITY, f64::min);
         assert!(
             (sep - gap).abs() < 2.0 * SIGMA,
             "exact gap {gap}: estimated {sep}"
+        );
+    }
+}
+
+/// Eq. 3 with each point's own full covariance: `p_i = Phi(-y_i f(x_i) /
+/// sqrt(g^T Sigma_i g))`, on plates noisier across the gap than along it (A
+/// anisotropic, B isotropic). Moved from the Python suite.
+#[test]
+fn per_point_probabilities_use_each_points_full_covariance() {
+    let grid: Vec<Point3> = (0..144)
+        .map(|k| Point3::new(0.01 * f64::from(k / 12), 0.01 * f64::from(k % 12), 0.0))
+        .collect();
+    let cov = Matrix3::from_diagonal(&Vector3::new(4e-6, 1e-6, 9e-6));
+    let a = PointCloud::from_covariances(
+        cloudprox::sample::add_noise(&grid, 1e-3, 1),
+        vec![cov; grid.len()],
+    )
+    .unwrap();
+    let b = PointCloud::from_sigma(cloudprox::sample::add_noise(&grid, 1e-3, 2), 0.002).unwrap();
+    let pose_b = Pose::translation(0.0, 0.0, 0.006);
+    let r = collide(
+        &Pose::identity(),
+        &a,
+        &pose_b,
+        &b,
+        &request(Surface::Linear),
+    )
+    .unwrap();
+    assert!(!r.patches.is_empty());
+    let mut checked = 0;
+    for patch in &r.patches {
+        for (indices, side, probabilities, label) in [
+            (&patch.indices_a, 0, &r.probabilities_a, 1.0),
+            (&patch.indices_b, 1, &r.probabilities_b, -1.0),
+        ] {
+            for &i in indices {
+                let i = i as usize;
+                let (x, sigma) = if side == 0 {
+                    (a.points()[i], cov)
+                } else {
+                    (pose_b * b.points()[i], Matrix3::identity() * 4e-6)
+                };
+                let (f, g) = patch.separator.value_and_gradient(&x);
+                let std = (g.transpose() * sigma * g)[(0, 0)].sqrt();
+                let want = normal_cdf(-label * f / std);
+                assert!(
+                    (probabilities[i] - want).abs() <= 1e-9 * want.max(1e-6),
+                    "side {side} point {i}: {} vs {want}",
+                    probabilities[i]
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 0);
+}
+
+/// Without noise the state is exact: apart is `P = 0`, overlapping `P = 1`.
+/// Moved from the Python suite.
+#[test]
+fn clouds_without_noise_are_decided_exactly() {
+    let pts = cloudprox::sample::sphere(&Point3::origin(), 0.1, 300);
+    let a = PointCloud::from_sigma(pts.clone(), 0.0).unwrap();
+    let b = PointCloud::from_sigma(pts, 0.0).unwrap();
+    let req = CollisionRequest::default();
+    let far = collide(
+        &Pose::identity(),
+        &a,
+        &Pose::translation(0.25, 0.0, 0.0),
+        &b,
+        &req,
+    )
+    .unwrap();
+    assert_eq!((far.probability, far.state), (0.0, CollisionState::Free));
+    let deep = collide(
+        &Pose::identity(),
+        &a,
+        &Pose::translation(0.1, 0.0, 0.0),
+        &b,
+        &req,
+    )
+    .unwrap();
+    assert_eq!(
+        (deep.probability, deep.state),
+        (1.0, CollisionState::Collision)
+    );
+}
+
+/// Two 10 cm spheres overlapping by half (1 mm noise): the neighbourhood
+/// means of the `surface` aggregation cancel at the crossing, yet every
+/// aggregation of the points model and the elements model read a collision.
+/// Moved from the Python suite.
+#[test]
+fn deep_interpenetration_is_a_collision_for_every_aggregation_and_model() {
+    let pts = cloudprox::sample::sphere(&Point3::origin(), 0.1, 2000);
+    let noisy = |seed| {
+        PointCloud::from_sigma(cloudprox::sample::add_noise(&pts, 0.001, seed), 0.001).unwrap()
+    };
+    let (a, b) = (noisy(1), noisy(2));
+    let points = |aggregation| CollisionRequest {
+        model: QueryModel::Points,
+        aggregation,
+        ..CollisionRequest::default()
+    };
+    let elements = CollisionRequest {
+        model: QueryModel::Elements,
+        ..CollisionRequest::default()
+    };
+    for req in [
+        points(Aggregation::Max),
+        points(Aggregation::Surface),
+        elements,
+    ] {
+        let r = collide(
+            &Pose::identity(),
+            &a,
+            &Pose::translation(0.1, 0.0, 0.0),
+            &b,
+            &req,
+        )
+        .unwrap();
+        assert_eq!(
+            r.state,
+            CollisionState::Collision,
+            "{:?} {:?}: P = {}",
+            req.model,
+            req.aggregation,
+            r.probability
         );
     }
 }

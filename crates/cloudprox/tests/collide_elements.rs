@@ -10,10 +10,10 @@ use cloudprox::sample::{add_noise, NormalRng};
 use common::{sphere_pose, spheres, SIGMA};
 
 fn elements() -> CollisionRequest {
-    CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .build()
-        .unwrap()
+    CollisionRequest {
+        model: QueryModel::Elements,
+        ..CollisionRequest::default()
+    }
 }
 
 /// A slab: two noisy square faces of `k x k` points at spacing `h`, the face
@@ -168,16 +168,16 @@ fn rigid_motion_and_swapping_change_nothing() {
 #[test]
 fn hierarchy_agrees_with_brute_force() {
     let (a, b) = spheres(1500);
-    let brute = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .use_hierarchy(false)
-        .build()
-        .unwrap();
+    let brute = CollisionRequest {
+        model: QueryModel::Elements,
+        use_hierarchy: false,
+        ..CollisionRequest::default()
+    };
     for gap in [-2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0] {
         let pb = sphere_pose(gap * SIGMA);
         let fast = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
         let slow = collide(&Pose::identity(), &a, &pb, &b, &brute).unwrap();
-        if fast.regions.len() <= 1 && slow.regions.len() <= 1 {
+        if fast.patches.len() <= 1 && slow.patches.len() <= 1 {
             assert!(
                 (fast.probability - slow.probability).abs() < 1e-6,
                 "gap {gap}: {} vs {}",
@@ -194,12 +194,15 @@ fn hierarchy_agrees_with_brute_force() {
 fn decide_only_gives_the_full_querys_state() {
     let (a, b) = spheres(3000);
     for model in [QueryModel::Elements, QueryModel::Points] {
-        let full = CollisionRequest::builder().model(model).build().unwrap();
-        let quick = CollisionRequest::builder()
-            .model(model)
-            .decide_only(true)
-            .build()
-            .unwrap();
+        let full = CollisionRequest {
+            model,
+            ..CollisionRequest::default()
+        };
+        let quick = CollisionRequest {
+            model,
+            decide_only: true,
+            ..CollisionRequest::default()
+        };
         let mut crossings = 0;
         for gap in [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0, 8.0, 20.0] {
             let pb = sphere_pose(gap * SIGMA);
@@ -224,16 +227,16 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     // cross along a ring, which the hierarchies find before any near set; a
     // sigma apart and beyond nothing crosses, and the query goes on as before.
     let (a, b) = spheres(10000);
-    let quick = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .build()
-        .unwrap();
+    let quick = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        ..CollisionRequest::default()
+    };
     for gap in [-6.0, -3.0, -2.0] {
         let q = collide(&Pose::identity(), &a, &sphere_pose(gap * SIGMA), &b, &quick).unwrap();
         assert_eq!(q.stats.counters.surface_crossings, 1, "gap {gap}");
         assert_eq!(q.state, CollisionState::Collision, "gap {gap}");
-        assert!(q.regions.is_empty() && q.stats.counters.points_classified == 0);
+        assert!(q.patches.is_empty() && q.stats.counters.points_classified == 0);
         // The crossing's bound at the noise's reach: 1 - 2 Phi(-z).
         let z = -normal_quantile(0.5 * quick.prune_epsilon);
         assert!((q.probability - (1.0 - 2.0 * normal_cdf(-z))).abs() < 1e-12);
@@ -256,12 +259,15 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     assert_eq!(r.state, CollisionState::Collision);
     // A collision threshold above the reach's confidence asks more of the
     // crossing: both probes then read beyond the threshold's quantile.
-    let strict = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .thresholds(1.0 - 1e-9, 0.1)
-        .build()
-        .unwrap();
+    let strict = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        thresholds: Thresholds {
+            collision: 1.0 - 1e-9,
+            free: 0.1,
+        },
+        ..CollisionRequest::default()
+    };
     let q = collide(
         &Pose::identity(),
         &a,
@@ -281,11 +287,11 @@ fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
     let sigma = 0.0005;
     let a = slab(30, 0.004, (0.2, 0.0), -0.05, sigma, 1);
     let tilted_back = slab(30, 0.004, (0.0, 0.0), 0.05, sigma, 2);
-    let quick = CollisionRequest::builder()
-        .model(QueryModel::Elements)
-        .decide_only(true)
-        .build()
-        .unwrap();
+    let quick = CollisionRequest {
+        model: QueryModel::Elements,
+        decide_only: true,
+        ..CollisionRequest::default()
+    };
     let q = collide_at_height(&a, &tilted_back, 0.0, &quick);
     assert_eq!(q.stats.counters.surface_crossings, 1);
     assert_eq!(q.state, CollisionState::Collision);
@@ -301,8 +307,8 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     let (a, b) = spheres(3000);
     let pb = sphere_pose(SIGMA);
     let r = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
-    assert_eq!(r.regions.len(), 1);
-    let region = &r.regions[0];
+    assert_eq!(r.patches.len(), 1);
+    let region = &r.patches[0];
     assert!(!region.indices_a.is_empty() && !region.indices_b.is_empty());
     for &i in &region.indices_a {
         let x = a.points()[i as usize];
@@ -320,7 +326,17 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     }
     // The region holds tens of samples, not thousands of points.
     assert!(r.stats.counters.points_classified < 400, "{:?}", r.stats);
-    let _ = normal_cdf(0.0);
+    // Every point of the patch's elements is reported, none outside it.
+    let inside: std::collections::HashSet<u32> = region.indices_a.iter().copied().collect();
+    for (i, &p) in r.probabilities_a.iter().enumerate() {
+        if !inside.contains(&(i as u32)) {
+            assert_eq!(p, 0.0, "point {i} outside the patch");
+        }
+    }
+    assert!(region
+        .indices_a
+        .iter()
+        .any(|&i| r.probabilities_a[i as usize] > 0.0));
 }
 
 #[test]
@@ -347,10 +363,10 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
     // noise's reach of the fitted surfaces: the element hulls (or, failing
     // them, each patch's facing pairs) decide the pair free.
     let (a, b) = spheres(3000);
-    let points = CollisionRequest::builder()
-        .model(QueryModel::Points)
-        .build()
-        .unwrap();
+    let points = CollisionRequest {
+        model: QueryModel::Points,
+        ..CollisionRequest::default()
+    };
     let mut pruned = 0;
     for gap in [3.0, 4.0, 5.0, 6.0, 7.0] {
         let pose = sphere_pose(gap * SIGMA);
@@ -363,7 +379,7 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
             continue;
         }
         pruned += 1;
-        assert!(r.regions.is_empty(), "gap {gap}");
+        assert!(r.patches.is_empty(), "gap {gap}");
         assert_eq!(r.probability, 0.0);
         assert_eq!(r.state, CollisionState::Free);
         assert!(r
@@ -379,7 +395,7 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
         "{:?}",
         near.stats
     );
-    assert!(!near.regions.is_empty());
+    assert!(!near.patches.is_empty());
 }
 
 /// Two noisy spheres of `na`, `nb` points (radii `ra`, `rb`, noise `sigma`,
@@ -460,11 +476,7 @@ proptest! {
     fn element_hierarchy_agrees_with_brute_force(
         (a, b, pose_b, gap) in sphere_scenes(300..1500, -3.0..14.0),
     ) {
-        let brute = CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .use_hierarchy(false)
-            .build()
-            .unwrap();
+        let brute = CollisionRequest { model: QueryModel::Elements, use_hierarchy: false, ..CollisionRequest::default() };
         let h = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose_b, &b, &brute).unwrap();
         let (ph, pb) = (h.probability, bf.probability);
@@ -485,11 +497,7 @@ proptest! {
     fn decide_only_agrees_with_the_full_query(
         (a, b, pose_b, gap) in sphere_scenes(300..3000, -6.0..6.0),
     ) {
-        let quick = CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .decide_only(true)
-            .build()
-            .unwrap();
+        let quick = CollisionRequest { model: QueryModel::Elements, decide_only: true, ..CollisionRequest::default() };
         let r = collide(&Pose::identity(), &a, &pose_b, &b, &elements()).unwrap();
         let q = collide(&Pose::identity(), &a, &pose_b, &b, &quick).unwrap();
         prop_assert_eq!(

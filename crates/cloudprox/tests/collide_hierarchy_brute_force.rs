@@ -13,18 +13,16 @@ use proptest::prelude::*;
 const SIGMA: f64 = 0.003;
 
 fn req(hierarchy: bool, surface: Surface, model: QueryModel) -> CollisionRequest {
-    CollisionRequest::builder()
-        .model(model)
-        .classify(
-            ClassifySettings::builder()
-                .surface(surface)
-                .build()
-                .unwrap(),
-        )
-        .use_hierarchy(hierarchy)
-        .region_max_points(100_000)
-        .build()
-        .unwrap()
+    CollisionRequest {
+        model,
+        classify: ClassifySettings {
+            surface,
+            ..ClassifySettings::default()
+        },
+        use_hierarchy: hierarchy,
+        region_max_points: 100_000,
+        ..CollisionRequest::default()
+    }
 }
 
 /// Two noisy spheres of radii `ra`, `rb` whose exact surfaces are `gap_sigmas`

@@ -11,8 +11,10 @@ use cloudprox::prelude::*;
 use common::{sphere_pose, spheres, SIGMA};
 
 fn requests() -> [CollisionRequest; 2] {
-    [QueryModel::Points, QueryModel::Elements]
-        .map(|model| CollisionRequest::builder().model(model).build().unwrap())
+    [QueryModel::Points, QueryModel::Elements].map(|model| CollisionRequest {
+        model,
+        ..CollisionRequest::default()
+    })
 }
 
 /// Poses of B from well inside A to beyond the noise's reach.

@@ -46,7 +46,7 @@ fn a_cube_meets_a_wall_at_the_gap_over_the_approach_cosine() {
     assert!((t - 0.55 / 0.6).abs() < 1e-7, "{t}");
     // The pose reached is at the target, as exact_proximity measures it.
     let p = Pose::translation(0.6 * t, 0.8 * t, 0.0);
-    assert!((exact_proximity(&p, &a, &pb, &b).distance - 0.25).abs() < 1e-7);
+    assert!((exact_proximity(&p, &a, &pb, &b).unwrap().distance - 0.25).abs() < 1e-7);
     // A rotated start: the cube turned 45 degrees about z reaches 0.1 * sqrt(2)
     // further along x.
     let turned = Pose::from_parts(
@@ -70,7 +70,7 @@ fn a_negative_target_is_a_penetration_depth() {
     let t = toi(&o, &a, d, &pb, &b, -0.05).unwrap();
     assert!((t - 0.85 / 0.6).abs() < 1e-8, "{t}");
     let p = Pose::translation(0.6 * t, 0.8 * t, 0.0);
-    let s = exact_proximity(&p, &a, &pb, &b).signed_distance();
+    let s = exact_proximity(&p, &a, &pb, &b).unwrap().signed_distance();
     assert!((s + 0.05).abs() < 1e-8, "{s}");
     // Already 0.02 deep, a 0.05 target is 0.03 further.
     let t = toi(&at(0.82, 0.0, 0.0), &a, Vector3::x(), &pb, &b, -0.05).unwrap();

@@ -51,7 +51,7 @@ fn a_link_pushed_into_a_wall_collides_and_the_rest_is_free() {
     }
     // Regions come with the link they belong to, in the world frame, at the wall.
     let link3 = hit.links.iter().find(|e| e.link == 3).unwrap();
-    let regions = &link3.result.as_ref().unwrap().regions;
+    let regions = &link3.result.as_ref().unwrap().patches;
     assert!(!regions.is_empty());
     assert!(regions.iter().all(|g| (g.point.x - 0.40).abs() < 0.03));
     assert!(hit.self_collisions.is_empty());
@@ -83,7 +83,10 @@ fn broad_phase_changes_the_cost_not_the_answer() {
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 3);
     for model in [QueryModel::Elements, QueryModel::Points] {
         let with = RobotRequest {
-            collide: CollisionRequest::builder().model(model).build().unwrap(),
+            collide: CollisionRequest {
+                model,
+                ..CollisionRequest::default()
+            },
             ..RobotRequest::default()
         };
         let without = RobotRequest {
@@ -122,10 +125,10 @@ fn the_elements_model_reads_contact_and_freedom_at_a_wall() {
     let robot = arm();
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 9);
     let req = RobotRequest {
-        collide: CollisionRequest::builder()
-            .model(QueryModel::Elements)
-            .build()
-            .unwrap(),
+        collide: CollisionRequest {
+            model: QueryModel::Elements,
+            ..CollisionRequest::default()
+        },
         ..RobotRequest::default()
     };
     let hit = collide_robot(
@@ -289,6 +292,72 @@ fn check_motion_finds_a_collision_between_two_free_waypoints() {
     let m = check_motion(&robot, &q0, &q1, &Pose::identity(), &away, &req).unwrap();
     assert!(m.safe && m.first_unsafe.is_none());
     assert_eq!(m.states_checked, m.states_total);
+}
+
+/// The smallest exact distance (0 when touching) of any link to `post` (at
+/// `post_pose`) over the motion `q0 -> q1`, at 1201 states.
+fn exact_clearance_along(
+    robot: &cloudprox::robot::Robot,
+    q0: &[f64; 4],
+    q1: &[f64; 4],
+    post: &ExactShape,
+    post_pose: &Pose,
+) -> f64 {
+    let mut best = f64::INFINITY;
+    for i in 0..=1200 {
+        let s = f64::from(i) / 1200.0;
+        let q: Vec<f64> = q0.iter().zip(q1).map(|(a, b)| a + s * (b - a)).collect();
+        let poses = robot.link_poses(&q, &Pose::identity()).unwrap();
+        for (link, pose) in robot.links().iter().zip(&poses) {
+            if let Some(g) = &link.geometry {
+                let d = exact_proximity(pose, &g.exact, post_pose, post).unwrap();
+                best = best.min(if d.intersecting { 0.0 } else { d.distance });
+            }
+        }
+    }
+    best
+}
+
+/// Link 2 (its underside at z = 0.28 when j2 = 0) sweeps over a post whose top
+/// lies `gap` sigma below it: the exact link grazes the exact post only between
+/// the motion's ends, both far from it. A motion that touches is never passed
+/// as safe, and one clear by more than 5 sigma is. Moved from the Python suite.
+#[test]
+fn check_motion_misses_no_grazing_contact() {
+    let robot = arm();
+    let half = Vector3::new(0.01, 0.01, 0.05);
+    let (q0, q1) = ([-0.6, 0.0, 0.0, 0.0], [0.6, 0.0, 0.0, 0.0]);
+    for gap in [-1.0, 0.0, 1.0, 6.0, 10.0] {
+        let centre = Point3::new(0.2, 0.0, 0.28 - gap * SIGMA - half.z);
+        let pts = box_surface(&centre, &half, 0.004);
+        let cloud =
+            PointCloud::from_sigma(cloudprox::sample::add_noise(&pts, SIGMA, 3), SIGMA).unwrap();
+        let post = ExactShape::new(&[Mesh::cuboid(half.x, half.y, half.z).unwrap()]).unwrap();
+        let post_pose = Pose::translation(centre.x, centre.y, centre.z);
+        let clearance = exact_clearance_along(&robot, &q0, &q1, &post, &post_pose);
+        assert!(
+            (clearance - gap.max(0.0) * SIGMA).abs() < 0.2 * SIGMA,
+            "gap {gap} sigma: exact clearance {clearance}"
+        );
+        let m = check_motion(
+            &robot,
+            &q0,
+            &q1,
+            &Pose::identity(),
+            &cloud,
+            &MotionRequest::default(),
+        )
+        .unwrap();
+        if clearance == 0.0 {
+            assert!(
+                !m.safe && m.first_unsafe.is_some(),
+                "gap {gap} sigma: {m:?}"
+            );
+        }
+        if clearance > 5.0 * SIGMA {
+            assert!(m.safe, "gap {gap} sigma: {m:?}");
+        }
+    }
 }
 
 #[test]

@@ -118,17 +118,17 @@ fn box_pairs_have_their_closed_form_distance_and_depth() {
     let a = shape(&[cube(0.1)]);
     let b = shape(&[Mesh::cuboid(0.2, 0.05, 0.1).unwrap()]);
     // Face to face along x: gap = 0.5 - 0.1 - 0.2.
-    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.5, 0.0, 0.0), &b);
+    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.5, 0.0, 0.0), &b).unwrap();
     assert!(!r.intersecting && (r.distance - 0.2).abs() < 1e-9, "{r:?}");
     assert!((r.signed_distance() - 0.2).abs() < 1e-9);
     // Edge to edge: offsets beyond contact of 0.2 in x and 0.1 in y.
-    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.5, 0.25, 0.0), &b);
+    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.5, 0.25, 0.0), &b).unwrap();
     assert!(
         (r.distance - (0.2f64.powi(2) + 0.1f64.powi(2)).sqrt()).abs() < 1e-9,
         "{r:?}"
     );
     // Overlapping by 0.03 along x (the shallowest axis).
-    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.27, 0.0, 0.0), &b);
+    let r = exact_proximity(&at(0.0, 0.0, 0.0), &a, &at(0.27, 0.0, 0.0), &b).unwrap();
     assert!(r.intersecting && r.distance == 0.0);
     assert!((r.signed_distance() + 0.03).abs() < 1e-7, "{r:?}");
 }
@@ -153,9 +153,9 @@ fn exact_answers_are_invariant_under_rigid_motion_and_swapping() {
     for z in [-0.3, -0.05, 0.0, 0.01, 0.05, 0.2] {
         let pa = Pose::from_parts(Translation3::new(0.05, -0.02, 0.15 + z), tilt);
         let pb = Pose::identity();
-        let r = exact_proximity(&pa, &a, &pb, &b);
-        let moved = exact_proximity(&(motion * pa), &a, &(motion * pb), &b);
-        let swapped = exact_proximity(&pb, &b, &pa, &a);
+        let r = exact_proximity(&pa, &a, &pb, &b).unwrap();
+        let moved = exact_proximity(&(motion * pa), &a, &(motion * pb), &b).unwrap();
+        let swapped = exact_proximity(&pb, &b, &pa, &a).unwrap();
         for o in [moved, swapped] {
             assert_eq!(o.intersecting, r.intersecting, "z={z}");
             assert!(
@@ -177,18 +177,18 @@ fn non_convex_parts_use_the_triangle_mesh_and_detect_containment() {
     let as_parts = shape(&[cube(0.1), cube(0.1).transformed(&at(0.5, 0.0, 0.0))]);
     let probe = shape(&[cube(0.02)]);
     for (x, y) in [(0.25, 0.0), (0.25, 0.3), (0.0, 0.2), (0.6, -0.2)] {
-        let m = exact_proximity(&Pose::identity(), &as_mesh, &at(x, y, 0.0), &probe);
-        let p = exact_proximity(&Pose::identity(), &as_parts, &at(x, y, 0.0), &probe);
+        let m = exact_proximity(&Pose::identity(), &as_mesh, &at(x, y, 0.0), &probe).unwrap();
+        let p = exact_proximity(&Pose::identity(), &as_parts, &at(x, y, 0.0), &probe).unwrap();
         assert!(
             !m.intersecting && (m.distance - p.distance).abs() < 1e-9,
             "{m:?} {p:?}"
         );
     }
     // The probe entirely inside one cube: no surface crosses, yet it intersects.
-    let inside = exact_proximity(&Pose::identity(), &as_mesh, &at(0.5, 0.0, 0.0), &probe);
+    let inside = exact_proximity(&Pose::identity(), &as_mesh, &at(0.5, 0.0, 0.0), &probe).unwrap();
     assert!(inside.intersecting && inside.penetration_depth.is_none());
     assert!(inside.signed_distance().is_nan());
-    let inside = exact_proximity(&Pose::identity(), &as_parts, &at(0.5, 0.0, 0.0), &probe);
+    let inside = exact_proximity(&Pose::identity(), &as_parts, &at(0.5, 0.0, 0.0), &probe).unwrap();
     assert!(
         inside.intersecting && (inside.signed_distance() + 0.12).abs() < 1e-6,
         "{inside:?}"
@@ -205,11 +205,11 @@ fn surfaces_intersect_only_where_triangles_cross() {
     ));
     // Inside the big cube: a solid would contain the probe; as surfaces the
     // probe's face at x = 0.04 is 0.06 from the cube's at x = 0.1.
-    let inside = exact_proximity(&Pose::identity(), &big, &at(0.02, 0.0, 0.0), &probe);
+    let inside = exact_proximity(&Pose::identity(), &big, &at(0.02, 0.0, 0.0), &probe).unwrap();
     assert!(!inside.intersecting, "{inside:?}");
     assert!((inside.distance - 0.06).abs() < 1e-9, "{inside:?}");
     // Across a face: the triangles cross.
-    let across = exact_proximity(&Pose::identity(), &big, &at(0.1, 0.0, 0.0), &probe);
+    let across = exact_proximity(&Pose::identity(), &big, &at(0.1, 0.0, 0.0), &probe).unwrap();
     assert!(across.intersecting && across.penetration_depth.is_none());
     // The same cubes as solids: contained, so intersecting.
     let solid = exact_proximity(
@@ -217,7 +217,8 @@ fn surfaces_intersect_only_where_triangles_cross() {
         &shape(&[cube(0.1)]),
         &at(0.02, 0.0, 0.0),
         &shape(&[cube(0.02)]),
-    );
+    )
+    .unwrap();
     assert!(solid.intersecting);
 }
 
@@ -228,9 +229,9 @@ fn many_poses_equal_a_loop() {
     let poses: Vec<Pose> = (0..40)
         .map(|i| at(0.0, 0.0, 0.1 + 0.01 * i as f64))
         .collect();
-    let many = exact_proximity_many(&poses, &a, &Pose::identity(), &b);
+    let many = exact_proximity_many(&poses, &a, &Pose::identity(), &b).unwrap();
     for (p, r) in poses.iter().zip(&many) {
-        assert_eq!(*r, exact_proximity(p, &a, &Pose::identity(), &b));
+        assert_eq!(*r, exact_proximity(p, &a, &Pose::identity(), &b).unwrap());
     }
     // Cube bottom at z - 0.1 over the cylinder top at 0.1: gap z - 0.2.
     for (i, r) in many.iter().enumerate() {
@@ -254,31 +255,55 @@ fn the_intersection_only_query_agrees_with_the_full_one() {
         .map(|i| at(-0.1 + 0.01 * f64::from(i), 0.0, 0.0))
         .collect();
     for target in [&solids, &surfaces] {
-        let fast = exact_intersects_many(&poses, &probe, &Pose::identity(), target);
+        let fast = exact_intersects_many(&poses, &probe, &Pose::identity(), target).unwrap();
         for (p, hit) in poses.iter().zip(&fast) {
-            let full = exact_proximity(p, &probe, &Pose::identity(), target);
+            let full = exact_proximity(p, &probe, &Pose::identity(), target).unwrap();
             assert_eq!(*hit, full.intersecting, "{p:?}");
-            assert_eq!(*hit, exact_intersects(p, &probe, &Pose::identity(), target));
+            assert_eq!(
+                *hit,
+                exact_intersects(p, &probe, &Pose::identity(), target).unwrap()
+            );
         }
     }
     // Inside the first cube: the solid holds the probe, the surface does not.
-    assert!(exact_intersects(
-        &at(0.0, 0.0, 0.0),
-        &probe,
-        &Pose::identity(),
-        &solids
-    ));
-    assert!(!exact_intersects(
-        &at(0.0, 0.0, 0.0),
-        &probe,
-        &Pose::identity(),
-        &surfaces
-    ));
+    assert!(exact_intersects(&at(0.0, 0.0, 0.0), &probe, &Pose::identity(), &solids).unwrap());
+    assert!(!exact_intersects(&at(0.0, 0.0, 0.0), &probe, &Pose::identity(), &surfaces).unwrap());
     // Across the face at x = 0.1.
-    assert!(exact_intersects(
-        &at(0.1, 0.0, 0.0),
-        &probe,
-        &Pose::identity(),
-        &surfaces
-    ));
+    assert!(exact_intersects(&at(0.1, 0.0, 0.0), &probe, &Pose::identity(), &surfaces).unwrap());
+}
+
+#[test]
+fn bad_poses_are_refused_with_the_pose_named() {
+    use cloudprox::query::exact::{exact_intersects, exact_intersects_many};
+    let a = shape(&[cube(0.1)]);
+    let b = shape(&[cube(0.1)]);
+    let id = Pose::identity();
+    let nan = Pose::translation(f64::NAN, 0.0, 0.0);
+    let far = Pose::translation(0.0, 1e12, 0.0);
+    let scaled = Pose::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0)),
+    );
+    let message = |e: Error| match e {
+        Error::InvalidInput(m) => m,
+        other => panic!("not an invalid input: {other}"),
+    };
+    let m = message(exact_proximity(&nan, &a, &id, &b).unwrap_err());
+    assert!(m.contains("pose_a") && m.contains("translation"), "{m}");
+    let m = message(exact_proximity(&id, &a, &far, &b).unwrap_err());
+    assert!(m.contains("pose_b") && m.contains("translation"), "{m}");
+    let m = message(exact_intersects(&scaled, &a, &id, &b).unwrap_err());
+    assert!(m.contains("pose_a") && m.contains("rotation"), "{m}");
+    let m = message(exact_intersects(&id, &a, &nan, &b).unwrap_err());
+    assert!(m.contains("pose_b"), "{m}");
+    // The many forms name the first bad pose by its index.
+    let poses = [id, at(0.5, 0.0, 0.0), nan, far];
+    let m = message(exact_proximity_many(&poses, &a, &id, &b).unwrap_err());
+    assert!(m.contains("poses_a[2]"), "{m}");
+    let m = message(exact_intersects_many(&poses, &a, &id, &b).unwrap_err());
+    assert!(m.contains("poses_a[2]"), "{m}");
+    let m = message(exact_intersects_many(&poses[..2], &a, &scaled, &b).unwrap_err());
+    assert!(m.contains("pose_b") && m.contains("rotation"), "{m}");
+    // Good poses still answer.
+    assert!(exact_intersects_many(&poses[..2], &a, &id, &b).unwrap() == [true, false]);
 }

@@ -33,6 +33,6 @@ mod surface;
 mod working_set;
 
 pub use separator::Separator;
-pub use settings::{ClassifySettings, ClassifySettingsBuilder, SocpSolver};
+pub use settings::{ClassifySettings, SocpSolver};
 pub use solve::{train, Classification, SolveStatus};
 pub use surface::Surface;

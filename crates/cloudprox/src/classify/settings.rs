@@ -1,4 +1,5 @@
-//! Settings of the robust classifier, with a validating builder.
+//! Settings of the robust classifier: public fields, [`Default`] and
+//! [`ClassifySettings::validate`].
 
 use crate::classify::Surface;
 use crate::error::{Error, Result};
@@ -22,8 +23,22 @@ crate::names::named_options!(SocpSolver, "solver", {
     Clarabel => "clarabel",
 });
 
-/// How separating surfaces are trained. Build with [`ClassifySettingsBuilder`] or
-/// take [`ClassifySettings::default`].
+/// How separating surfaces are trained: set the fields over
+/// [`ClassifySettings::default`]; every entry point that takes the settings
+/// checks them with [`ClassifySettings::validate`].
+///
+/// ```
+/// use cloudprox::classify::{ClassifySettings, SocpSolver, Surface};
+///
+/// let settings = ClassifySettings {
+///     surface: Surface::Linear,
+///     solver: SocpSolver::Clarabel,
+///     ..ClassifySettings::default()
+/// };
+/// assert!(settings.validate().is_ok());
+/// let bad = ClassifySettings { robust_eta: 1.0, ..settings };
+/// assert!(bad.validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClassifySettings {
     /// Surface family (default [`Surface::Quadric`]).
@@ -59,12 +74,12 @@ impl Default for ClassifySettings {
 }
 
 impl ClassifySettings {
-    /// A builder starting from the defaults.
-    pub fn builder() -> ClassifySettingsBuilder {
-        ClassifySettingsBuilder::default()
-    }
-
     /// Checks every field's domain.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the first field out of its domain: a
+    /// `slack_weight` that is not finite and positive, a `robust_eta` outside
+    /// `[0.5, 1)`, `solver_max_iter` 0, or a `solver_tol` outside `(0, 1)`.
     pub fn validate(&self) -> Result<()> {
         if !(self.slack_weight.is_finite() && self.slack_weight > 0.0) {
             return Err(Error::invalid(format!(
@@ -86,56 +101,10 @@ impl ClassifySettings {
     }
 
     /// The robustness radius `r` for these settings.
+    ///
+    /// # Errors
+    /// As [`RobustModel::radius`] for a `robust_eta` out of its domain.
     pub fn robust_radius(&self) -> Result<Real> {
         self.robust_model.radius(self.robust_eta)
-    }
-}
-
-/// Builder of [`ClassifySettings`]; [`ClassifySettingsBuilder::build`] validates.
-#[derive(Debug, Clone, Default)]
-pub struct ClassifySettingsBuilder {
-    inner: ClassifySettings,
-}
-
-impl ClassifySettingsBuilder {
-    /// Surface family.
-    pub fn surface(mut self, surface: Surface) -> Self {
-        self.inner.surface = surface;
-        self
-    }
-    /// Slack weight (`lambda` in the formulas).
-    pub fn slack_weight(mut self, weight: Real) -> Self {
-        self.inner.slack_weight = weight;
-        self
-    }
-    /// Chance-constraint confidence `eta`.
-    pub fn robust_eta(mut self, eta: Real) -> Self {
-        self.inner.robust_eta = eta;
-        self
-    }
-    /// Distribution assumption for `r(eta)`.
-    pub fn robust_model(mut self, model: RobustModel) -> Self {
-        self.inner.robust_model = model;
-        self
-    }
-    /// Which solver.
-    pub fn solver(mut self, solver: SocpSolver) -> Self {
-        self.inner.solver = solver;
-        self
-    }
-    /// Clarabel's iteration limit.
-    pub fn solver_max_iter(mut self, n: u32) -> Self {
-        self.inner.solver_max_iter = n;
-        self
-    }
-    /// Solver tolerance.
-    pub fn solver_tol(mut self, tol: Real) -> Self {
-        self.inner.solver_tol = tol;
-        self
-    }
-    /// The validated settings.
-    pub fn build(self) -> Result<ClassifySettings> {
-        self.inner.validate()?;
-        Ok(self.inner)
     }
 }

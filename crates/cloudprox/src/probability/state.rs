@@ -31,9 +31,9 @@ impl CollisionState {
 /// Conservative users raise `collision` and lower `free`, widening the undecided band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Thresholds {
-    /// `A`: `P >= A` is in-collision.
+    /// `A`: `P >= A` is in-collision (default 0.9).
     pub collision: Real,
-    /// `B`: `P <= B` is collision-free.
+    /// `B`: `P <= B` is collision-free (default 0.1).
     pub free: Real,
 }
 

@@ -9,6 +9,6 @@ pub mod collide;
 pub mod exact;
 
 pub use collide::{
-    collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionRequestBuilder,
-    CollisionResult, ContactRegion, MeshSampling, QueryCounters, QueryModel, QueryStats,
+    collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
+    MeshSampling, QueryCounters, QueryModel, QueryStats,
 };

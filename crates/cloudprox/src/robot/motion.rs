@@ -17,7 +17,7 @@ pub const MAX_MOTION_STATES: usize = 1_000_000;
 /// Options of [`check_motion`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MotionRequest {
-    /// The query at each state.
+    /// The query at each state (default [`RobotRequest::default`]).
     pub robot: RobotRequest,
     /// The largest distance (metres) any point of any link may move between two
     /// checked states; `None`: the cloud's median sensor standard deviation
@@ -30,6 +30,32 @@ pub struct MotionRequest {
     /// constraint), or when links collide with each other (if self-collision is
     /// checked). `None`: the request's free threshold.
     pub max_probability: Option<Real>,
+}
+
+impl MotionRequest {
+    /// Checks every field's domain.
+    ///
+    /// # Errors
+    /// As [`RobotRequest::validate`]; a `resolution` given that is not finite
+    /// and positive; a `max_probability` given outside `[0, 1]`.
+    pub fn validate(&self) -> Result<()> {
+        self.robot.validate()?;
+        if let Some(r) = self.resolution {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::invalid(format!(
+                    "motion resolution must be finite and > 0, got {r}"
+                )));
+            }
+        }
+        if let Some(p) = self.max_probability {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(Error::invalid(format!(
+                    "max_probability must be in [0, 1], got {p}"
+                )));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The answer of [`check_motion`].
@@ -75,8 +101,9 @@ fn default_resolution(cloud: &PointCloud) -> Real {
 /// `q0`, stopping at the first unsafe state.
 ///
 /// # Errors
-/// As [`Robot::check_configuration`] for `q0` and `q1`; an invalid request or
-/// resolution; a motion needing more than `MAX_MOTION_STATES` (one million) states.
+/// As [`MotionRequest::validate`]; as [`Robot::check_configuration`] for `q0`
+/// and `q1`; a cloud whose default resolution is 0 (coinciding points without
+/// noise); a motion needing more than `MAX_MOTION_STATES` (one million) states.
 pub fn check_motion(
     robot: &Robot,
     q0: &[Real],
@@ -85,7 +112,7 @@ pub fn check_motion(
     cloud: &PointCloud,
     request: &MotionRequest,
 ) -> Result<MotionResult> {
-    request.robot.validate()?;
+    request.validate()?;
     check_base(base)?;
     robot
         .check_configuration(q0)
@@ -98,17 +125,13 @@ pub fn check_motion(
         .unwrap_or_else(|| default_resolution(cloud));
     if !(resolution.is_finite() && resolution > 0.0) {
         return Err(Error::invalid(format!(
-            "motion resolution must be finite and > 0, got {resolution}"
+            "the cloud gives a motion resolution of {resolution} (no noise and coinciding \
+             points): give the resolution"
         )));
     }
     let threshold = request
         .max_probability
         .unwrap_or(request.robot.collide.thresholds.free);
-    if !(0.0..=1.0).contains(&threshold) {
-        return Err(Error::invalid(format!(
-            "max_probability must be in [0, 1], got {threshold}"
-        )));
-    }
     let dq: Vec<Real> = q0.iter().zip(q1).map(|(a, b)| b - a).collect();
     let travel = robot.displacement_bound(&dq);
     let steps_f = (travel / resolution).ceil().max(1.0);

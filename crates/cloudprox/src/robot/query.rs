@@ -15,7 +15,7 @@ use crate::query::collide::{
     collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, CollisionRequest,
     CollisionResult, QueryModel,
 };
-use crate::query::exact::exact_intersects;
+use crate::query::exact::intersects;
 use crate::Real;
 
 /// Options of [`collide_robot`]: the per-link query's options and the robot's own.
@@ -232,7 +232,7 @@ pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollisio
         .filter_map(|&(a, b)| {
             let ga = robot.links[a].geometry.as_ref()?;
             let gb = robot.links[b].geometry.as_ref()?;
-            exact_intersects(&poses[a], &ga.exact, &poses[b], &gb.exact).then_some(SelfCollision {
+            intersects(&poses[a], &ga.exact, &poses[b], &gb.exact).then_some(SelfCollision {
                 link_a: a,
                 link_b: b,
             })

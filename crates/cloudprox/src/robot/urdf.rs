@@ -9,7 +9,7 @@ use super::model::{Joint, JointKind, Link, Mimic, Robot};
 use crate::error::{Error, Result};
 use crate::io::read_mesh;
 use crate::math::{Point3, Pose, Vector3};
-use crate::query::exact::exact_intersects;
+use crate::query::exact::intersects;
 use crate::shape::Mesh;
 use crate::Real;
 
@@ -420,7 +420,7 @@ impl Robot {
                         self.links[b].geometry.as_ref().map(|g| &g.exact),
                     );
                     match (ga, gb) {
-                        (Some(ga), Some(gb)) => exact_intersects(&poses[a], ga, &poses[b], gb),
+                        (Some(ga), Some(gb)) => intersects(&poses[a], ga, &poses[b], gb),
                         _ => false,
                     }
                 };

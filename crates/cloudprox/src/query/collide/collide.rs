@@ -19,7 +19,7 @@ use crate::query::collide::probabilities::{
 };
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
-    CollisionRequest, CollisionResult, ContactRegion, QueryModel, QueryStats,
+    CollisionRequest, CollisionResult, ContactPatch, QueryModel, QueryStats,
 };
 use crate::Real;
 
@@ -124,7 +124,7 @@ pub(crate) fn collide_with_workspace(
                 state: request.thresholds.state(probability),
                 probabilities_a: vec![0.0; a.len()],
                 probabilities_b: vec![0.0; b.len()],
-                regions: Vec::new(),
+                patches: Vec::new(),
                 stats,
             });
         }
@@ -143,7 +143,7 @@ pub(crate) fn collide_with_workspace(
     // or the pair crossing probability.
     let mut inputs_a = vec![0.0; sa.len()];
     let mut inputs_b = vec![0.0; sb.len()];
-    let mut regions = Vec::new();
+    let mut patches = Vec::new();
     // The samples given an input: every other input is 0, which changes no
     // aggregate, so `P` reads these alone (a query against a cloud of 10^7
     // points then does not pass over all of them).
@@ -311,7 +311,7 @@ pub(crate) fn collide_with_workspace(
             };
             let mut separator = fit.classification.separator;
             separator.frame = *pose_b;
-            regions.push(ContactRegion {
+            patches.push(ContactPatch {
                 component: patch.component,
                 indices_a,
                 indices_b,
@@ -329,7 +329,7 @@ pub(crate) fn collide_with_workspace(
             }
         }
     }
-    stats.counters.patches = regions.len();
+    stats.counters.patches = patches.len();
     // In index order, as over every sample: a sum's order is kept, and the
     // zeros left out add exactly nothing.
     for t in [&mut touched.0, &mut touched.1] {
@@ -346,7 +346,7 @@ pub(crate) fn collide_with_workspace(
         state: request.thresholds.state(probability),
         probabilities_a,
         probabilities_b,
-        regions,
+        patches,
         stats,
     })
 }

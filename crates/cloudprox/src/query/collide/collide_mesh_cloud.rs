@@ -11,11 +11,28 @@ use crate::Real;
 /// [`collide_mesh_cloud`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MeshSampling {
-    /// Sampling spacing (metres); `None` picks it from the other cloud
-    /// ([`mesh_sampling_spacing`]).
+    /// Sampling spacing (metres); `None` (the default) picks it from the other
+    /// cloud ([`mesh_sampling_spacing`]).
     pub spacing: Option<Real>,
-    /// Seed of the area-uniform sampling.
+    /// Seed of the area-uniform sampling (default 0).
     pub seed: u64,
+}
+
+impl MeshSampling {
+    /// Checks every field's domain.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] if `spacing` is given and is not finite and positive.
+    pub fn validate(&self) -> Result<()> {
+        if let Some(s) = self.spacing {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(Error::invalid(format!(
+                    "mesh sampling spacing must be finite and > 0, got {s}"
+                )));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The mesh's share of the cloud's sampling spacing: the mesh is sampled
@@ -44,7 +61,8 @@ pub fn mesh_sampling_spacing(cloud: &PointCloud) -> Real {
 /// with [`PointCloud::from_mesh`] and call [`collide`] directly.
 ///
 /// # Errors
-/// As [`collide`] and [`PointCloud::from_mesh`]; a spacing that would sample the
+/// As [`CollisionRequest::validate`] and [`MeshSampling::validate`] (before
+/// any work), [`collide`] and [`PointCloud::from_mesh`]; a spacing that would sample the
 /// mesh into more than 1e9 points.
 pub fn collide_mesh_cloud(
     pose_mesh: &Pose,
@@ -54,6 +72,8 @@ pub fn collide_mesh_cloud(
     request: &CollisionRequest,
     sampling: &MeshSampling,
 ) -> Result<CollisionResult> {
+    request.validate()?;
+    sampling.validate()?;
     let spacing = match sampling.spacing {
         Some(s) => s,
         None => mesh_sampling_spacing(cloud),

@@ -17,7 +17,7 @@ pub(crate) struct PatchFit {
     pub point: Point3,
     /// The surface's unit normal there, from A towards B.
     pub normal: Vector3,
-    /// The separation estimate (see [`crate::query::ContactRegion::separation`]);
+    /// The separation estimate (see [`crate::query::ContactPatch::separation`]);
     /// not computed (NaN) when `contact` is false.
     pub separation: Real,
 }

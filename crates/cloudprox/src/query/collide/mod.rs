@@ -40,5 +40,5 @@ pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
 };
 pub(crate) use elements::element_surfaces_may_reach;
-pub use request::{CollisionRequest, CollisionRequestBuilder, QueryModel};
-pub use result::{CollisionResult, ContactRegion, QueryCounters, QueryStats};
+pub use request::{CollisionRequest, QueryModel};
+pub use result::{CollisionResult, ContactPatch, QueryCounters, QueryStats};

@@ -1,4 +1,5 @@
-//! What a collision query should compute, with a validating builder.
+//! What a collision query should compute: public fields, [`Default`] and
+//! [`CollisionRequest::validate`].
 
 use crate::classify::ClassifySettings;
 use crate::error::{Error, Result};
@@ -29,13 +30,35 @@ crate::names::named_options!(QueryModel, "model", {
     Points => "points",
 });
 
-/// Options of [`crate::query::collide()`]. Build with [`CollisionRequestBuilder`] or
-/// take [`CollisionRequest::default`].
+/// Options of [`crate::query::collide()`]: set the fields over
+/// [`CollisionRequest::default`]; every query that takes a request checks it
+/// with [`CollisionRequest::validate`] before any work.
+///
+/// ```
+/// use cloudprox::classify::{ClassifySettings, Surface};
+/// use cloudprox::probability::{Aggregation, Thresholds};
+/// use cloudprox::query::CollisionRequest;
+///
+/// let request = CollisionRequest {
+///     aggregation: Aggregation::Independent,
+///     thresholds: Thresholds { collision: 0.95, free: 0.05 },
+///     classify: ClassifySettings {
+///         surface: Surface::Linear,
+///         ..ClassifySettings::default()
+///     },
+///     ..CollisionRequest::default()
+/// };
+/// assert!(request.validate().is_ok());
+/// let bad = CollisionRequest { prune_epsilon: -1.0, ..request };
+/// assert!(bad.validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CollisionRequest {
-    /// What is classified: surface elements or points (see [`QueryModel`]).
+    /// What is classified: surface elements or points (see [`QueryModel`];
+    /// default [`QueryModel::Points`]).
     pub model: QueryModel,
-    /// How separating surfaces are trained.
+    /// How separating surfaces are trained (default
+    /// [`ClassifySettings::default`]).
     pub classify: ClassifySettings,
     /// How per-point probabilities become `P` (default [`Aggregation::Max`]).
     pub aggregation: Aggregation,
@@ -59,7 +82,7 @@ pub struct CollisionRequest {
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
-    /// patches). The brute-force reference.
+    /// patches). The brute-force reference. Default `true`.
     pub use_hierarchy: bool,
     /// Return as soon as the state is decided (default `false`): no per-point
     /// probabilities, no separation estimates, and with the `max` aggregation the
@@ -86,12 +109,14 @@ impl Default for CollisionRequest {
 }
 
 impl CollisionRequest {
-    /// A builder starting from the defaults.
-    pub fn builder() -> CollisionRequestBuilder {
-        CollisionRequestBuilder::default()
-    }
-
     /// Checks every field's domain.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the first field out of its domain: as
+    /// [`ClassifySettings::validate`] and [`Thresholds::validate`]; a
+    /// `prune_epsilon` outside `[0, 1)`, a `near_context` below 0.5 or not
+    /// finite, `region_max_points` below 8, or the `surface` aggregation with
+    /// the elements model.
     pub fn validate(&self) -> Result<()> {
         self.classify.validate()?;
         self.thresholds.validate()?;
@@ -119,64 +144,5 @@ impl CollisionRequest {
             )));
         }
         Ok(())
-    }
-}
-
-/// Builder of [`CollisionRequest`]; [`CollisionRequestBuilder::build`] validates.
-#[derive(Debug, Clone, Default)]
-pub struct CollisionRequestBuilder {
-    inner: CollisionRequest,
-}
-
-impl CollisionRequestBuilder {
-    /// What is classified: surface elements or points.
-    pub fn model(mut self, model: QueryModel) -> Self {
-        self.inner.model = model;
-        self
-    }
-    /// Whether to return as soon as the state is decided.
-    pub fn decide_only(mut self, yes: bool) -> Self {
-        self.inner.decide_only = yes;
-        self
-    }
-    /// Classifier settings.
-    pub fn classify(mut self, settings: ClassifySettings) -> Self {
-        self.inner.classify = settings;
-        self
-    }
-    /// Aggregation of per-point probabilities.
-    pub fn aggregation(mut self, aggregation: Aggregation) -> Self {
-        self.inner.aggregation = aggregation;
-        self
-    }
-    /// Decision thresholds `threshold_collision` (A) and `threshold_free` (B).
-    pub fn thresholds(mut self, collision: Real, free: Real) -> Self {
-        self.inner.thresholds = Thresholds { collision, free };
-        self
-    }
-    /// Pruning bound `epsilon`.
-    pub fn prune_epsilon(mut self, epsilon: Real) -> Self {
-        self.inner.prune_epsilon = epsilon;
-        self
-    }
-    /// Context around the near region, in sampling spacings.
-    pub fn near_context(mut self, spacings: Real) -> Self {
-        self.inner.near_context = spacings;
-        self
-    }
-    /// Largest patch.
-    pub fn region_max_points(mut self, n: usize) -> Self {
-        self.inner.region_max_points = n;
-        self
-    }
-    /// Whether to use the hierarchy (`false`: brute force).
-    pub fn use_hierarchy(mut self, yes: bool) -> Self {
-        self.inner.use_hierarchy = yes;
-        self
-    }
-    /// The validated request.
-    pub fn build(self) -> Result<CollisionRequest> {
-        self.inner.validate()?;
-        Ok(self.inner)
     }
 }

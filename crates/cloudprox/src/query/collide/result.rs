@@ -5,9 +5,11 @@ use crate::math::{Point3, Vector3};
 use crate::probability::CollisionState;
 use crate::Real;
 
-/// One patch of a near region, with its own separating surface. World frame.
+/// One classified patch of a near region (a connected group of near points,
+/// cut into patches along the contact when large or misfit), with its own
+/// separating surface. World frame.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ContactRegion {
+pub struct ContactPatch {
     /// Index of the connected near region this patch belongs to.
     pub component: u32,
     /// Indices of cloud A's points in the patch.
@@ -48,7 +50,7 @@ pub struct QueryCounters {
     pub leaf_pairs: usize,
     /// Connected near regions.
     pub near_regions: usize,
-    /// Patches (= [`CollisionResult::regions`]) classified.
+    /// Patches (= [`CollisionResult::patches`]) classified.
     pub patches: usize,
     /// Patches cut in two because their surface put a point beyond the noise's
     /// reach of the other cloud on the wrong side.
@@ -105,7 +107,7 @@ pub struct CollisionResult {
     /// The same for cloud B.
     pub probabilities_b: Vec<Real>,
     /// The classified patches of the near regions.
-    pub regions: Vec<ContactRegion>,
+    pub patches: Vec<ContactPatch>,
     /// Counters and timings.
     pub stats: QueryStats,
 }

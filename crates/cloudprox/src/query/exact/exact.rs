@@ -5,6 +5,8 @@ use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::exact_shape::{ExactPart, ExactShape};
+use crate::cloud::validate_pose;
+use crate::error::Result;
 use crate::math::Pose;
 use crate::Real;
 
@@ -93,7 +95,25 @@ fn part_pair(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> (bool, Real,
 ///
 /// Part pairs whose bounding boxes are farther apart than the best distance found
 /// so far are skipped (they can neither intersect nor be closer).
+///
+/// # Errors
+/// [`Error::InvalidInput`](crate::Error::InvalidInput) if a pose is not finite,
+/// its rotation is not a unit quaternion, or its translation is beyond
+/// [`MAX_COORDINATE`](crate::cloud::MAX_COORDINATE) (a `Pose` built from parts
+/// can hold any of these; the message names the pose).
 pub fn exact_proximity(
+    pose_a: &Pose,
+    a: &ExactShape,
+    pose_b: &Pose,
+    b: &ExactShape,
+) -> Result<ExactProximity> {
+    validate_pose(pose_a, "pose_a")?;
+    validate_pose(pose_b, "pose_b")?;
+    Ok(proximity(pose_a, a, pose_b, b))
+}
+
+/// [`exact_proximity`] on poses already checked by the caller.
+pub(crate) fn proximity(
     pose_a: &Pose,
     a: &ExactShape,
     pose_b: &Pose,
@@ -145,7 +165,22 @@ pub fn exact_proximity(
 /// Whether `a` at `pose_a` and `b` at `pose_b` intersect: the `intersecting` of
 /// [`exact_proximity`] without the distance, which costs far more for large
 /// meshes that are apart.
-pub fn exact_intersects(pose_a: &Pose, a: &ExactShape, pose_b: &Pose, b: &ExactShape) -> bool {
+///
+/// # Errors
+/// As [`exact_proximity`].
+pub fn exact_intersects(
+    pose_a: &Pose,
+    a: &ExactShape,
+    pose_b: &Pose,
+    b: &ExactShape,
+) -> Result<bool> {
+    validate_pose(pose_a, "pose_a")?;
+    validate_pose(pose_b, "pose_b")?;
+    Ok(intersects(pose_a, a, pose_b, b))
+}
+
+/// [`exact_intersects`] on poses already checked by the caller.
+pub(crate) fn intersects(pose_a: &Pose, a: &ExactShape, pose_b: &Pose, b: &ExactShape) -> bool {
     let boxes_b: Vec<_> = b.aabbs.iter().map(|x| x.transformed(pose_b)).collect();
     a.aabbs.iter().enumerate().any(|(i, box_a)| {
         let box_a = box_a.transformed(pose_a);
@@ -156,28 +191,45 @@ pub fn exact_intersects(pose_a: &Pose, a: &ExactShape, pose_b: &Pose, b: &ExactS
     })
 }
 
+/// Checks every pose of a `_many` query (named by index) and `pose_b`.
+fn validate_poses(poses_a: &[Pose], pose_b: &Pose) -> Result<()> {
+    for (i, p) in poses_a.iter().enumerate() {
+        validate_pose(p, &format!("poses_a[{i}]"))?;
+    }
+    validate_pose(pose_b, "pose_b")
+}
+
 /// [`exact_intersects`] for many poses of `a`, in parallel.
+///
+/// # Errors
+/// As [`exact_proximity`], for the first bad pose (by index; the message names
+/// it), before any query runs.
 pub fn exact_intersects_many(
     poses_a: &[Pose],
     a: &ExactShape,
     pose_b: &Pose,
     b: &ExactShape,
-) -> Vec<bool> {
-    poses_a
+) -> Result<Vec<bool>> {
+    validate_poses(poses_a, pose_b)?;
+    Ok(poses_a
         .par_iter()
-        .map(|p| exact_intersects(p, a, pose_b, b))
-        .collect()
+        .map(|p| intersects(p, a, pose_b, b))
+        .collect())
 }
 
 /// [`exact_proximity`] for many poses of `a`, in parallel.
+///
+/// # Errors
+/// As [`exact_intersects_many`].
 pub fn exact_proximity_many(
     poses_a: &[Pose],
     a: &ExactShape,
     pose_b: &Pose,
     b: &ExactShape,
-) -> Vec<ExactProximity> {
-    poses_a
+) -> Result<Vec<ExactProximity>> {
+    validate_poses(poses_a, pose_b)?;
+    Ok(poses_a
         .par_iter()
-        .map(|p| exact_proximity(p, a, pose_b, b))
-        .collect()
+        .map(|p| proximity(p, a, pose_b, b))
+        .collect())
 }

@@ -14,6 +14,7 @@ mod exact;
 mod exact_shape;
 mod time_of_impact;
 
+pub(crate) use exact::intersects;
 pub use exact::{
     exact_intersects, exact_intersects_many, exact_proximity, exact_proximity_many, ExactProximity,
 };

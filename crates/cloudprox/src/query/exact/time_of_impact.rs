@@ -6,7 +6,7 @@ use parry3d_f64::query::{self, PointQuery, ShapeCastOptions};
 use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
 
-use super::exact::{as_shape, exact_intersects, exact_proximity};
+use super::exact::{as_shape, intersects, proximity};
 use super::exact_shape::{ExactPart, ExactShape};
 use crate::cloud::validate_pose;
 use crate::error::{Error, Result};
@@ -213,7 +213,7 @@ fn signed_at(
     b: &ExactShape,
     t: Real,
 ) -> Result<Real> {
-    let s = exact_proximity(&moved(pose_a, direction, t), a, pose_b, b).signed_distance();
+    let s = proximity(&moved(pose_a, direction, t), a, pose_b, b).signed_distance();
     if s.is_nan() {
         return Err(Error::invalid(
             "a negative target needs penetration depths, which are known only \
@@ -342,7 +342,7 @@ pub fn exact_time_of_impact(
         )));
     }
     let direction = direction / norm;
-    if exact_intersects(pose_a, a, pose_b, b) {
+    if intersects(pose_a, a, pose_b, b) {
         if target >= 0.0 {
             return Ok(Some(0.0));
         }
