@@ -35,7 +35,7 @@ def test_result_fields(spheres) -> None:
         "surface_crossings",
         "points_classified",
         "solver_iterations",
-        "barrier_fallbacks",
+        "clarabel_fallbacks",
         "solver_fallbacks",
         "pruned_bound",
         "time_seconds",
@@ -55,7 +55,7 @@ def test_result_fields(spheres) -> None:
         assert region.normal[0] > 0.5  # from A (at the origin) towards B (along +x)
         assert region.surface == "quadric"
         assert region.status in ("solved", "almost_solved", "fallback")
-        # The barrier method takes at least one step to a solution.
+        # The interior-point method takes at least one step to a solution.
         assert region.iterations >= 1 or region.status == "fallback"
         assert 0.0 <= region.probability <= 1.0
         assert isinstance(region.separation, float) and isinstance(region.component, int)

@@ -117,7 +117,7 @@ def bad_last_row() -> np.ndarray:
             {"robust_model": "student"},
             r"unknown robust_model 'student'; valid names: 'gaussian', 'chebyshev'",
         ),
-        ({"solver": "ecos"}, r"unknown solver 'ecos'; valid names: 'barrier', 'clarabel'"),
+        ({"solver": "ecos"}, r"unknown solver 'ecos'; valid names: 'primal_dual', 'clarabel'"),
         ({"robust_eta": 1.0}, r"robust_eta must be in \[0.5, 1\), got 1"),
         ({"slack_weight": 0.0}, r"slack_weight must be finite and > 0"),
         ({"prune_epsilon": 1.0}, r"prune_epsilon must be in \[0, 1\)"),

@@ -224,7 +224,7 @@ OPTIONS: dict[str, st.SearchStrategy[Any]] = {
     "slack_weight": FLOATS,
     "robust_eta": FLOATS,
     "robust_model": st.sampled_from(["gaussian", "chebyshev", "cauchy"]),
-    "solver": st.sampled_from(["barrier", "clarabel", "newton"]),
+    "solver": st.sampled_from(["primal_dual", "clarabel", "newton"]),
     "use_hierarchy": st.booleans(),
     "model": st.sampled_from(["points", "elements", "voxels"]),
     "decide_only": st.booleans(),

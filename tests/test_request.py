@@ -115,7 +115,7 @@ def test_pickle_copy_and_json() -> None:
         ),
         ("model", "voxels", r"unknown model 'voxels'; valid names: 'elements', 'points'"),
         ("robust_model", "student", r"unknown robust_model 'student'; valid names: 'gaussian'"),
-        ("solver", "ecos", r"unknown solver 'ecos'; valid names: 'barrier', 'clarabel'"),
+        ("solver", "ecos", r"unknown solver 'ecos'; valid names: 'primal_dual', 'clarabel'"),
         ("surface", "Linear", r"unknown surface 'Linear'"),
         ("slack_weight", 0.0, r"slack_weight must be finite and > 0, got 0"),
         ("slack_weight", float("nan"), r"slack_weight must be finite"),

@@ -531,7 +531,7 @@ impl RequestInput {
             solver: if self.clarabel {
                 SocpSolver::Clarabel
             } else {
-                SocpSolver::Barrier
+                SocpSolver::PrimalDual
             },
             ..ClassifySettings::default()
         };

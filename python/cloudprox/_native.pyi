@@ -94,7 +94,7 @@ _SurfaceName = Literal["linear", "quadric"]
 _AggregationName = Literal["surface", "max", "union", "independent"]
 _ModelName = Literal["elements", "points"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
-_SolverName = Literal["barrier", "clarabel"]
+_SolverName = Literal["primal_dual", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
 _CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
 _MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
@@ -385,8 +385,8 @@ class QueryStats:
     def solver_iterations(self) -> int:
         """Interior-point iterations over all patches."""
     @property
-    def barrier_fallbacks(self) -> int:
-        """Patches where the barrier method gave way to Clarabel."""
+    def clarabel_fallbacks(self) -> int:
+        """Patches where the specialized solver gave way to Clarabel."""
     @property
     def solver_fallbacks(self) -> int:
         """Patches whose solve fell back to a plane (``ContactPatch.status == "fallback"``)."""
@@ -698,8 +698,8 @@ class CollisionRequest:
         Confidence of each point's chance constraint, in ``[0.5, 1)``.
     robust_model : {"gaussian", "chebyshev"}, optional
         Distribution assumption of the robustness radius.
-    solver : {"barrier", "clarabel"}, optional
-        SOCP solver: the specialized log-barrier method (falls back to Clarabel if
+    solver : {"primal_dual", "clarabel"}, optional
+        SOCP solver: the specialized primal-dual method (falls back to Clarabel if
         it does not converge) or Clarabel alone.
     use_hierarchy : bool, optional
         ``False`` finds the near points by testing every point pair and classifies

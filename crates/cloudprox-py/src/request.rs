@@ -211,7 +211,7 @@ impl PyCollisionRequest {
         self.inner.classify.robust_model.name()
     }
 
-    /// Solver of the classifier: ``"barrier"`` (specialised, falls back to
+    /// Solver of the classifier: ``"primal_dual"`` (specialised, falls back to
     /// Clarabel) or ``"clarabel"`` (the general conic reference).
     #[getter]
     fn solver(&self) -> &'static str {

@@ -177,8 +177,9 @@ stats_class! {
         points_classified: usize,
         /// Interior-point iterations over all patches.
         solver_iterations: u64,
-        /// Patches where the barrier method did not converge and Clarabel was used.
-        barrier_fallbacks: usize,
+        /// Patches where the specialized solver did not converge and Clarabel
+        /// was used.
+        clarabel_fallbacks: usize,
         /// Patches whose solve fell back to the mean-difference plane
         /// (``ContactPatch.status == "fallback"``).
         solver_fallbacks: usize,

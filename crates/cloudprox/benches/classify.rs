@@ -29,7 +29,7 @@ fn bench_classify(c: &mut Criterion) {
     let mut group = c.benchmark_group("train");
     group.sample_size(20);
     for surface in [Surface::Linear, Surface::Quadric] {
-        for solver in [SocpSolver::Barrier, SocpSolver::Clarabel] {
+        for solver in [SocpSolver::PrimalDual, SocpSolver::Clarabel] {
             let s = ClassifySettings {
                 surface,
                 solver,

@@ -6,7 +6,7 @@
 //!
 //! Two clouds A and B are collision-free iff a surface separates them. Every point
 //! carries a 3x3 covariance (sensor noise plus discretization error). A robust
-//! classifier (a second-order cone program, solved by a specialized barrier method
+//! classifier (a second-order cone program, solved by a specialized primal-dual interior-point method
 //! with Clarabel as reference and fallback) finds the separating
 //! surface that tolerates that noise; every point then gets the probability of lying
 //! on the wrong side of it (a Gaussian cdf), and the pair gets an aggregated

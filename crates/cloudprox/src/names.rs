@@ -151,6 +151,6 @@ mod tests {
         let msg = "".parse::<RobustModel>().unwrap_err().to_string();
         assert!(msg.contains("unknown robust_model ''"), "{msg}");
         let msg = "cvx".parse::<SocpSolver>().unwrap_err().to_string();
-        assert!(msg.contains("'barrier', 'clarabel'"), "{msg}");
+        assert!(msg.contains("'primal_dual', 'clarabel'"), "{msg}");
     }
 }

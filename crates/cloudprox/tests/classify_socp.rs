@@ -59,7 +59,7 @@ fn objective(
 }
 
 fn check(surface: Surface, isotropic: bool, gap: f64, seed: u64) {
-    for solver in [SocpSolver::Barrier, SocpSolver::Clarabel] {
+    for solver in [SocpSolver::PrimalDual, SocpSolver::Clarabel] {
         check_with(surface, isotropic, gap, seed, solver);
     }
 }
@@ -164,7 +164,7 @@ fn train_rejects_bad_labels_and_lengths() {
 }
 
 #[test]
-fn barrier_method_agrees_with_clarabel() {
+fn the_specialized_method_agrees_with_clarabel() {
     for (k, surface) in [Surface::Linear, Surface::Quadric].into_iter().enumerate() {
         for (j, &gap) in [0.2, 0.05, 0.0, -0.05, -0.2].iter().enumerate() {
             for isotropic in [true, false] {
@@ -175,11 +175,11 @@ fn barrier_method_agrees_with_clarabel() {
                     solver,
                     ..ClassifySettings::default()
                 };
-                let fb = train(&pts, &covs, &labels, &s(SocpSolver::Barrier)).unwrap();
+                let fb = train(&pts, &covs, &labels, &s(SocpSolver::PrimalDual)).unwrap();
                 let fc = train(&pts, &covs, &labels, &s(SocpSolver::Clarabel)).unwrap();
                 assert_eq!(
                     fb.solver,
-                    SocpSolver::Barrier,
+                    SocpSolver::PrimalDual,
                     "{surface:?} gap {gap} iso {isotropic}"
                 );
                 let ob = objective(
@@ -189,7 +189,7 @@ fn barrier_method_agrees_with_clarabel() {
                     &pts,
                     &covs,
                     &labels,
-                    &s(SocpSolver::Barrier),
+                    &s(SocpSolver::PrimalDual),
                 );
                 let oc = objective(
                     &fc,
@@ -202,7 +202,7 @@ fn barrier_method_agrees_with_clarabel() {
                 );
                 assert!(
                     (ob - oc).abs() <= 1e-5 * oc.abs().max(1.0),
-                    "{surface:?} gap {gap}: barrier {ob} vs clarabel {oc}"
+                    "{surface:?} gap {gap}: specialized {ob} vs clarabel {oc}"
                 );
                 // w is unique (the objective is strictly convex in w); b need not be
                 // (the hinge terms can be flat in b), so only w is compared.
@@ -238,9 +238,9 @@ fn the_specialized_method_solves_large_patches_in_few_iterations() {
             solver,
             ..ClassifySettings::default()
         };
-        let fb = train(&pts, &covs, &labels, &s(SocpSolver::Barrier)).unwrap();
+        let fb = train(&pts, &covs, &labels, &s(SocpSolver::PrimalDual)).unwrap();
         let fc = train(&pts, &covs, &labels, &s(SocpSolver::Clarabel)).unwrap();
-        assert_eq!(fb.solver, SocpSolver::Barrier, "gap {gap}: fell back");
+        assert_eq!(fb.solver, SocpSolver::PrimalDual, "gap {gap}: fell back");
         assert!(
             fb.iterations <= 40,
             "gap {gap}: {} iterations",
@@ -253,7 +253,7 @@ fn the_specialized_method_solves_large_patches_in_few_iterations() {
             &pts,
             &covs,
             &labels,
-            &s(SocpSolver::Barrier),
+            &s(SocpSolver::PrimalDual),
         );
         let oc = objective(
             &fc,

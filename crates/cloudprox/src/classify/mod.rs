@@ -13,7 +13,7 @@
 //! deviation at the point (the covariance pushed through the feature map). It is
 //! a second-order cone program, solved by a specialized primal-dual
 //! interior-point method whose Newton systems have only `dim + 1` unknowns
-//! ([`SocpSolver::Barrier`], the default), with Clarabel ([`SocpSolver::Clarabel`]) as the exact reference and
+//! ([`SocpSolver::PrimalDual`], the default), with Clarabel ([`SocpSolver::Clarabel`]) as the exact reference and
 //! the fallback. Coordinates are normalized per
 //! problem (centred, divided by their RMS radius) and the covariances scaled by
 //! the same factor squared.

@@ -9,17 +9,17 @@ use crate::Real;
 /// Which solver trains the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SocpSolver {
-    /// The specialized log-barrier interior-point method: Newton systems of
-    /// `dim + 1` unknowns, `O(n)` per step. Falls back to Clarabel if it does not
-    /// converge. The default.
+    /// The specialized primal-dual interior-point method: Newton systems of
+    /// `dim + 1` unknowns, `O(n)` per iteration, on a working set of the
+    /// constraints. Falls back to Clarabel if it does not converge. The default.
     #[default]
-    Barrier,
+    PrimalDual,
     /// Clarabel, a general conic interior-point solver: the exact reference.
     Clarabel,
 }
 
 crate::names::named_options!(SocpSolver, "solver", {
-    Barrier => "barrier",
+    PrimalDual => "primal_dual",
     Clarabel => "clarabel",
 });
 
@@ -51,7 +51,7 @@ pub struct ClassifySettings {
     pub robust_eta: Real,
     /// Distribution assumption behind `r = r(eta)` (default Gaussian).
     pub robust_model: RobustModel,
-    /// Which solver (default [`SocpSolver::Barrier`]).
+    /// Which solver (default [`SocpSolver::PrimalDual`]).
     pub solver: SocpSolver,
     /// Clarabel's interior-point iteration limit (default 100).
     pub solver_max_iter: u32,
@@ -66,7 +66,7 @@ impl Default for ClassifySettings {
             slack_weight: 100.0,
             robust_eta: 0.9,
             robust_model: RobustModel::Gaussian,
-            solver: SocpSolver::Barrier,
+            solver: SocpSolver::PrimalDual,
             solver_max_iter: 100,
             solver_tol: 1e-7,
         }

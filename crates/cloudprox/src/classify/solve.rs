@@ -86,7 +86,7 @@ pub fn train(
     }
     let r = settings.robust_radius()?;
     let norm = Normalized::new(points, covs);
-    if settings.solver == SocpSolver::Barrier {
+    if settings.solver == SocpSolver::PrimalDual {
         if let Some(sol) = solve_reduced(
             &norm,
             labels,
@@ -105,7 +105,7 @@ pub fn train(
                     frame: Pose::identity(),
                 },
                 status: SolveStatus::Solved,
-                solver: SocpSolver::Barrier,
+                solver: SocpSolver::PrimalDual,
                 iterations: sol.iterations,
                 slacks: sol.xi,
             });

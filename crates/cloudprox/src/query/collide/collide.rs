@@ -278,9 +278,9 @@ pub(crate) fn collide_with_workspace(
             );
             stats.counters.points_classified += pts.len();
             stats.counters.solver_iterations += u64::from(fit.classification.iterations);
-            stats.counters.barrier_fallbacks += usize::from(
-                request.classify.solver == SocpSolver::Barrier
-                    && fit.classification.solver != SocpSolver::Barrier,
+            stats.counters.clarabel_fallbacks += usize::from(
+                request.classify.solver == SocpSolver::PrimalDual
+                    && fit.classification.solver != SocpSolver::PrimalDual,
             );
             stats.counters.solver_fallbacks +=
                 usize::from(fit.classification.status == SolveStatus::Fallback);

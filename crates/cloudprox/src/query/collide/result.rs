@@ -67,8 +67,9 @@ pub struct QueryCounters {
     pub points_classified: usize,
     /// Interior-point iterations over all patches.
     pub solver_iterations: u64,
-    /// Patches where the barrier method did not converge and Clarabel was used.
-    pub barrier_fallbacks: usize,
+    /// Patches where the specialized solver did not converge and Clarabel was
+    /// used.
+    pub clarabel_fallbacks: usize,
     /// Patches whose solve fell back to the mean-difference plane (see
     /// [`SolveStatus::Fallback`]).
     pub solver_fallbacks: usize,
