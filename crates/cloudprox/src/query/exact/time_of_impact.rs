@@ -300,7 +300,7 @@ fn search_past_contact(
 ///   shape rounded by the gap.
 /// - `target < 0`: a penetration depth of `-target`: the first contact as
 ///   above, then a search along the line past it on the signed distance of
-///   [`exact_proximity`] (conservative advancement, secant steps, bisection;
+///   [`exact_proximity`](super::exact_proximity) (conservative advancement, secant steps, bisection;
 ///   to within [`IMPACT_TOLERANCE`]). It is the first crossing unless the
 ///   signed distance dips below the target and comes back between two
 ///   evaluations.
