@@ -56,7 +56,9 @@ __all__ = [
 
 CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
 MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
-EncodingName = Literal["ascii", "binary", "binary_big_endian", "binary_compressed"]
+EncodingName = Literal[
+    "ascii", "binary", "binary_little_endian", "binary_big_endian", "binary_compressed"
+]
 PathLike = str | os.PathLike[str]
 FloatArray = npt.NDArray[np.float64]
 

@@ -16,8 +16,8 @@
 //! Mehrotra's predictor-corrector (Vandenberghe, *The CVXOPT linear and
 //! quadratic cone program solvers*, 2010; Nocedal & Wright ch. 14): each
 //! iteration solves the Newton system twice with one factorization and moves
-//! both primal and dual variables, typically 15-30 iterations against the
-//! barrier method's 50-250 Newton steps.
+//! both primal and dual variables: 11-14 iterations from 100 to 2000 points,
+//! where the log-barrier method it replaced took 50-460 Newton steps.
 //!
 //! The Newton system's matrix `P + G^T W^-2 G` is an arrow: the NT scaling
 //! `W_i^2 = eta_i^2 (2 wb_i wb_i^T - J)` of each cone couples only `z` and
@@ -28,9 +28,8 @@
 //! `c (2 v_0 p - a)` to the `z, xi_i` column and `c (2 v_0^2 - 1) + y_i / s_i`
 //! (its half-line's scaling) to the `xi_i` diagonal.
 //!
-//! The iteration count hardly grows with the points (11-14 iterations from
-//! 100 to 2000 points of two facing patches); which points it sees is
-//! [`super::working_set`]'s choice.
+//! As the iteration count hardly grows with the points, which points it sees
+//! is [`super::working_set`]'s choice.
 //!
 //! Clarabel stays the exact reference: tests compare the two, and
 //! [`super::train`] falls back to Clarabel when this method does not converge.
