@@ -1,5 +1,6 @@
 #![allow(missing_docs)]
-//! One robust SOCP (Clarabel) on two noisy facing patches, by size and surface.
+//! One robust SOCP on two noisy facing patches, by size, surface and solver
+//! (the specialized primal-dual method and Clarabel).
 //!
 //! `cargo bench -p cloudprox --bench classify`
 
