@@ -163,6 +163,17 @@ fn train_rejects_bad_labels_and_lengths() {
         .contains("label 3"));
 }
 
+/// [`objective`] at the fit's own `(w, b)`.
+fn objective_at_fit(
+    fit: &Classification,
+    pts: &[Point3],
+    covs: &[Matrix3],
+    labels: &[f64],
+    s: &ClassifySettings,
+) -> f64 {
+    objective(fit, &fit.separator.w, fit.separator.b, pts, covs, labels, s)
+}
+
 #[test]
 fn the_specialized_method_agrees_with_clarabel() {
     for (k, surface) in [Surface::Linear, Surface::Quadric].into_iter().enumerate() {
@@ -182,24 +193,8 @@ fn the_specialized_method_agrees_with_clarabel() {
                     SocpSolver::PrimalDual,
                     "{surface:?} gap {gap} iso {isotropic}"
                 );
-                let ob = objective(
-                    &fb,
-                    &fb.separator.w,
-                    fb.separator.b,
-                    &pts,
-                    &covs,
-                    &labels,
-                    &s(SocpSolver::PrimalDual),
-                );
-                let oc = objective(
-                    &fc,
-                    &fc.separator.w,
-                    fc.separator.b,
-                    &pts,
-                    &covs,
-                    &labels,
-                    &s(SocpSolver::Clarabel),
-                );
+                let ob = objective_at_fit(&fb, &pts, &covs, &labels, &s(SocpSolver::PrimalDual));
+                let oc = objective_at_fit(&fc, &pts, &covs, &labels, &s(SocpSolver::Clarabel));
                 assert!(
                     (ob - oc).abs() <= 1e-5 * oc.abs().max(1.0),
                     "{surface:?} gap {gap}: specialized {ob} vs clarabel {oc}"
@@ -246,24 +241,8 @@ fn the_specialized_method_solves_large_patches_in_few_iterations() {
             "gap {gap}: {} iterations",
             fb.iterations
         );
-        let ob = objective(
-            &fb,
-            &fb.separator.w,
-            fb.separator.b,
-            &pts,
-            &covs,
-            &labels,
-            &s(SocpSolver::PrimalDual),
-        );
-        let oc = objective(
-            &fc,
-            &fc.separator.w,
-            fc.separator.b,
-            &pts,
-            &covs,
-            &labels,
-            &s(SocpSolver::Clarabel),
-        );
+        let ob = objective_at_fit(&fb, &pts, &covs, &labels, &s(SocpSolver::PrimalDual));
+        let oc = objective_at_fit(&fc, &pts, &covs, &labels, &s(SocpSolver::Clarabel));
         assert!(
             (ob - oc).abs() <= 1e-5 * oc.abs().max(1.0),
             "gap {gap}: specialized {ob} vs clarabel {oc}"
