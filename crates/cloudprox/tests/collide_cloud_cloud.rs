@@ -444,3 +444,47 @@ fn deep_interpenetration_is_a_collision_for_every_aggregation_and_model() {
         );
     }
 }
+
+#[test]
+fn a_sparse_cloud_against_a_dense_one_gets_bounded_patches() {
+    // Three points (one on the surface, two well inside) against a 20 000-point
+    // sphere: the sparse cloud's wide spacing makes most of the sphere near,
+    // and no cut can keep points of both clouds in each half, so the sparse
+    // points are shared between patches.
+    let b = PointCloud::from_sigma(
+        cloudprox::sample::sphere(&Point3::origin(), 0.1, 20_000),
+        0.0005,
+    )
+    .unwrap();
+    let a = PointCloud::from_sigma(
+        vec![
+            Point3::new(0.1, 0.0, 0.0),
+            Point3::new(0.02, 0.03, 0.0),
+            Point3::new(0.0, -0.02, 0.03),
+        ],
+        0.0005,
+    )
+    .unwrap();
+    let request = CollisionRequest {
+        region_max_points: 500,
+        ..CollisionRequest::default()
+    };
+    let r = collide(&Pose::identity(), &a, &Pose::identity(), &b, &request).unwrap();
+    assert!(r.patches.len() > 1);
+    let mut in_patches_a = [0; 3];
+    let mut in_patches_b = vec![0; b.len()];
+    for p in &r.patches {
+        assert!(p.indices_a.len() + p.indices_b.len() <= 500, "{p:?}");
+        p.indices_a
+            .iter()
+            .for_each(|&i| in_patches_a[i as usize] += 1);
+        p.indices_b
+            .iter()
+            .for_each(|&i| in_patches_b[i as usize] += 1);
+    }
+    // The dense cloud is partitioned; the sparse points are shared.
+    assert!(in_patches_b.iter().all(|&c| c <= 1));
+    assert!(in_patches_a.iter().any(|&c| c > 1), "{in_patches_a:?}");
+    // A shared point reports its largest value over its patches.
+    assert!(r.probability >= r.patches.iter().map(|p| p.probability).fold(0.0, f64::max) - 1e-12);
+}

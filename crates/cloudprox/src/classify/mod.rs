@@ -32,7 +32,7 @@ mod solve;
 mod surface;
 mod working_set;
 
-pub use separator::Separator;
+pub use separator::{QuadraticForm, Separator};
 pub use settings::{ClassifySettings, SocpSolver};
 pub use solve::{train, Classification, SolveStatus};
 pub use surface::Surface;

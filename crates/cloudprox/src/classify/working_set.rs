@@ -97,14 +97,18 @@ const WORKING_SET_TREE_MIN: usize = 512;
 fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
     let n = labels.len();
     if n <= WORKING_SET_TREE_MIN {
-        return (0..n)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| labels[j] != labels[i])
-                    .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
-                    .fold(Real::INFINITY, Real::min)
-            })
-            .collect();
+        // Every pair of opposite labels once, each distance updating both ends.
+        let mut d2 = vec![Real::INFINITY; n];
+        for i in 0..n {
+            for j in i + 1..n {
+                if labels[j] != labels[i] {
+                    let d = (norm.u[i] - norm.u[j]).norm_squared();
+                    d2[i] = d2[i].min(d);
+                    d2[j] = d2[j].min(d);
+                }
+            }
+        }
+        return d2;
     }
     // One hierarchy per label, each queried by the other label's points.
     let mut d2 = vec![Real::INFINITY; n];

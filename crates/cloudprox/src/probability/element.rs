@@ -465,8 +465,9 @@ pub(crate) fn element_crossing_probabilities(
         undescribed_max: 0.0,
     };
     let active = within_reach_of(&po, &pt, reach_sds);
+    let form = sep.quadratic_form(&Pose::identity());
     for_each_facing(&po, &pt, &active, |f| {
-        let (_, g) = sep.value_and_gradient_local(&nalgebra::center(&f.x, &f.y));
+        let (_, g) = form.value_and_gradient(&nalgebra::center(&f.x, &f.y));
         let gn = g.norm();
         if gn <= 0.0 || !gn.is_finite() {
             return true;
@@ -486,7 +487,10 @@ pub(crate) fn element_crossing_probabilities(
             } else if p > out.undescribed_max.min(out.described_max) {
                 // Only a pair that would cross and could raise one of the two
                 // maxima needs the test.
-                let (fx, fy) = (sep.value_local(&f.x), sep.value_local(&f.y));
+                let (fx, fy) = (
+                    form.value_and_gradient(&f.x).0,
+                    form.value_and_gradient(&f.y).0,
+                );
                 let near_end = fx.abs().min(fy.abs()) / gn;
                 // A separating surface running across the two surfaces here,
                 // not between them, says nothing of their order either.

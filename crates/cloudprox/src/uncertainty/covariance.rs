@@ -33,10 +33,20 @@ pub fn validate_covariance(cov: &Matrix3, what: &str) -> Result<()> {
 
 /// A factor `L` with `L L^T = cov`, so that `||L^T v|| = sqrt(v^T cov v)`.
 ///
-/// Computed from the eigen-decomposition (`L = V sqrt(Lambda)`), which, unlike a
-/// Cholesky factor, exists for singular (rank-deficient) covariances too.
-/// Eigenvalues that round below zero are clamped to zero.
+/// The Cholesky factor when `cov` is positive definite (closed form, a few
+/// square roots); otherwise from the eigen-decomposition (`L = V sqrt(Lambda)`),
+/// which exists for singular (rank-deficient) covariances too, with
+/// eigenvalues that round below zero clamped to zero. Any factor gives the same
+/// `||L^T v||`.
 pub fn covariance_factor(cov: &Matrix3) -> Matrix3 {
+    if let Some(chol) = cov.cholesky() {
+        let l = chol.l();
+        // A factor of a near-singular matrix can lose the digits of its
+        // smallest direction: keep it only while it reproduces `cov`.
+        if (l * l.transpose() - cov).amax() <= 1e-12 * cov.amax() {
+            return l;
+        }
+    }
     let eig = cov.symmetric_eigen();
     let sqrt_vals = eig.eigenvalues.map(|l| l.max(0.0).sqrt());
     eig.eigenvectors * Matrix3::from_diagonal(&sqrt_vals)

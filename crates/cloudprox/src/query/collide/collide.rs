@@ -137,12 +137,12 @@ pub(crate) fn collide_with_workspace(
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();
 
-    let mut probabilities_a = vec![0.0; a.len()];
-    let mut probabilities_b = vec![0.0; b.len()];
+    let mut probabilities_a: Vec<Real> = vec![0.0; a.len()];
+    let mut probabilities_b: Vec<Real> = vec![0.0; b.len()];
     // What the aggregation reads per sample: p_i, the surface probability q_i,
     // or the pair crossing probability.
-    let mut inputs_a = vec![0.0; sa.len()];
-    let mut inputs_b = vec![0.0; sb.len()];
+    let mut inputs_a: Vec<Real> = vec![0.0; sa.len()];
+    let mut inputs_b: Vec<Real> = vec![0.0; sb.len()];
     let mut patches = Vec::new();
     // The samples given an input: every other input is 0, which changes no
     // aggregate, so `P` reads these alone (a query against a cloud of 10^7
@@ -264,11 +264,13 @@ pub(crate) fn collide_with_workspace(
                     fit.probabilities[na..].to_vec(),
                 ),
             };
+            // A sample of a sparse cloud can be in several patches
+            // ([`split_patches`]): it keeps its largest value.
             for (&i, &q) in ia.iter().zip(&qa) {
-                inputs_a[i as usize] = q;
+                inputs_a[i as usize] = inputs_a[i as usize].max(q);
             }
             for (&i, &q) in ib.iter().zip(&qb) {
-                inputs_b[i as usize] = q;
+                inputs_b[i as usize] = inputs_b[i as usize].max(q);
             }
             touched.0.extend_from_slice(&ia);
             touched.1.extend_from_slice(&ib);
@@ -291,10 +293,10 @@ pub(crate) fn collide_with_workspace(
                 None => {
                     if !request.decide_only {
                         for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
-                            probabilities_a[i as usize] = p;
+                            probabilities_a[i as usize] = probabilities_a[i as usize].max(p);
                         }
                         for (&i, &p) in ib.iter().zip(&fit.probabilities[na..]) {
-                            probabilities_b[i as usize] = p;
+                            probabilities_b[i as usize] = probabilities_b[i as usize].max(p);
                         }
                     }
                     (ia, ib)

@@ -3,7 +3,7 @@
 
 use crate::classify::{train, Classification};
 use crate::error::Result;
-use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
+use crate::math::{Matrix3, Point3, Pose, PrincipalAxes, Vector3};
 use crate::probability::point_probability;
 use crate::query::collide::CollisionRequest;
 use crate::Real;
@@ -41,8 +41,9 @@ pub(crate) fn fit_patch(
     let sep = &classification.separator;
     let mut probabilities = Vec::with_capacity(pts.len());
     let mut margins = Vec::with_capacity(pts.len());
+    let form = sep.quadratic_form(&Pose::identity());
     for ((x, cov), &c) in pts.iter().zip(covs).zip(&labels) {
-        let (f, g) = sep.value_and_gradient_local(x);
+        let (f, g) = form.value_and_gradient(x);
         probabilities.push(point_probability(f, &g, cov, c));
         let gn = g.norm();
         margins.push(if gn > 0.0 { c * f / gn } else { c * f });

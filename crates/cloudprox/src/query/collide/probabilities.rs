@@ -23,14 +23,13 @@ pub(crate) fn point_probabilities(
     label: Real,
     out: &mut [Real],
 ) {
-    // The gradient is turned into the cloud's frame rather than every
-    // covariance into the separator's: `g^T (R C R^T) g = (R^T g)^T C (R^T g)`.
-    let back = pose.rotation.inverse();
+    // The surface is turned into the cloud's frame rather than every point
+    // and covariance into the separator's.
+    let form = sep.quadratic_form(pose);
     for &i in idx {
         let i = i as usize;
-        let x = pose * cloud.points()[i];
-        let (f, g) = sep.value_and_gradient_local(&x);
-        let p = point_probability(f, &(back * g), &cloud.covariances()[i], label);
+        let (f, g) = form.value_and_gradient(&cloud.points()[i]);
+        let p = point_probability(f, &g, &cloud.covariances()[i], label);
         out[i] = out[i].max(p);
     }
 }
@@ -65,11 +64,12 @@ pub(crate) fn surface_probabilities(
     covs: &[Matrix3],
     label: Real,
 ) -> Vec<Real> {
+    let form = sep.quadratic_form(&Pose::identity());
     let (margins, stds): (Vec<Real>, Vec<Real>) = pts
         .iter()
         .zip(covs)
         .map(|(x, c)| {
-            let (f, g) = sep.value_and_gradient_local(x);
+            let (f, g) = form.value_and_gradient(x);
             (label * f, directional_std_of(c, &g))
         })
         .unzip();

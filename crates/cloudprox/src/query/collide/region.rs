@@ -280,7 +280,11 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
 /// the points' scatter projected onto the plane orthogonal to the line between the
 /// two clouds' centroids. Cutting along the contact keeps both clouds in each
 /// half, and lets each patch follow a curved or wrapped contact with its own
-/// surface. A cut that would leave one half without points of a cloud is not made.
+/// surface. A cut that would leave one half without points of a cloud gives
+/// that cloud's points to both halves when they are at most half of
+/// `max_points` (a sparse cloud against a dense one: a point is then in
+/// several patches and keeps the largest of its values); otherwise it is not
+/// made.
 pub fn split_patches(region: Patch, pa: &[Point3], pb: &[Point3], max_points: usize) -> Vec<Patch> {
     let mut out = Vec::new();
     let mut todo = vec![region];
@@ -289,7 +293,27 @@ pub fn split_patches(region: Patch, pa: &[Point3], pb: &[Point3], max_points: us
             out.push(p);
             continue;
         }
-        match cut(&p, pa, pb) {
+        let halves = halves(&p, pa, pb).and_then(|(mut l, mut r)| {
+            let shared = max_points / 2;
+            for (side, whole) in [(0, &p.a), (1, &p.b)] {
+                let (sl, sr) = match side {
+                    0 => (&mut l.a, &mut r.a),
+                    _ => (&mut l.b, &mut r.b),
+                };
+                if sl.is_empty() || sr.is_empty() {
+                    if whole.len() > shared {
+                        return None;
+                    }
+                    sl.clone_from(whole);
+                    sr.clone_from(whole);
+                }
+            }
+            // Only one cloud may be shared, or nothing shrinks.
+            let shrinks = l.a.len() + l.b.len() < p.a.len() + p.b.len()
+                && r.a.len() + r.b.len() < p.a.len() + p.b.len();
+            shrinks.then_some((l, r))
+        });
+        match halves {
             Some((l, r)) => {
                 todo.push(r);
                 todo.push(l);
@@ -303,6 +327,17 @@ pub fn split_patches(region: Patch, pa: &[Point3], pb: &[Point3], max_points: us
 /// Cuts a patch in two at the median along the contact (see [`split_patches`]);
 /// `None` when a half would lose all points of a cloud.
 pub fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
+    halves(p, pa, pb)
+        .filter(|(l, r)| !(l.a.is_empty() || r.a.is_empty() || l.b.is_empty() || r.b.is_empty()))
+}
+
+/// The two halves of a patch cut at the median along the contact (see
+/// [`split_patches`]), a half possibly without points of a cloud; `None` for
+/// a patch without points.
+fn halves(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
+    if p.a.is_empty() || p.b.is_empty() {
+        return None;
+    }
     let xa = p.a.iter().map(|&i| pa[i as usize].coords);
     let xb = p.b.iter().map(|&i| pb[i as usize].coords);
     let mean_a = xa.clone().sum::<Vector3>() / p.a.len() as Real;
@@ -333,9 +368,6 @@ pub fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
     };
     let (al, ar) = side(pa, &p.a);
     let (bl, br) = side(pb, &p.b);
-    if al.is_empty() || ar.is_empty() || bl.is_empty() || br.is_empty() {
-        return None;
-    }
     Some((
         Patch {
             component: p.component,
@@ -348,4 +380,88 @@ pub fn cut(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
             b: br,
         },
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n x n` points of spacing `h` in the plane `z`.
+    fn grid(n: usize, h: Real, z: Real) -> Vec<Point3> {
+        (0..n * n)
+            .map(|k| Point3::new((k % n) as Real * h, (k / n) as Real * h, z))
+            .collect()
+    }
+
+    fn all(n: usize) -> Vec<u32> {
+        (0..n as u32).collect()
+    }
+
+    /// How many patches hold each point.
+    fn counts(patches: &[Patch], n: usize, of: impl Fn(&Patch) -> &Vec<u32>) -> Vec<usize> {
+        let mut c = vec![0; n];
+        for p in patches {
+            for &i in of(p) {
+                c[i as usize] += 1;
+            }
+        }
+        c
+    }
+
+    #[test]
+    fn a_sparse_cloud_is_shared_so_that_every_patch_is_bounded() {
+        // Three points over a 4900-point plane: no cut keeps points of both
+        // clouds in each half, so the sparse side goes to both halves.
+        let pa = vec![
+            Point3::new(0.01, 0.01, 0.002),
+            Point3::new(0.03, 0.05, 0.002),
+            Point3::new(0.06, 0.02, 0.002),
+        ];
+        let pb = grid(70, 0.001, 0.0);
+        let region = Patch {
+            component: 0,
+            a: all(pa.len()),
+            b: all(pb.len()),
+        };
+        let patches = split_patches(region, &pa, &pb, 400);
+        assert!(patches.len() >= 4900 / 400, "{} patches", patches.len());
+        for p in &patches {
+            assert!(
+                p.a.len() + p.b.len() <= 400,
+                "{} + {}",
+                p.a.len(),
+                p.b.len()
+            );
+            assert!(!p.a.is_empty() && !p.b.is_empty());
+        }
+        // The dense cloud is partitioned; every sparse point is in some patch.
+        assert!(counts(&patches, pb.len(), |p| &p.b).iter().all(|&c| c == 1));
+        assert!(counts(&patches, pa.len(), |p| &p.a).iter().all(|&c| c >= 1));
+    }
+
+    #[test]
+    fn dense_clouds_are_partitioned_and_a_large_sparse_side_is_not_shared() {
+        // Two planes of 900 points: each point in exactly one patch.
+        let (pa, pb) = (grid(30, 0.001, 0.001), grid(30, 0.001, 0.0));
+        let region = Patch {
+            component: 0,
+            a: all(pa.len()),
+            b: all(pb.len()),
+        };
+        let patches = split_patches(region, &pa, &pb, 200);
+        assert!(patches.iter().all(|p| p.a.len() + p.b.len() <= 200));
+        assert!(counts(&patches, pa.len(), |p| &p.a).iter().all(|&c| c == 1));
+        assert!(counts(&patches, pb.len(), |p| &p.b).iter().all(|&c| c == 1));
+        // A cloud of more than half the bound on one side of every cut is not
+        // copied into both halves: the patch stays whole.
+        let pa: Vec<Point3> = (0..150).map(|_| Point3::new(0.0, 0.0, 0.001)).collect();
+        let region = Patch {
+            component: 0,
+            a: all(pa.len()),
+            b: all(pb.len()),
+        };
+        let patches = split_patches(region, &pa, &pb, 200);
+        assert_eq!(patches.len(), 1);
+        assert_eq!(patches[0].a.len() + patches[0].b.len(), 1050);
+    }
 }
