@@ -687,7 +687,9 @@ class CollisionRequest:
     region_max_points : int, optional
         Near regions larger than this are split into patches (``>= 8``):
         a bound on the cost of one solve. Regions are also cut where one surface
-        misfits (``QueryStats.misfit_cuts``).
+        misfits (``QueryStats.misfit_cuts``). A cloud too sparse to be cut (a
+        handful of points against thousands) is shared by the patches; its
+        points keep their largest value.
     near_context : float, optional
         Context kept around the near points, in sampling spacings (each point's
         distance to its 6th nearest neighbour; ``>= 0.5``).

@@ -79,6 +79,9 @@ pub struct CollisionRequest {
     /// contact, each with its own surface (default 2000): a bound on the cost of
     /// one solve. Smaller patches are also cut where one surface misfits (see
     /// [`QueryCounters::misfit_cuts`](crate::query::QueryCounters::misfit_cuts)).
+    /// A cloud too sparse for a cut to leave points of it in both halves (a
+    /// handful of points against thousands) is shared by the halves when it
+    /// holds at most half this many; its points keep their largest value.
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
