@@ -34,18 +34,14 @@ pub fn validate_covariance(cov: &Matrix3, what: &str) -> Result<()> {
 /// A factor `L` with `L L^T = cov`, so that `||L^T v|| = sqrt(v^T cov v)`.
 ///
 /// The Cholesky factor when `cov` is positive definite (closed form, a few
-/// square roots); otherwise from the eigen-decomposition (`L = V sqrt(Lambda)`),
-/// which exists for singular (rank-deficient) covariances too, with
-/// eigenvalues that round below zero clamped to zero. Any factor gives the same
-/// `||L^T v||`.
+/// square roots; backward stable, so `L L^T` reproduces `cov` to rounding as
+/// the eigen-decomposition does); otherwise from the eigen-decomposition
+/// (`L = V sqrt(Lambda)`), which exists for singular (rank-deficient)
+/// covariances too, with eigenvalues that round below zero clamped to zero.
+/// Any factor gives the same `||L^T v||`.
 pub fn covariance_factor(cov: &Matrix3) -> Matrix3 {
     if let Some(chol) = cov.cholesky() {
-        let l = chol.l();
-        // A factor of a near-singular matrix can lose the digits of its
-        // smallest direction: keep it only while it reproduces `cov`.
-        if (l * l.transpose() - cov).amax() <= 1e-12 * cov.amax() {
-            return l;
-        }
+        return chol.l();
     }
     let eig = cov.symmetric_eigen();
     let sqrt_vals = eig.eigenvalues.map(|l| l.max(0.0).sqrt());

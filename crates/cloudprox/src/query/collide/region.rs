@@ -293,20 +293,21 @@ pub fn split_patches(region: Patch, pa: &[Point3], pb: &[Point3], max_points: us
             out.push(p);
             continue;
         }
-        let halves = halves(&p, pa, pb).and_then(|(mut l, mut r)| {
-            let shared = max_points / 2;
-            for (side, whole) in [(0, &p.a), (1, &p.b)] {
-                let (sl, sr) = match side {
-                    0 => (&mut l.a, &mut r.a),
-                    _ => (&mut l.b, &mut r.b),
-                };
-                if sl.is_empty() || sr.is_empty() {
-                    if whole.len() > shared {
-                        return None;
-                    }
-                    sl.clone_from(whole);
-                    sr.clone_from(whole);
+        // One cloud's halves, given all of its points when one is empty
+        // and the cloud is small enough to share; `false` when it is not.
+        let share = |l: &mut Vec<u32>, r: &mut Vec<u32>, whole: &Vec<u32>| {
+            if l.is_empty() || r.is_empty() {
+                if whole.len() > max_points / 2 {
+                    return false;
                 }
+                l.clone_from(whole);
+                r.clone_from(whole);
+            }
+            true
+        };
+        let halves = halves(&p, pa, pb).and_then(|(mut l, mut r)| {
+            if !(share(&mut l.a, &mut r.a, &p.a) && share(&mut l.b, &mut r.b, &p.b)) {
+                return None;
             }
             // Only one cloud may be shared, or nothing shrinks.
             let shrinks = l.a.len() + l.b.len() < p.a.len() + p.b.len()
