@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from cloudprox.cli import main
-from cloudprox.reproduce.methods import sampling_spacing, states_from
+from cloudprox.reproduce.methods import Draw, nn_gap_answer, sampling_spacing, states_from
 from cloudprox.reproduce.metrics import auc, compute_metrics, roc_curve
 from cloudprox.reproduce.noise import NoiseModel
 from cloudprox.reproduce.poses import sample_poses
@@ -90,6 +90,37 @@ def test_poses_hit_their_target_band_with_exact_labels() -> None:
     assert np.array_equal(q.intersecting, q.signed_distance <= 0.0)
     for t in q.poses:
         assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3), atol=1e-12)
+
+
+def test_nn_gap_equals_the_score_over_every_nearest_neighbour() -> None:
+    """The bounded search gives the formula's score on every point, near and far."""
+    from scipy.spatial import cKDTree
+    from scipy.special import ndtr
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(400, 3)) * [0.1, 0.1, 0.01]
+    b = rng.normal(size=(600, 3)) * [0.3, 0.3, 0.01]
+    # Different noise per point (an anisotropic level's).
+    std_a, std_b = 0.02 + 0.03 * rng.random(400), 0.02 + 0.03 * rng.random(600)
+    cov = lambda s: s[:, None, None] ** 2 * np.eye(3)  # noqa: E731
+    draw = Draw(a, cov(std_a), b, cov(std_b))
+    poses = np.repeat(np.eye(4)[None], 12, axis=0)
+    # From overlapping to far beyond the first search radius (several doublings).
+    poses[:, 2, 3] = [-0.02, 0.0, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8, 1.2, 1.6, 2.0]
+    got = nn_gap_answer(draw, poses).score
+    tree = cKDTree(b)
+    for pose, score in zip(poses, got, strict=True):
+        d, j = tree.query(a + pose[:3, 3])
+        s = np.sqrt(std_a**2 + std_b[j] ** 2)
+        assert score == pytest.approx(float(ndtr(np.max(-(d - 2.0 * s) / s))), rel=1e-12, abs=0)
+    assert got[0] > 0.5 and 0.0 < got[-1] < 1e-100
+    # The nearest pair found first is not the best one: a noisier pair farther
+    # apart (beyond the first search radius) scores higher.
+    std = np.array([0.01, 0.1])
+    a2 = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]])
+    b2 = np.array([[0.0, 0.0, 0.5], [10.0, 0.0, 0.7]])
+    two = nn_gap_answer(Draw(a2, cov(std), b2, cov(std)), np.eye(4)[None]).score[0]
+    assert two == pytest.approx(float(ndtr(2.0 - 0.7 / np.sqrt(0.02))), rel=1e-12)
 
 
 def test_sampling_spacing_of_a_grid_is_its_pitch() -> None:

@@ -307,3 +307,77 @@ fn bad_poses_are_refused_with_the_pose_named() {
     // Good poses still answer.
     assert!(exact_intersects_many(&poses[..2], &a, &id, &b).unwrap() == [true, false]);
 }
+
+/// Two bare surfaces (meshes of thousands of triangles): the distance of
+/// `exact_proximity` (both meshes' hierarchies traversed at once) equals
+/// parry's own mesh-vs-mesh distance, for a small mesh inside a large one's
+/// box (where parry prunes nothing) and beside it, under random rigid poses.
+#[test]
+fn mesh_mesh_distance_agrees_with_parry() {
+    use cloudprox::robot::{capsule_mesh, sphere_mesh};
+    let small = Mesh::merged(&[
+        sphere_mesh(0.05).unwrap(),
+        capsule_mesh(0.02, 0.1)
+            .unwrap()
+            .transformed(&at(0.06, 0.0, 0.0)),
+    ])
+    .unwrap();
+    let room = Mesh::merged(&[
+        Mesh::cuboid(1.0, 1.0, 1.0).unwrap(),
+        sphere_mesh(0.2).unwrap().transformed(&at(0.4, 0.1, 0.0)),
+        capsule_mesh(0.1, 0.5)
+            .unwrap()
+            .transformed(&at(-0.5, -0.3, 0.2)),
+    ])
+    .unwrap();
+    let (a, b) = (
+        ExactShape::surfaces(&[small]).unwrap(),
+        ExactShape::surfaces(&[room]).unwrap(),
+    );
+    let (ExactPart::Mesh { mesh: ma, .. }, ExactPart::Mesh { mesh: mb, .. }) =
+        (&a.parts()[0], &b.parts()[0])
+    else {
+        panic!("surfaces are meshes");
+    };
+    assert!(ma.num_triangles() > 1000 && mb.num_triangles() > 1000);
+    let mut state = 3_u64;
+    let mut unit = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let pose_b = Pose::from_parts(
+        Translation3::new(0.3, -0.2, 0.1),
+        UnitQuaternion::from_euler_angles(0.3, -0.2, 1.0),
+    );
+    let (mut free, mut hit) = (0, 0);
+    for k in 0..60 {
+        let mut v = Vector3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5);
+        let t = if k % 2 == 0 {
+            // Anywhere in the room's box.
+            Translation3::from(1.8 * v)
+        } else {
+            // About the room's sphere's surface: crossing it or near.
+            v = v.normalize() * (0.2 + 0.1 * (unit() - 0.5));
+            Translation3::from(Vector3::new(0.4, 0.1, 0.0) + v)
+        };
+        let q = UnitQuaternion::from_euler_angles(6.0 * unit(), 6.0 * unit(), 6.0 * unit());
+        let pose_a = pose_b * Pose::from_parts(t, q);
+        let r = exact_proximity(&pose_a, &a, &pose_b, &b).unwrap();
+        let want_hit = parry3d_f64::query::intersection_test(&pose_a, ma, &pose_b, mb).unwrap();
+        assert_eq!(r.intersecting, want_hit);
+        if want_hit {
+            hit += 1;
+            continue;
+        }
+        free += 1;
+        let want = parry3d_f64::query::distance(&pose_a, ma, &pose_b, mb).unwrap();
+        assert!(
+            (r.distance - want).abs() <= 1e-9,
+            "distance {} vs parry's {want}",
+            r.distance
+        );
+    }
+    assert!(free >= 20 && hit >= 5, "{free} free, {hit} intersecting");
+}

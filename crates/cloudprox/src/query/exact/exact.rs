@@ -5,6 +5,7 @@ use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::exact_shape::{ExactPart, ExactShape};
+use super::mesh_distance::{mesh_mesh_distance, TriangleTree};
 use crate::cloud::validate_pose;
 use crate::error::Result;
 use crate::math::Pose;
@@ -66,7 +67,12 @@ fn pair_intersects(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> bool {
 }
 
 /// One part pair: `(intersecting, distance, penetration depth if known)`.
-fn part_pair(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> (bool, Real, Option<Real>) {
+fn part_pair(
+    pa: &Pose,
+    (a, ta): (&ExactPart, Option<&TriangleTree>),
+    pb: &Pose,
+    (b, tb): (&ExactPart, Option<&TriangleTree>),
+) -> (bool, Real, Option<Real>) {
     let (sa, sb) = (as_shape(a), as_shape(b));
     if let (ExactPart::Convex(_), ExactPart::Convex(_)) = (a, b) {
         let d = query::distance(pa, sa, pb, sb).unwrap_or(Real::NAN);
@@ -80,21 +86,27 @@ fn part_pair(pa: &Pose, a: &ExactPart, pb: &Pose, b: &ExactPart) -> (bool, Real,
         return (true, 0.0, Some(depth));
     }
     if pair_intersects(pa, a, pb, b) {
-        (true, 0.0, None)
-    } else {
-        (
-            false,
-            query::distance(pa, sa, pb, sb).unwrap_or(Real::NAN),
-            None,
-        )
+        return (true, 0.0, None);
     }
+    let d = match (a, ta, b, tb) {
+        (
+            ExactPart::Mesh { mesh: ma, .. },
+            Some(ta),
+            ExactPart::Mesh { mesh: mb, .. },
+            Some(tb),
+        ) => mesh_mesh_distance(pa, (ma, ta), pb, (mb, tb)),
+        _ => query::distance(pa, sa, pb, sb).unwrap_or(Real::NAN),
+    };
+    (false, d, None)
 }
 
 /// Exact proximity of `a` at `pose_a` and `b` at `pose_b` (each pose maps the
 /// object's frame to the world).
 ///
 /// Part pairs whose bounding boxes are farther apart than the best distance found
-/// so far are skipped (they can neither intersect nor be closer).
+/// so far are skipped (they can neither intersect nor be closer). Two triangle
+/// meshes that do not intersect get their distance from a traversal of both
+/// meshes' hierarchies at once, nearest node pair first.
 ///
 /// # Errors
 /// [`Error::InvalidInput`](crate::Error::InvalidInput) if a pose is not finite,
@@ -142,7 +154,7 @@ pub(crate) fn proximity(
         if lower_bound > 0.0 && lower_bound > out.distance {
             break;
         }
-        let (hit, d, depth) = part_pair(pose_a, &a.parts[i], pose_b, &b.parts[j]);
+        let (hit, d, depth) = part_pair(pose_a, a.part(i), pose_b, b.part(j));
         if hit {
             out.intersecting = true;
             out.distance = 0.0;

@@ -2,6 +2,7 @@
 
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 
+use super::mesh_distance::TriangleTree;
 use crate::bvh::Aabb;
 use crate::cloud::MAX_COORDINATE;
 use crate::error::{Error, Result};
@@ -43,6 +44,9 @@ impl std::fmt::Debug for ExactPart {
 pub struct ExactShape {
     pub(crate) parts: Vec<ExactPart>,
     pub(crate) aabbs: Vec<Aabb>,
+    /// The hierarchy over each mesh part's triangles (`None` for a convex
+    /// part).
+    pub(crate) trees: Vec<Option<TriangleTree>>,
 }
 
 impl ExactShape {
@@ -110,14 +114,27 @@ impl ExactShape {
             };
             out.push(part);
         }
+        let trees = out
+            .iter()
+            .map(|p| match p {
+                ExactPart::Mesh { mesh, .. } => TriangleTree::new(mesh).map(Some),
+                ExactPart::Convex(_) => Ok(None),
+            })
+            .collect::<Result<Vec<_>>>()?;
         Ok(Self {
             parts: out,
             aabbs: parts.iter().map(Mesh::aabb).collect(),
+            trees,
         })
     }
 
     /// The prepared parts.
     pub fn parts(&self) -> &[ExactPart] {
         &self.parts
+    }
+
+    /// Part `i` with its triangle hierarchy (a mesh part's).
+    pub(crate) fn part(&self, i: usize) -> (&ExactPart, Option<&TriangleTree>) {
+        (&self.parts[i], self.trees[i].as_ref())
     }
 }

@@ -12,6 +12,7 @@
 #[allow(clippy::module_inception)]
 mod exact;
 mod exact_shape;
+mod mesh_distance;
 mod time_of_impact;
 
 pub(crate) use exact::intersects;
