@@ -18,15 +18,16 @@ use parry3d_f64::shape::{TriMesh, Triangle};
 
 use crate::bvh::{Aabb, Bvh, BvhSettings};
 use crate::error::Result;
-use crate::math::{Point3, Pose, Vector3};
+use crate::math::{Point3, Pose};
 use crate::Real;
 
-/// A hierarchy over a mesh's triangles: over their centroids, each with the
-/// distance to its farthest corner as its spread, so a node's box grown by its
-/// largest spread holds its triangles.
+/// A hierarchy over a mesh's triangles (the point hierarchy over their
+/// centroids), with the box of each node's triangles themselves.
 #[derive(Debug, Clone)]
 pub(crate) struct TriangleTree {
     tree: Bvh,
+    /// Per node, the box of its triangles' corners.
+    boxes: Vec<Aabb>,
 }
 
 /// Triangles per leaf: a leaf pair costs a triangle-pair distance per pair.
@@ -35,34 +36,41 @@ const LEAF_TRIANGLES: usize = 4;
 impl TriangleTree {
     /// The hierarchy over `mesh`'s triangles.
     pub(crate) fn new(mesh: &TriMesh) -> Result<Self> {
-        let (centroids, radii): (Vec<Point3>, Vec<Real>) = (0..mesh.num_triangles() as u32)
-            .map(|i| {
-                let t = mesh.triangle(i);
-                let c = t.center();
-                let r = [t.a, t.b, t.c]
-                    .iter()
-                    .map(|v| (v - c).norm())
-                    .fold(0.0, Real::max);
-                (c, r)
-            })
-            .unzip();
+        let centroids: Vec<Point3> = (0..mesh.num_triangles() as u32)
+            .map(|i| mesh.triangle(i).center())
+            .collect();
         let settings = BvhSettings {
             leaf_max_points: LEAF_TRIANGLES,
         };
-        Ok(Self {
-            tree: Bvh::build(&centroids, &radii, &settings)?,
-        })
+        let tree = Bvh::build(&centroids, &vec![0.0; centroids.len()], &settings)?;
+        // Children follow their parent in the node array: from the last node
+        // back, every child's box is known before its parent's.
+        let mut boxes = vec![Aabb::empty(); tree.nodes().len()];
+        for id in (0..tree.nodes().len()).rev() {
+            boxes[id] = match tree.nodes()[id].children {
+                Some([l, r]) => boxes[l as usize].merged(&boxes[r as usize]),
+                None => tree
+                    .node_points(id as u32)
+                    .iter()
+                    .fold(Aabb::empty(), |b, &t| {
+                        b.merged(&triangle_box(&mesh.triangle(t)))
+                    }),
+            };
+        }
+        Ok(Self { tree, boxes })
     }
 
     /// The box of node `id`'s triangles, moved by `pose`.
     fn node_box(&self, id: u32, pose: &Pose) -> Aabb {
-        let node = &self.tree.nodes()[id as usize];
-        let grow = Vector3::repeat(node.sigma_max);
-        Aabb {
-            mins: node.aabb.mins - grow,
-            maxs: node.aabb.maxs + grow,
-        }
-        .transformed(pose)
+        self.boxes[id as usize].transformed(pose)
+    }
+}
+
+/// The box of a triangle's corners.
+fn triangle_box(t: &Triangle) -> Aabb {
+    Aabb {
+        mins: t.a.inf(&t.b).inf(&t.c),
+        maxs: t.a.sup(&t.b).sup(&t.c),
     }
 }
 
@@ -128,8 +136,14 @@ pub(crate) fn mesh_mesh_distance(
             (None, None) => {
                 for &s in ta.tree.node_points(i) {
                     let tri_a = moved(s);
+                    let box_a = triangle_box(&tri_a);
                     for &t in tb.tree.node_points(j) {
                         let tri_b = b.triangle(t);
+                        // The boxes first: most pairs of a leaf pair are
+                        // farther apart than the best already.
+                        if box_a.distance(&triangle_box(&tri_b)) >= best {
+                            continue;
+                        }
                         if let Ok(d) = query::distance(&id, &tri_a, &id, &tri_b) {
                             best = best.min(d);
                         }
