@@ -172,8 +172,9 @@ fn axial_offset<'a>(
 /// is one run.
 struct LineIndex<'a> {
     pts: &'a [Point3],
-    /// Two unit vectors across the axis, and the cell width.
+    /// Two unit vectors across the axis.
     across: [Vector3; 2],
+    /// The cells' width.
     cell: Real,
     /// Point indices sorted by cell, with their cells.
     sorted: Vec<((i64, i64), u32)>,
@@ -224,10 +225,15 @@ impl<'a> LineIndex<'a> {
             if all {
                 return if di == 0 { 0..self.pts.len() } else { 0..0 };
             }
-            let lo = self.sorted.partition_point(|&(c, _)| c < (ci + di, cj - 1));
-            let hi = self
-                .sorted
-                .partition_point(|&(c, _)| c <= (ci + di, cj + 1));
+            // (Saturating: a cell index saturates for a coordinate far beyond
+            // the cell width, and its neighbour must not overflow.)
+            let column = ci.saturating_add(di);
+            let (first, last) = (
+                (column, cj.saturating_sub(1)),
+                (column, cj.saturating_add(1)),
+            );
+            let lo = self.sorted.partition_point(|&(c, _)| c < first);
+            let hi = self.sorted.partition_point(|&(c, _)| c <= last);
             lo..hi
         });
         runs.flat_map(move |run| {

@@ -122,7 +122,7 @@ pub(crate) fn mesh_mesh_distance(
     let mut best = Real::INFINITY;
     let mut heap = BinaryHeap::new();
     let pending = |i: u32, j: u32| Pending {
-        bound: ta.node_box(i, &rel).distance(&tb.node_box(j, &id)),
+        bound: ta.node_box(i, &rel).distance(&tb.boxes[j as usize]),
         a: i,
         b: j,
     };
