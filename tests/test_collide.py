@@ -132,6 +132,13 @@ def test_options_take_effect(spheres) -> None:
     union = cp.collide(a, b, pose_b=pose_b, aggregation="union", model="points")
     independent = cp.collide(a, b, pose_b=pose_b, aggregation="independent", model="points")
     assert base.probability <= independent.probability <= union.probability
+    # One points query gives the paper's three aggregates, exactly.
+    assert base.point_aggregates == {
+        "max": base.probability,
+        "union": union.probability,
+        "independent": independent.probability,
+    }
+    assert cp.collide(a, b, pose_b=pose_b, model="elements").point_aggregates is None
     linear = cp.collide(a, b, pose_b=pose_b, surface="linear", model="points")
     assert all(r.surface == "linear" for r in linear.patches)
     strict = cp.collide(

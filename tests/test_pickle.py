@@ -18,6 +18,7 @@ def roundtrip(obj):
 
 def assert_same_result(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
     assert r.probability == s.probability and r.state == s.state
+    assert r.point_aggregates == s.point_aggregates
     np.testing.assert_array_equal(r.probabilities_a, s.probabilities_a)
     np.testing.assert_array_equal(r.probabilities_b, s.probabilities_b)
     assert len(r.patches) == len(s.patches)
@@ -93,7 +94,7 @@ def test_result_and_region_roundtrip() -> None:
     a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
     b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
     result = cp.collide(a, b, pose_b=from_translation((0.199, 0.0, 0.0)))
-    assert result.patches
+    assert result.patches and result.point_aggregates is not None
     back = roundtrip(result)
     assert_same_result(result, back)
     assert back.stats == result.stats

@@ -350,6 +350,16 @@ class CollisionResult:
     def patches(self) -> list[ContactPatch]:
         """The classified patches of the near regions."""
     @property
+    def point_aggregates(self) -> dict[str, float] | None:
+        """``P`` under each of the paper's aggregations, with the points model.
+
+        ``{"max": ..., "union": ..., "independent": ...}`` from this query's
+        per-point probabilities over the points ``P`` aggregates: a points-model
+        query asking for one of them returns it as its ``probability``, exactly,
+        so one query gives all three. ``None`` with the elements model (its ``P``
+        aggregates surface crossings) and with ``decide_only``.
+        """
+    @property
     def stats(self) -> QueryStats:
         """Counters and timings of the query."""
 

@@ -70,7 +70,15 @@ type PatchState = (
 );
 
 /// The pickled form of a `CollisionResult` (without the clouds it was computed on).
-type ResultState = (f64, String, Vec<f64>, Vec<f64>, Vec<PatchState>, StatsState);
+type ResultState = (
+    f64,
+    String,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<PatchState>,
+    StatsState,
+    Option<[f64; 3]>,
+);
 
 fn patch_to_state(r: &ContactPatch) -> PatchState {
     let sep = &r.separator;
@@ -319,6 +327,8 @@ pub struct PyCollisionResult {
     probabilities_b: Vec<f64>,
     patches: Vec<Py<PyContactPatch>>,
     stats: QueryStats,
+    /// The points model's `max`, `union` and `independent` aggregates.
+    point_aggregates: Option<[f64; 3]>,
     sides: Option<QueriedSides>,
 }
 
@@ -350,6 +360,7 @@ impl PyCollisionResult {
             probabilities_b: r.probabilities_b,
             patches,
             stats: r.stats,
+            point_aggregates: r.point_aggregates.map(|g| [g.max, g.union, g.independent]),
             sides: None,
         })
     }
@@ -452,6 +463,7 @@ impl PyCollisionResult {
             me.probabilities_b.clone(),
             patches,
             PyQueryStats::state_of(&me.stats),
+            me.point_aggregates,
         );
         Ok((slf.getattr("_from_state")?, (state,)))
     }
@@ -459,7 +471,8 @@ impl PyCollisionResult {
     /// Rebuilds a pickled result (see `__reduce__`).
     #[staticmethod]
     fn _from_state(py: Python<'_>, state: ResultState) -> PyResult<Self> {
-        let (probability, state_text, probabilities_a, probabilities_b, patches, stats) = state;
+        let (probability, state_text, probabilities_a, probabilities_b, patches, stats, aggregates) =
+            state;
         let patches = patches
             .into_iter()
             .map(|r| Py::new(py, PyContactPatch::wrap(patch_from_state(py, r)?)))
@@ -471,8 +484,27 @@ impl PyCollisionResult {
             probabilities_b,
             patches,
             stats: PyQueryStats::from_state(stats),
+            point_aggregates: aggregates,
             sides: None,
         })
+    }
+
+    /// With the points model: `P` under each of the paper's aggregations
+    /// (`{"max": ..., "union": ..., "independent": ...}`), from this query's
+    /// per-point probabilities over the points `P` aggregates. A points-model
+    /// query asking for one of them returns it as its `probability`, exactly,
+    /// so one query gives all three. `None` with the elements model (its `P`
+    /// aggregates surface crossings) and with `decide_only`.
+    #[getter]
+    fn point_aggregates<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some([max, union, independent]) = self.point_aggregates else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("max", max)?;
+        d.set_item("union", union)?;
+        d.set_item("independent", independent)?;
+        Ok(Some(d))
     }
 
     /// The classified patches (a new list of the same patch objects each time).

@@ -7,8 +7,8 @@ use cloudprox::prelude::*;
 use cloudprox::probability::normal_cdf;
 use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 
-/// The paper's per-point model (this file's subject; the surface elements,
-/// the default, are tested in `collide_elements.rs`) with `surface`.
+/// The paper's per-point model (this file's subject; the surface elements
+/// are tested in `collide_elements.rs`) with `surface`.
 fn request(surface: Surface) -> CollisionRequest {
     CollisionRequest {
         model: QueryModel::Points,
@@ -487,4 +487,63 @@ fn a_sparse_cloud_against_a_dense_one_gets_bounded_patches() {
     assert!(in_patches_a.iter().any(|&c| c > 1), "{in_patches_a:?}");
     // A shared point reports its largest value over its patches.
     assert!(r.probability >= r.patches.iter().map(|p| p.probability).fold(0.0, f64::max) - 1e-12);
+}
+
+/// One points-model query gives `P` under each of the paper's three
+/// aggregations: `point_aggregates` equals, bit for bit, the `probability`
+/// of a query asking for that aggregation, whichever aggregation (the
+/// `surface` one too) and surface family the first query asked for, from
+/// well apart through contact to deep overlap. The elements model and
+/// `decide_only` have none.
+#[test]
+fn one_points_query_gives_every_paper_aggregate() {
+    let (a, b) = spheres(1500);
+    let with = |surface, aggregation| CollisionRequest {
+        aggregation,
+        ..request(surface)
+    };
+    let paper = [
+        Aggregation::Max,
+        Aggregation::Union,
+        Aggregation::Independent,
+    ];
+    let mut nonzero = 0;
+    for gap in [-4.0 * SIGMA, -SIGMA, 0.0, SIGMA, 3.0 * SIGMA, 8.0 * SIGMA] {
+        let pose = sphere_pose(gap);
+        for surface in [Surface::Quadric, Surface::Linear] {
+            let own = |agg| collide(&Pose::identity(), &a, &pose, &b, &with(surface, agg));
+            let each: Vec<f64> = paper.iter().map(|&g| own(g).unwrap().probability).collect();
+            nonzero += usize::from(each[2] > each[0]);
+            for asked in [Aggregation::Max, Aggregation::Surface, Aggregation::Union] {
+                let r = own(asked).unwrap();
+                let got = r.point_aggregates.expect("a points-model query has them");
+                for (g, want) in paper.iter().zip(&each) {
+                    assert_eq!(
+                        got.get(*g).unwrap().to_bits(),
+                        want.to_bits(),
+                        "gap {gap}, {surface:?}, asked {asked:?}, {g:?}"
+                    );
+                }
+                assert_eq!(got.get(Aggregation::Surface), None);
+                if asked != Aggregation::Surface {
+                    assert_eq!(got.get(asked), Some(r.probability));
+                }
+            }
+        }
+    }
+    // The three differ somewhere (else the test could not tell them apart).
+    assert!(nonzero >= 4, "independent above max at {nonzero} cases");
+    let pose = sphere_pose(0.0);
+    let elements = CollisionRequest {
+        model: QueryModel::Elements,
+        ..CollisionRequest::default()
+    };
+    let decide = CollisionRequest {
+        decide_only: true,
+        ..request(Surface::Quadric)
+    };
+    for req in [elements, decide] {
+        let r = collide(&Pose::identity(), &a, &pose, &b, &req).unwrap();
+        assert_eq!(r.point_aggregates, None);
+    }
 }

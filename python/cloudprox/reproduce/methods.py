@@ -52,9 +52,11 @@ from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
 
 __all__ = [
     "AGGREGATIONS",
+    "PAPER_AGGREGATIONS",
     "Draw",
     "MethodAnswer",
     "cloudprox_answer",
+    "cloudprox_answers",
     "collision_map_answer",
     "nn_gap_answer",
     "reconstruct_answer",
@@ -74,6 +76,9 @@ THRESHOLD_FREE = CollisionRequest().threshold_free
 TIMED_QUERIES = 30
 #: The points model's aggregations: the surface one and the paper's three.
 AGGREGATIONS = ("surface", "max", "union", "independent")
+#: The paper's aggregations: one points-model query gives all three
+#: (``CollisionResult.point_aggregates``).
+PAPER_AGGREGATIONS = ("max", "union", "independent")
 
 
 @dataclass(frozen=True)
@@ -221,14 +226,45 @@ def cloudprox_answer(
     ``many`` replaces :func:`cloudprox.collide_many` (e.g.
     :func:`cloudprox.distributed.collide_many`: the same answers, as Ray tasks).
     """
+    return cloudprox_answers(draw, poses, surface, (aggregation,), model, many)[aggregation]
+
+
+def cloudprox_answers(
+    draw: Draw,
+    poses: FloatArray,
+    surface: str,
+    aggregations: tuple[str, ...],
+    model: str = "points",
+    many: Callable[..., list[CollisionResult]] | None = None,
+) -> dict[str, MethodAnswer]:
+    """Answer every pose under several aggregations with one query per pose.
+
+    The query asks for ``aggregations[0]``; the others must be the paper's
+    (``"max"``, ``"union"``, ``"independent"``, points model) and are read from
+    its ``point_aggregates``: exactly what a query asking for them returns, so
+    they share its time. See :func:`cloudprox_answer`.
+    """
+    first, *rest = aggregations
+    if rest and (model != "points" or not set(rest) <= set(PAPER_AGGREGATIONS)):
+        raise ValueError(
+            f"only the points model's {PAPER_AGGREGATIONS} can be read from one query, "
+            f"not {rest} with model {model!r}"
+        )
     piano, room = draw.clouds()
-    request = CollisionRequest(surface=surface, aggregation=aggregation, model=model)
+    request = CollisionRequest(surface=surface, aggregation=first, model=model)
     results = (many or collide_many)(piano, room, poses, request=request)
-    return MethodAnswer(
-        np.array([r.probability for r in results]),
-        np.array([r.state for r in results]),
-        np.array([r.stats.time_seconds for r in results]),
-    )
+    seconds = np.array([r.stats.time_seconds for r in results])
+    out = {
+        first: MethodAnswer(
+            np.array([r.probability for r in results]),
+            np.array([r.state for r in results]),
+            seconds,
+        )
+    }
+    for agg in rest:
+        scores = np.array([(r.point_aggregates or {})[agg] for r in results])
+        out[agg] = MethodAnswer(scores, states_from(scores), seconds)
+    return out
 
 
 def variant_name(model: str, surface: str, aggregation: str) -> str:

@@ -19,7 +19,7 @@ use crate::query::collide::probabilities::{
 };
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
-    CollisionRequest, CollisionResult, ContactPatch, QueryModel, QueryStats,
+    CollisionRequest, CollisionResult, ContactPatch, PointAggregates, QueryModel, QueryStats,
 };
 use crate::Real;
 
@@ -125,6 +125,7 @@ pub(crate) fn collide_with_workspace(
                 probabilities_a: vec![0.0; a.len()],
                 probabilities_b: vec![0.0; b.len()],
                 patches: Vec::new(),
+                point_aggregates: None,
                 stats,
             });
         }
@@ -342,6 +343,17 @@ pub(crate) fn collide_with_workspace(
         core_values(indexed_inputs(&touched.0, &inputs_a), &core.0)
             .chain(core_values(indexed_inputs(&touched.1, &inputs_b), &core.1)),
     );
+    // The points model's samples are its points: the same points, read for
+    // their Eq. 3 probabilities (the inputs themselves unless `surface`).
+    let point_aggregates = (elements.is_none() && !request.decide_only).then(|| {
+        let values: Vec<Real> = core_values(indexed_inputs(&touched.0, &probabilities_a), &core.0)
+            .chain(core_values(
+                indexed_inputs(&touched.1, &probabilities_b),
+                &core.1,
+            ))
+            .collect();
+        PointAggregates::of(&values)
+    });
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,
@@ -349,6 +361,7 @@ pub(crate) fn collide_with_workspace(
         probabilities_a,
         probabilities_b,
         patches,
+        point_aggregates,
         stats,
     })
 }

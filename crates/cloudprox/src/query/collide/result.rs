@@ -2,7 +2,7 @@
 
 use crate::classify::{Separator, SolveStatus, Surface};
 use crate::math::{Point3, Vector3};
-use crate::probability::CollisionState;
+use crate::probability::{Aggregation, CollisionState};
 use crate::Real;
 
 /// One classified patch of a near region (a connected group of near points,
@@ -109,6 +109,49 @@ pub struct CollisionResult {
     pub probabilities_b: Vec<Real>,
     /// The classified patches of the near regions.
     pub patches: Vec<ContactPatch>,
+    /// With the points model (not `decide_only`): `P` under each of the
+    /// paper's aggregations, from this query's per-point probabilities over
+    /// the points `P` aggregates. A points-model query asking for one of them
+    /// returns it as its `probability`, bit for bit, so one query gives all
+    /// three. `None` with the elements model (its `P` aggregates surface
+    /// crossings, not points) and with `decide_only` (no per-point
+    /// probabilities).
+    pub point_aggregates: Option<PointAggregates>,
     /// Counters and timings.
     pub stats: QueryStats,
+}
+
+/// The paper's three aggregates of one points-model query's per-point
+/// probabilities (see [`CollisionResult::point_aggregates`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointAggregates {
+    /// [`Aggregation::Max`].
+    pub max: Real,
+    /// [`Aggregation::Union`].
+    pub union: Real,
+    /// [`Aggregation::Independent`].
+    pub independent: Real,
+}
+
+impl PointAggregates {
+    /// The three aggregates of `probabilities`.
+    pub fn of(probabilities: &[Real]) -> Self {
+        let p = || probabilities.iter().copied();
+        Self {
+            max: Aggregation::Max.aggregate(p()),
+            union: Aggregation::Union.aggregate(p()),
+            independent: Aggregation::Independent.aggregate(p()),
+        }
+    }
+
+    /// The aggregate under `aggregation` (`None` for [`Aggregation::Surface`],
+    /// which reads the surfaces around the points, not their probabilities).
+    pub fn get(&self, aggregation: Aggregation) -> Option<Real> {
+        match aggregation {
+            Aggregation::Max => Some(self.max),
+            Aggregation::Union => Some(self.union),
+            Aggregation::Independent => Some(self.independent),
+            Aggregation::Surface => None,
+        }
+    }
 }
