@@ -1,6 +1,6 @@
 //! Axis-aligned bounding boxes.
 
-use crate::math::{Point3, Pose, Vector3};
+use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::Real;
 
 /// An axis-aligned box `[mins, maxs]`.
@@ -52,9 +52,14 @@ impl Aabb {
 
     /// The axis-aligned box (in the target frame) enclosing this box moved by `pose`.
     pub fn transformed(&self, pose: &Pose) -> Aabb {
-        let c = pose * self.center();
-        let r = pose.rotation.to_rotation_matrix();
-        let h = r.matrix().abs() * self.half_extents();
+        self.moved(&BoxMotion::new(pose))
+    }
+
+    /// [`Aabb::transformed`] by a motion prepared once for many boxes (the
+    /// same box, without turning the rotation into a matrix per box).
+    pub fn moved(&self, motion: &BoxMotion) -> Aabb {
+        let c = motion.pose * self.center();
+        let h = motion.abs_rotation * self.half_extents();
         Aabb {
             mins: c - h,
             maxs: c + h,
@@ -64,15 +69,48 @@ impl Aabb {
     /// Euclidean distance between the two boxes (0 when they overlap): a lower
     /// bound on the distance between any point of one and any point of the other.
     pub fn distance(&self, other: &Aabb) -> Real {
+        self.distance_squared(other).sqrt()
+    }
+
+    /// The square of [`Aabb::distance`] (no square root, for comparisons).
+    pub fn distance_squared(&self, other: &Aabb) -> Real {
         let gap = (self.mins - other.maxs)
             .sup(&(other.mins - self.maxs))
             .sup(&Vector3::zeros());
-        gap.norm()
+        gap.norm_squared()
     }
 
     /// Squared distance from a point to the box (0 inside).
     pub fn distance_squared_to_point(&self, p: &Point3) -> Real {
         let gap = (self.mins - p).sup(&(p - self.maxs)).sup(&Vector3::zeros());
         gap.norm_squared()
+    }
+}
+
+/// A rigid motion prepared for moving many boxes ([`Aabb::moved`]): the
+/// pose and the absolute values of its rotation matrix.
+#[derive(Debug, Clone, Copy)]
+pub struct BoxMotion {
+    pose: Pose,
+    abs_rotation: Matrix3,
+}
+
+impl BoxMotion {
+    /// The motion `pose`.
+    pub fn new(pose: &Pose) -> Self {
+        Self {
+            pose: *pose,
+            abs_rotation: pose.rotation.to_rotation_matrix().matrix().abs(),
+        }
+    }
+
+    /// Whether the rotation maps the axes onto the axes (a matrix of 0s and
+    /// ±1s, to rounding): a moved box's axis-aligned box is then the moved box
+    /// itself, and the gap between two boxes along one frame's axes is their
+    /// distance.
+    pub fn keeps_axes(&self) -> bool {
+        self.abs_rotation
+            .iter()
+            .all(|&x| x <= 1e-12 || x >= 1.0 - 1e-12)
     }
 }

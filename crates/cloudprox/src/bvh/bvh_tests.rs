@@ -230,3 +230,55 @@ fn parallel_build_equals_the_serial_build() {
         parallel.assert_well_formed(&pts, &sig);
     }
 }
+
+#[test]
+fn moved_boxes_enclose_the_moved_corners_and_bound_their_distance() {
+    use crate::bvh::{Aabb, BoxMotion};
+    use nalgebra::{Translation3, UnitQuaternion};
+    let b = Aabb {
+        mins: Point3::new(-0.1, 0.2, -0.3),
+        maxs: Point3::new(0.4, 0.25, 0.1),
+    };
+    let other = Aabb {
+        mins: Point3::new(1.0, 1.0, 1.0),
+        maxs: Point3::new(1.5, 1.2, 1.1),
+    };
+    let corners: Vec<Point3> = (0..8)
+        .map(|k| {
+            let pick = |bit: usize, lo: f64, hi: f64| if k & bit == 0 { lo } else { hi };
+            Point3::new(
+                pick(1, b.mins.x, b.maxs.x),
+                pick(2, b.mins.y, b.maxs.y),
+                pick(4, b.mins.z, b.maxs.z),
+            )
+        })
+        .collect();
+    for (k, angles) in [(0.0, 0.0, 0.0), (0.3, -1.1, 2.0), (1.2, 0.4, -0.7)]
+        .into_iter()
+        .enumerate()
+    {
+        let pose = Pose::from_parts(
+            Translation3::new(0.1 * k as f64, -0.2, 0.3),
+            UnitQuaternion::from_euler_angles(angles.0, angles.1, angles.2),
+        );
+        let motion = BoxMotion::new(&pose);
+        let moved = b.moved(&motion);
+        assert_eq!(moved, b.transformed(&pose));
+        for c in &corners {
+            assert!(moved.distance_squared_to_point(&(pose * c)) <= 1e-24);
+        }
+        // A lower bound on the distance of every moved corner to `other`.
+        let d = moved.distance(&other);
+        assert!((d * d - moved.distance_squared(&other)).abs() <= 1e-15);
+        for c in &corners {
+            assert!(other.distance_squared_to_point(&(pose * c)).sqrt() >= d - 1e-12);
+        }
+        assert_eq!(motion.keeps_axes(), k == 0, "{angles:?}");
+    }
+    // A quarter turn maps the axes onto the axes: the moved box is exact.
+    let quarter = Pose::from_parts(
+        Translation3::new(0.0, 0.0, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+    );
+    assert!(BoxMotion::new(&quarter).keeps_axes());
+}

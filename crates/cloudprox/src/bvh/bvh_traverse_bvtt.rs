@@ -1,7 +1,7 @@
 //! Simultaneous traversal of two hierarchies (the bounding volume test tree) with
 //! probabilistic pruning.
 
-use crate::bvh::{Bvh, BvhWorkspace};
+use crate::bvh::{BoxMotion, Bvh, BvhWorkspace};
 use crate::math::Pose;
 use crate::probability::normal_cdf;
 use crate::Real;
@@ -80,12 +80,13 @@ impl Bvh {
         let mut out = PairTraversal::default();
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
+        let motion = BoxMotion::new(pose);
         out.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.pair_stack,
             |ia, ib| {
                 let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
-                let gap = (na.aabb.transformed(pose).distance(&nb.aabb)
+                let gap = (na.aabb.moved(&motion).distance(&nb.aabb)
                     - margin(margin_self, ia).max(margin(margin_other, ib)))
                 .max(0.0);
                 let bound = prune_bound(

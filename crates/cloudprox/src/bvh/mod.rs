@@ -30,7 +30,7 @@ mod grid_knn;
 #[cfg(test)]
 mod bvh_tests;
 
-pub use aabb::Aabb;
+pub use aabb::{Aabb, BoxMotion};
 pub use bvh_traverse_bvtt::{prune_bound, PairTraversal};
 pub use bvh_tree::{Bvh, BvhNode, BvhSettings, BvhWorkspace};
 

@@ -16,7 +16,7 @@ use std::collections::BinaryHeap;
 use parry3d_f64::query;
 use parry3d_f64::shape::{TriMesh, Triangle};
 
-use crate::bvh::{Aabb, Bvh, BvhSettings};
+use crate::bvh::{Aabb, BoxMotion, Bvh, BvhSettings};
 use crate::error::Result;
 use crate::math::{Point3, Pose};
 use crate::Real;
@@ -60,9 +60,9 @@ impl TriangleTree {
         Ok(Self { tree, boxes })
     }
 
-    /// The box of node `id`'s triangles, moved by `pose`.
-    fn node_box(&self, id: u32, pose: &Pose) -> Aabb {
-        self.boxes[id as usize].transformed(pose)
+    /// The box of node `id`'s triangles, moved by `motion`.
+    fn node_box(&self, id: u32, motion: &BoxMotion) -> Aabb {
+        self.boxes[id as usize].moved(motion)
     }
 }
 
@@ -113,6 +113,7 @@ pub(crate) fn mesh_mesh_distance(
 ) -> Real {
     // In b's frame.
     let rel = pose_b.inverse() * pose_a;
+    let motion = BoxMotion::new(&rel);
     let id = Pose::identity();
     let moved = |i: u32| -> Triangle {
         let t = a.triangle(i);
@@ -122,7 +123,7 @@ pub(crate) fn mesh_mesh_distance(
     let mut best = Real::INFINITY;
     let mut heap = BinaryHeap::new();
     let pending = |i: u32, j: u32| Pending {
-        bound: ta.node_box(i, &rel).distance(&tb.boxes[j as usize]),
+        bound: ta.node_box(i, &motion).distance(&tb.boxes[j as usize]),
         a: i,
         b: j,
     };
