@@ -123,6 +123,42 @@ def test_nn_gap_equals_the_score_over_every_nearest_neighbour() -> None:
     assert two == pytest.approx(float(ndtr(2.0 - 0.7 / np.sqrt(0.02))), rel=1e-12)
 
 
+def test_one_points_query_answers_the_papers_three_aggregations() -> None:
+    from cloudprox.reproduce.methods import cloudprox_answer, cloudprox_answers
+    from cloudprox.reproduce.run import VARIANTS, _query_groups
+
+    # Every variant once; `max` asks and gives `union` and `independent`.
+    groups = _query_groups(VARIANTS)
+    assert sorted((k, a) for k, aggs in groups for a in aggs) == sorted(
+        ((mo, su), ag) for mo, su, ag in VARIANTS
+    )
+    assert (("points", "quadric"), ("max", "union", "independent")) in groups
+    assert (("points", "quadric"), ("surface",)) in groups
+    assert (("elements", "quadric"), ("max",)) in groups
+    # The read aggregates are what their own queries return, with the states.
+    rng = np.random.default_rng(3)
+    base = rng.normal(size=(600, 3))
+    base /= np.linalg.norm(base, axis=1, keepdims=True)
+    base *= 0.1
+    cov = np.broadcast_to(1e-6 * np.eye(3), (600, 3, 3)).copy()
+    draw = Draw(
+        base + rng.normal(scale=1e-3, size=base.shape),
+        cov,
+        base + rng.normal(scale=1e-3, size=base.shape),
+        cov,
+    )
+    poses = np.tile(np.eye(4), (6, 1, 1))
+    poses[:, 0, 3] = 0.2 + 1e-3 * np.array([-4.0, -1.0, 0.0, 1.0, 2.0, 6.0])
+    shared = cloudprox_answers(draw, poses, "quadric", ("max", "union", "independent"))
+    for agg in ("max", "union", "independent"):
+        own = cloudprox_answer(draw, poses, "quadric", agg)
+        np.testing.assert_array_equal(shared[agg].score, own.score)
+        np.testing.assert_array_equal(shared[agg].state, own.state)
+    assert (shared["union"].score > shared["max"].score).any()
+    with pytest.raises(ValueError, match="only the points model"):
+        cloudprox_answers(draw, poses, "quadric", ("max", "union"), model="elements")
+
+
 def test_sampling_spacing_of_a_grid_is_its_pitch() -> None:
     g = np.stack(np.meshgrid(np.arange(60) * 0.01, np.arange(60) * 0.01, [0.0]), -1).reshape(-1, 3)
     # 6th neighbour of a square grid at pitch h: sqrt(2) h, giving sqrt(2 pi / 6) h.
