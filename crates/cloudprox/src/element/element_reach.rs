@@ -257,8 +257,8 @@ pub(crate) fn surfaces_may_reach(
             // The gap along B's axes (A's box moved into B's frame), then,
             // when the motion turns the axes, along A's (B's box moved into
             // A's): each is a lower bound on the distance between the two
-            // boxes, and together they prune a third of the node pairs of
-            // randomly turned real meshes.
+            // boxes (on the real-mesh bench's turned poses at 0.5%, 12% fewer
+            // node pairs over all poses, 32% over those the hulls decide).
             let apart = |x: &Aabb, y: &Aabb| x.distance_squared(y) > limit * limit;
             !apart(&a.node_box[ia].moved(&motion), &b.node_box[ib])
                 && (same_axes || !apart(&b.node_box[ib].moved(&back), &a.node_box[ia]))
