@@ -85,24 +85,19 @@ pub(crate) fn fit_patch(
     // plate): offsets further apart than this belong to different surfaces.
     let split = (4.0 * sigma).max(0.5 * spacing);
     let stride = pts.len().div_ceil(64).max(1);
-    let (side_a, side_b) = (
-        AxialIndex::new(&pts[..na], axis),
-        AxialIndex::new(&pts[na..], axis),
-    );
     let separation = pts
         .iter()
         .step_by(stride)
         .filter_map(|x| {
-            let at = side_a.coordinates(x);
-            let sb = side_b.offset(at, radius, -1.0, split)?;
-            let sa = side_a.offset(at, radius, 1.0, split)?;
+            let sb = axial_offset(&pts[na..], x, axis, radius, -1.0, split)?;
+            let sa = axial_offset(&pts[..na], x, axis, radius, 1.0, split)?;
             Some(sb - sa)
         })
         .reduce(Real::min)
         .unwrap_or_else(|| {
-            let (at, inf) = (side_a.coordinates(&mid), Real::INFINITY);
-            side_b.offset(at, inf, -1.0, split).unwrap_or(0.0)
-                - side_a.offset(at, inf, 1.0, split).unwrap_or(0.0)
+            let inf = Real::INFINITY;
+            axial_offset(&pts[na..], &mid, axis, inf, -1.0, split).unwrap_or(0.0)
+                - axial_offset(&pts[..na], &mid, axis, inf, 1.0, split).unwrap_or(0.0)
         });
     Ok(PatchFit {
         classification,
@@ -128,161 +123,41 @@ pub(crate) fn mean(p: &[Point3]) -> Vector3 {
     p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }
 
-/// One side's points of a patch in coordinates of the separation axis:
-/// across it (`u`, `v`, an orthonormal pair perpendicular to the axis) and
-/// along it, sorted by `u` so that the points near a line along the axis are
-/// found by a binary search.
-struct AxialIndex {
-    frame: [Vector3; 3],
-    /// `(u, v, along)` of every point, by increasing `u`.
-    coords: Vec<[Real; 3]>,
-}
-
-impl AxialIndex {
-    fn new(pts: &[Point3], axis: &Vector3) -> Self {
-        // Any unit vector across the axis, then the third by the cross product.
-        let seed = if axis.x.abs() <= axis.y.abs() && axis.x.abs() <= axis.z.abs() {
-            Vector3::x()
-        } else if axis.y.abs() <= axis.z.abs() {
-            Vector3::y()
-        } else {
-            Vector3::z()
-        };
-        let u = axis.cross(&seed).normalize();
-        let v = axis.cross(&u);
-        let frame = [u, v, *axis];
-        let mut coords: Vec<[Real; 3]> = pts
-            .iter()
-            .map(|x| frame.map(|d| x.coords.dot(&d)))
-            .collect();
-        coords.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]));
-        Self { frame, coords }
-    }
-
-    /// `(u, v, along)` of `x`.
-    fn coordinates(&self, x: &Point3) -> [Real; 3] {
-        self.frame.map(|d| x.coords.dot(&d))
-    }
-
-    /// Where this side's surface crosses the line along the axis through the
-    /// point at `at` ([`AxialIndex::coordinates`]), as an offset along the
-    /// axis from that point: among the side's 12 points nearest the line
-    /// (within `radius` of it), sorted by their offset along the axis starting
-    /// from the end that faces the other cloud (`facing = +1`: the largest
-    /// offsets first), the median of the leading run of offsets less than
-    /// `split` apart, i.e. of the surface nearest the other cloud; `None` with
-    /// fewer than 3 points near the line or 2 in that run. Medians keep the
-    /// estimate unbiased by the noise on a flat contact.
-    fn offset(&self, at: [Real; 3], radius: Real, facing: Real, split: Real) -> Option<Real> {
-        let r2 = radius * radius;
-        // The points with `|u - u_at| <= radius` (a little more: the exact
-        // test below decides).
-        let reach = radius * (1.0 + 1e-9);
-        let lo = self.coords.partition_point(|c| c[0] < at[0] - reach);
-        let hi = self.coords.partition_point(|c| c[0] <= at[0] + reach);
-        let mut by_lateral: Vec<(Real, Real)> = self.coords[lo..hi]
-            .iter()
-            .filter_map(|c| {
-                let (du, dv) = (c[0] - at[0], c[1] - at[1]);
-                let lat = du * du + dv * dv;
-                (lat <= r2).then_some((lat, c[2] - at[2]))
-            })
-            .collect();
-        if by_lateral.len() < 3 {
-            return None;
-        }
-        let k = 12.min(by_lateral.len());
-        by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-        let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
-        along.sort_by(|a, b| b.total_cmp(a));
-        let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
-        if run < 2 {
-            return None;
-        }
-        Some(facing * along[run / 2])
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// [`AxialIndex::offset`] without the index: every point's lateral
-    /// distance from the line computed in 3-D.
-    fn brute_force(
-        pts: &[Point3],
-        point: &Point3,
-        axis: &Vector3,
-        radius: Real,
-        facing: Real,
-        split: Real,
-    ) -> Option<Real> {
-        let mut by_lateral: Vec<(Real, Real)> = pts
-            .iter()
-            .filter_map(|x| {
-                let d = x - point;
-                let along = d.dot(axis);
-                let lat = (d - axis * along).norm_squared();
-                (lat <= radius * radius).then_some((lat, along))
-            })
-            .collect();
-        if by_lateral.len() < 3 {
-            return None;
-        }
-        by_lateral.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut along: Vec<Real> = by_lateral.iter().take(12).map(|x| facing * x.1).collect();
-        along.sort_by(|a, b| b.total_cmp(a));
-        let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
-        (run >= 2).then(|| facing * along[run / 2])
-    }
-
-    #[test]
-    fn the_axial_index_finds_the_offsets_of_the_brute_force_search() {
-        // A wavy noisy sheet with a second sheet (a thin plate's far face)
-        // beneath part of it, seen along tilted axes.
-        let mut state = 7u64;
-        let mut rand = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as Real / (1u64 << 53) as Real
-        };
-        let mut pts = Vec::new();
-        for _ in 0..1500 {
-            let (x, y) = (rand() * 0.1, rand() * 0.1);
-            let z = 0.003 * (40.0 * x).sin() + 0.0005 * (rand() - 0.5);
-            pts.push(Point3::new(x, y, z));
-            if x > 0.05 {
-                pts.push(Point3::new(x, y, z - 0.004));
-            }
-        }
-        let (mut found, mut none) = (0, 0);
-        for (k, axis) in [
-            Vector3::z(),
-            Vector3::new(0.1, -0.2, 1.0).normalize(),
-            Vector3::new(-0.3, 0.05, -1.0).normalize(),
-            Vector3::new(1.0, 0.0, 0.0),
-        ]
+/// Where one side's surface crosses the line through `point` along `axis`: among
+/// the side's 12 points nearest that line (within `radius` of it), sorted by
+/// their offset along `axis` starting from the end that faces the other cloud
+/// (`facing = +1`: the largest offsets first), the median of the leading run of
+/// offsets less than `split` apart, i.e. of the surface nearest the other cloud;
+/// `None` with fewer than 3 points near the line or 2 in that run. Medians keep
+/// the estimate unbiased by the noise on a flat contact.
+fn axial_offset(
+    pts: &[Point3],
+    point: &Point3,
+    axis: &Vector3,
+    radius: Real,
+    facing: Real,
+    split: Real,
+) -> Option<Real> {
+    let r2 = radius * radius;
+    let mut by_lateral: Vec<(Real, Real)> = pts
         .iter()
-        .enumerate()
-        {
-            let index = AxialIndex::new(&pts, axis);
-            for (j, x) in pts.iter().enumerate().step_by(37) {
-                let facing = if (j + k) % 2 == 0 { 1.0 } else { -1.0 };
-                for radius in [0.002, 0.005, Real::INFINITY] {
-                    let fast = index.offset(index.coordinates(x), radius, facing, 0.002);
-                    let slow = brute_force(&pts, x, axis, radius, facing, 0.002);
-                    match (fast, slow) {
-                        (Some(f), Some(s)) => {
-                            assert!((f - s).abs() <= 1e-12, "{f} vs {s}");
-                            found += 1;
-                        }
-                        (None, None) => none += 1,
-                        other => panic!("axis {k}, point {j}, radius {radius}: {other:?}"),
-                    }
-                }
-            }
-        }
-        assert!(found > 300 && none > 20, "{found} found, {none} none");
+        .filter_map(|x| {
+            let d = x - point;
+            let along = d.dot(axis);
+            let lat = (d - axis * along).norm_squared();
+            (lat <= r2).then_some((lat, along))
+        })
+        .collect();
+    if by_lateral.len() < 3 {
+        return None;
     }
+    let k = 12.min(by_lateral.len());
+    by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
+    along.sort_by(|a, b| b.total_cmp(a));
+    let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
+    if run < 2 {
+        return None;
+    }
+    Some(facing * along[run / 2])
 }
