@@ -339,10 +339,6 @@ pub(crate) fn collide_with_workspace(
         t.sort_unstable();
         t.dedup();
     }
-    let probability = request.aggregation.aggregate(
-        core_values(indexed_inputs(&touched.0, &inputs_a), &core.0)
-            .chain(core_values(indexed_inputs(&touched.1, &inputs_b), &core.1)),
-    );
     // The points model's samples are its points: the same points, read for
     // their Eq. 3 probabilities (the inputs themselves unless `surface`).
     let point_aggregates = (elements.is_none() && !request.decide_only).then(|| {
@@ -354,6 +350,16 @@ pub(crate) fn collide_with_workspace(
             .collect();
         PointAggregates::of(&values)
     });
+    // A paper aggregation of the points model is one of those (the same
+    // values in the same order); otherwise the inputs are aggregated.
+    let probability = point_aggregates
+        .and_then(|g| g.get(request.aggregation))
+        .unwrap_or_else(|| {
+            request.aggregation.aggregate(
+                core_values(indexed_inputs(&touched.0, &inputs_a), &core.0)
+                    .chain(core_values(indexed_inputs(&touched.1, &inputs_b), &core.1)),
+            )
+        });
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,
