@@ -109,6 +109,7 @@ def test_collide_with_pose_and_options(capsys, npy_files) -> None:
         (["collide", "{a}", "{b}"], "--sigma"),
         (["demo", "--sigma", "0"], "--sigma must be finite and > 0"),
         (["bench", "--repeat", "0"], "--repeat"),
+        (["reproduce", "--workers", "0"], "--workers must be >= 1, got 0"),
         (["frobnicate"], "invalid choice"),
         ([], "a command is required"),
     ],

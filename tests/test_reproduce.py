@@ -124,18 +124,29 @@ def test_nn_gap_equals_the_score_over_every_nearest_neighbour() -> None:
 
 
 def test_one_points_query_answers_the_papers_three_aggregations() -> None:
-    from cloudprox.reproduce.methods import cloudprox_answer, cloudprox_answers
-    from cloudprox.reproduce.run import VARIANTS, _query_groups
-
-    # Every variant once; `max` asks and gives `union` and `independent`.
-    groups = _query_groups(VARIANTS)
-    assert sorted((k, a) for k, aggs in groups for a in aggs) == sorted(
-        ((mo, su), ag) for mo, su, ag in VARIANTS
+    from cloudprox.reproduce.methods import (
+        cloudprox_answer,
+        cloudprox_answers,
+        query_groups,
+        timed_subset,
     )
-    assert (("points", "quadric"), ("max", "union", "independent")) in groups
-    assert (("points", "quadric"), ("surface",)) in groups
+    from cloudprox.reproduce.run import SCAN_VARIANTS, VARIANTS
+
+    # Every variant once; one points query per surface family, asking `surface`.
+    for variants in (VARIANTS, SCAN_VARIANTS):
+        groups = query_groups(variants)
+        assert sorted((k, a) for k, aggs in groups for a in aggs) == sorted(
+            ((mo, su), ag) for mo, su, ag in variants
+        )
+    groups = query_groups(VARIANTS)
+    assert (("points", "quadric"), ("surface", "max", "union", "independent")) in groups
+    assert (("points", "linear"), ("surface", "max")) in groups
     assert (("elements", "quadric"), ("max",)) in groups
-    # The read aggregates are what their own queries return, with the states.
+    assert query_groups((("points", "quadric", "union"), ("points", "quadric", "max"))) == [
+        (("points", "quadric"), ("max", "union"))
+    ]
+    # The read aggregates are what their own queries return, with the states,
+    # whether the query asks `max` or `surface`.
     rng = np.random.default_rng(3)
     base = rng.normal(size=(600, 3))
     base /= np.linalg.norm(base, axis=1, keepdims=True)
@@ -147,16 +158,58 @@ def test_one_points_query_answers_the_papers_three_aggregations() -> None:
         base + rng.normal(scale=1e-3, size=base.shape),
         cov,
     )
-    poses = np.tile(np.eye(4), (6, 1, 1))
-    poses[:, 0, 3] = 0.2 + 1e-3 * np.array([-4.0, -1.0, 0.0, 1.0, 2.0, 6.0])
-    shared = cloudprox_answers(draw, poses, "quadric", ("max", "union", "independent"))
-    for agg in ("max", "union", "independent"):
-        own = cloudprox_answer(draw, poses, "quadric", agg)
-        np.testing.assert_array_equal(shared[agg].score, own.score)
-        np.testing.assert_array_equal(shared[agg].state, own.state)
-    assert (shared["union"].score > shared["max"].score).any()
+    poses = np.tile(np.eye(4), (40, 1, 1))
+    poses[:, 0, 3] = 0.2 + 1e-3 * np.linspace(-4.0, 6.0, 40)
+    paper = ("max", "union", "independent")
+    by_max = cloudprox_answers(draw, poses, "quadric", paper)
+    by_surface = cloudprox_answers(draw, poses, "quadric", ("surface", *paper))
+    own = {agg: cloudprox_answer(draw, poses, "quadric", agg) for agg in ("surface", *paper)}
+    for shared in (by_max, by_surface):
+        for agg in shared:
+            np.testing.assert_array_equal(shared[agg].score, own[agg].score)
+            np.testing.assert_array_equal(shared[agg].state, own[agg].state)
+    assert (by_max["union"].score > by_max["max"].score).any()
+    # A `max` query's paper aggregates share its times; a `surface` query's
+    # are their own `max` query's, on the timed subset only (here all 40).
+    np.testing.assert_array_equal(by_max["union"].seconds, by_max["max"].seconds)
+    assert np.isfinite(by_surface["max"].seconds).all()
+    assert not np.array_equal(by_surface["max"].seconds, by_surface["surface"].seconds)
+    timed = timed_subset(5000)
+    assert len(timed) == 625 and timed[1] == 8
+    assert len(timed_subset(100)) == 34 and len(timed_subset(20)) == 20
     with pytest.raises(ValueError, match="only the points model"):
         cloudprox_answers(draw, poses, "quadric", ("max", "union"), model="elements")
+
+
+def test_point_baselines_in_a_process_pool_answer_as_in_one_process() -> None:
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from cloudprox.reproduce.methods import POINT_BASELINES, point_baseline_answers
+
+    rng = np.random.default_rng(5)
+    a = rng.uniform(-0.1, 0.1, size=(300, 3))
+    b = rng.uniform(-0.1, 0.1, size=(400, 3))
+    cov = lambda n: np.broadcast_to(4e-6 * np.eye(3), (n, 3, 3)).copy()  # noqa: E731
+    draws = [Draw(a, cov(300), b, cov(400)), Draw(a + 1e-3, cov(300), b, cov(400))]
+    poses = np.tile(np.eye(4), (7, 1, 1))
+    poses[:, 0, 3] = np.linspace(0.0, 0.25, 7)
+    alone = point_baseline_answers(draws, poses, 0.01)
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        pooled = point_baseline_answers(draws, poses, 0.01, pool, workers=3)
+    assert list(pooled) == list(POINT_BASELINES)
+    for name in POINT_BASELINES:
+        assert len(pooled[name]) == 2
+        for x, y in zip(alone[name], pooled[name], strict=True):
+            np.testing.assert_array_equal(x.score, y.score)
+            np.testing.assert_array_equal(x.state, y.state)
+            assert y.seconds.shape == (7,) and (y.seconds > 0.0).all()
+    # The poses span free to overlapping: the answers are not all alike.
+    assert len(set(pooled["collision-map"][0].state)) == 2
+    with pytest.raises(ValueError, match="unknown baseline"):
+        from cloudprox.reproduce.methods import _point_baseline
+
+        _point_baseline("octomap", draws[0], poses, 0.01)
 
 
 def test_sampling_spacing_of_a_grid_is_its_pitch() -> None:

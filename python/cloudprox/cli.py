@@ -15,7 +15,7 @@
     Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 ``cloudprox bench``
     cloudprox against a nearest-neighbour baseline and python-fcl on the same clouds.
-``cloudprox reproduce [--quick] [--out DIR] [--ray [ADDRESS]]``
+``cloudprox reproduce [--quick] [--out DIR] [--workers N] [--ray [ADDRESS]]``
     The paper's experiments against exact ground truth and the baselines: figures,
     a metrics table and the raw per-query results.
 
@@ -726,6 +726,8 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         if args.points < 500:
             raise CliError(f"--points must be >= 500, got {args.points}")
         config = replace(config, piano_points=args.points)
+    if args.workers is not None and args.workers < 1:
+        raise CliError(f"--workers must be >= 1, got {args.workers}")
     out = Path(args.out)
     many = None
     if args.ray is not None:
@@ -767,7 +769,11 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     ) as bar:
         task = bar.add_task("starting", total=steps(config))
         summary = run(
-            config, out, lambda desc, n: bar.update(task, advance=n, description=desc), many
+            config,
+            out,
+            lambda desc, n: bar.update(task, advance=n, description=desc),
+            many,
+            args.workers,
         )
     table = Table(
         title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma / "
@@ -1099,6 +1105,13 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         default=None,
         help="gripper poses on the real Kinect frame (overrides; 0 skips the experiment)",
+    )
+    rep.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="processes for the Python baselines (default: the CPUs available; "
+        "1: in this process); the answers do not depend on it",
     )
     rep.add_argument(
         "--ray",

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,16 +54,20 @@ from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
 __all__ = [
     "AGGREGATIONS",
     "PAPER_AGGREGATIONS",
+    "POINT_BASELINES",
     "Draw",
     "MethodAnswer",
     "cloudprox_answer",
     "cloudprox_answers",
     "collision_map_answer",
     "nn_gap_answer",
+    "point_baseline_answers",
+    "query_groups",
     "reconstruct_answer",
     "sampling_spacing",
     "sphere_union_answer",
     "states_from",
+    "timed_subset",
     "variant_name",
 ]
 
@@ -72,8 +77,13 @@ FloatArray = npt.NDArray[np.float64]
 #: core's defaults (``CollisionRequest()``).
 THRESHOLD_COLLISION = CollisionRequest().threshold_collision
 THRESHOLD_FREE = CollisionRequest().threshold_free
-#: Queries of the reconstruction baseline timed one by one.
+#: Queries of the reconstruction baseline timed one by one (and the fewest
+#: :func:`timed_subset` gives).
 TIMED_QUERIES = 30
+#: Share of the poses whose queries :func:`timed_subset` times (one in this many).
+TIMED_SHARE = 8
+#: The baselines on the points themselves (:func:`point_baseline_answers`).
+POINT_BASELINES = ("nn-gap", "collision-map", "spheres")
 #: The points model's aggregations: the surface one and the paper's three.
 AGGREGATIONS = ("surface", "max", "union", "independent")
 #: The paper's aggregations: one points-model query gives all three
@@ -241,8 +251,12 @@ def cloudprox_answers(
 
     The query asks for ``aggregations[0]``; the others must be the paper's
     (``"max"``, ``"union"``, ``"independent"``, points model) and are read from
-    its ``point_aggregates``: exactly what a query asking for them returns, so
-    they share its time. See :func:`cloudprox_answer`.
+    its ``point_aggregates``: exactly what a query asking for them returns (the
+    points model trains the same surfaces under every aggregation). They share
+    its time when it asks for ``max``; when it asks for ``surface`` (which
+    costs more), their time is that of their own ``max`` query on every
+    :func:`timed_subset` pose (``nan`` for the others). See
+    :func:`cloudprox_answer`.
     """
     first, *rest = aggregations
     if rest and (model != "points" or not set(rest) <= set(PAPER_AGGREGATIONS)):
@@ -261,9 +275,52 @@ def cloudprox_answers(
             seconds,
         )
     }
+    if rest and first not in PAPER_AGGREGATIONS:
+        timed = timed_subset(len(poses))
+        own = (many or collide_many)(
+            piano,
+            room,
+            poses[timed],
+            request=CollisionRequest(surface=surface, aggregation="max", model=model),
+        )
+        seconds = np.full(len(poses), np.nan)
+        seconds[timed] = [r.stats.time_seconds for r in own]
     for agg in rest:
         scores = np.array([(r.point_aggregates or {})[agg] for r in results])
         out[agg] = MethodAnswer(scores, states_from(scores), seconds)
+    return out
+
+
+def timed_subset(n: int) -> npt.NDArray[np.intp]:
+    """Return the indices of the poses (of ``n``) whose queries are timed on their own.
+
+    Every ``TIMED_SHARE``-th pose, and at least :data:`TIMED_QUERIES` (all when
+    fewer): a median's estimate within a few percent at the full run's 5000
+    poses (625 timed), at an eighth of the queries' cost.
+    """
+    step = max(1, min(TIMED_SHARE, n // TIMED_QUERIES))
+    return np.arange(0, n, step)
+
+
+def query_groups(
+    variants: tuple[tuple[str, str, str], ...],
+) -> list[tuple[tuple[str, str], tuple[str, ...]]]:
+    """Group ``variants`` into queries, one per (model, surface, asked aggregation).
+
+    One points-model query per surface family gives every aggregation: it asks
+    for ``surface`` (else ``max``), and the paper's ``max``, ``union`` and
+    ``independent`` are its ``point_aggregates`` (the same numbers as their own
+    queries; see :func:`cloudprox_answers` for their times).
+    """
+    groups: dict[tuple[str, str, str], list[str]] = {}
+    for model, surface, agg in variants:
+        key = (model, surface, "one" if model == "points" else agg)
+        groups.setdefault(key, []).append(agg)
+    out = []
+    for (model, surface, _), aggs in groups.items():
+        # The query asks for `surface` when it is among them, else `max`.
+        aggs.sort(key=lambda a: (a != "surface", a != "max"))
+        out.append(((model, surface), tuple(aggs)))
     return out
 
 
@@ -337,3 +394,63 @@ def collision_map_answer(draw: Draw, poses: FloatArray, resolution: float) -> Me
 def sphere_union_answer(draw: Draw, poses: FloatArray, radius: float) -> MethodAnswer:
     """Spheres of one ``radius`` on every point; collision iff two overlap."""
     return _overlap_answer(draw, poses, 2.0 * radius, 2.0)
+
+
+def _point_baseline(method: str, draw: Draw, poses: FloatArray, spacing: float) -> MethodAnswer:
+    """One of :data:`POINT_BASELINES` on ``poses`` (a pool's task)."""
+    if method == "nn-gap":
+        return nn_gap_answer(draw, poses)
+    if method == "collision-map":
+        return collision_map_answer(draw, poses, spacing)
+    if method == "spheres":
+        return sphere_union_answer(draw, poses, spacing / np.sqrt(2.0))
+    raise ValueError(f"unknown baseline {method!r}; expected one of {POINT_BASELINES}")
+
+
+def point_baseline_answers(
+    draws: list[Draw],
+    poses: FloatArray,
+    spacing: float,
+    pool: Executor | None = None,
+    workers: int = 1,
+) -> dict[str, list[MethodAnswer]]:
+    """nn-gap, collision map and spheres (cell side ``spacing``) for every draw.
+
+    With ``pool`` (e.g. a process pool of ``workers``), each draw's poses are
+    split into ``workers`` runs of consecutive poses, each a task: every pose
+    is answered and timed on its own, so the answers are those of one process
+    (the times are each worker's). Returns per method one answer per draw.
+    """
+    if pool is None or workers <= 1:
+        return {b: [_point_baseline(b, d, poses, spacing) for d in draws] for b in POINT_BASELINES}
+    chunks = [c for c in np.array_split(np.arange(len(poses)), workers) if len(c)]
+    # A draw's own arrays only (its cache of trees is rebuilt by each task).
+    bare = [
+        Draw(
+            d.piano_points,
+            d.piano_sensor_cov,
+            d.room_points,
+            d.room_sensor_cov,
+            d.room_noise_correlation,
+        )
+        for d in draws
+    ]
+    futures = {
+        (b, k, i): pool.submit(_point_baseline, b, d, poses[c], spacing)
+        for b in POINT_BASELINES
+        for k, d in enumerate(bare)
+        for i, c in enumerate(chunks)
+    }
+    out: dict[str, list[MethodAnswer]] = {}
+    for b in POINT_BASELINES:
+        out[b] = []
+        for k in range(len(draws)):
+            parts = [futures[(b, k, i)].result() for i in range(len(chunks))]
+            out[b].append(
+                MethodAnswer(
+                    np.concatenate([x.score for x in parts]),
+                    np.concatenate([x.state for x in parts]),
+                    np.concatenate([x.seconds for x in parts]),
+                )
+            )
+    return out

@@ -42,8 +42,8 @@ units of each pose's sigma.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Any
 
@@ -301,11 +301,15 @@ def run_scan(
     variants: tuple[tuple[str, str, str], ...],
     tick: Callable[[str, int], None],
     many: Callable[..., Any] | None = None,
+    pool: Executor | None = None,
+    workers: int = 1,
 ) -> ScanResult:
     """Run every method on the Kinect frame with ``n_poses`` gripper poses.
 
     ``tick(description, advance)`` reports progress (:data:`SCAN_STEPS` steps);
-    ``many`` replaces ``cloudprox.collide_many`` in cloudprox's queries.
+    ``many`` replaces ``cloudprox.collide_many`` in cloudprox's queries;
+    ``pool`` (of ``workers`` processes) runs the point baselines
+    (:func:`cloudprox.reproduce.methods.point_baseline_answers`).
     """
     rng = np.random.default_rng(seed)
     frame = load_kinect_frame()
@@ -345,15 +349,14 @@ def run_scan(
         )
     spacing = m.sampling_spacing(draws[0].room_points)
     answers: dict[str, list[m.MethodAnswer]] = {}
-    for model, surface, agg in variants:
-        key = m.variant_name(model, surface, agg)
-        answers[key] = [m.cloudprox_answer(d, q.poses, surface, agg, model, many) for d in draws]
-        tick(f"kinect: {key}", 1)
-    answers["nn-gap"] = [m.nn_gap_answer(d, q.poses) for d in draws]
-    answers["collision-map"] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
-    answers["spheres"] = [
-        m.sphere_union_answer(d, q.poses, spacing / math.sqrt(2.0)) for d in draws
-    ]
+    for (model, surface), aggs in m.query_groups(variants):
+        per_draw = [m.cloudprox_answers(d, q.poses, surface, aggs, model, many) for d in draws]
+        for agg in aggs:
+            answers[m.variant_name(model, surface, agg)] = [x[agg] for x in per_draw]
+        tick(f"kinect: cloudprox {model} {surface} {'/'.join(aggs)}", len(aggs))
+    # In the order of `variants` (the table's).
+    answers = {m.variant_name(*v): answers[m.variant_name(*v)] for v in variants}
+    answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
     if reconstruction_available():
         answers["reconstruct"] = []
         for d in draws:

@@ -18,8 +18,12 @@ from __future__ import annotations
 import csv
 import json
 import math
+import multiprocessing
+import os
 import time
 from collections.abc import Callable
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -127,28 +131,6 @@ class Summary:
     seconds: float = 0.0
     notes: list[str] = field(default_factory=list)
     scan_facts: dict[str, float] = field(default_factory=dict)
-
-
-def _query_groups(
-    variants: tuple[tuple[str, str, str], ...],
-) -> list[tuple[tuple[str, str], tuple[str, ...]]]:
-    """Group ``variants`` into queries, one per (model, surface, aggregation).
-
-    The points model's ``max`` query also gives ``union`` and ``independent``
-    (its ``point_aggregates``: the same numbers as their own queries, in the
-    same time).
-    """
-    groups: dict[tuple[str, str, str], list[str]] = {}
-    for model, surface, agg in variants:
-        shared = model == "points" and agg in m.PAPER_AGGREGATIONS
-        key = (model, surface, "paper" if shared else agg)
-        groups.setdefault(key, []).append(agg)
-    out = []
-    for (model, surface, _), aggs in groups.items():
-        # The query asks for `max` when it is among them (its time is `max`'s).
-        aggs.sort(key=lambda a: a != "max")
-        out.append(((model, surface), tuple(aggs)))
-    return out
 
 
 def _level_name(share: float, anisotropic: bool) -> str:
@@ -264,6 +246,7 @@ def run(
     out: Path,
     progress: Callable[[str, int], None] | None = None,
     many: Callable[..., Any] | None = None,
+    workers: int | None = None,
 ) -> Summary:
     """Run every method at every level and write the outputs into ``out``.
 
@@ -279,11 +262,35 @@ def run(
     many : callable, optional
         Replaces :func:`cloudprox.collide_many` in cloudprox's queries (e.g.
         :func:`cloudprox.distributed.collide_many`, the same answers as Ray tasks).
+    workers : int, optional
+        Processes for the Python baselines (default: the CPUs this process may
+        use; 1: in this process). The answers do not depend on it.
 
     Returns
     -------
     Summary
     """
+    workers = workers or len(os.sched_getaffinity(0))
+    with ExitStack() as stack:
+        pool = (
+            stack.enter_context(
+                ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+            )
+            if workers > 1
+            else None
+        )
+        return _run(config, out, progress, many, pool, workers)
+
+
+def _run(
+    config: Config,
+    out: Path,
+    progress: Callable[[str, int], None] | None,
+    many: Callable[..., Any] | None,
+    pool: Executor | None,
+    workers: int,
+) -> Summary:
+    """:func:`run` with the baselines' process ``pool`` (``None``: in this process)."""
     t0 = time.perf_counter()
     tick = progress or (lambda _d, _n: None)
     out.mkdir(parents=True, exist_ok=True)
@@ -322,18 +329,14 @@ def run(
             draws.append(d)
         tick(f"{name}: noise draws", 1)
         answers: dict[str, list[m.MethodAnswer]] = {}
-        for (model, surface), aggs in _query_groups(VARIANTS):
+        for (model, surface), aggs in m.query_groups(VARIANTS):
             per_draw = [m.cloudprox_answers(d, q.poses, surface, aggs, model, many) for d in draws]
             for agg in aggs:
                 answers[m.variant_name(model, surface, agg)] = [x[agg] for x in per_draw]
             tick(f"{name}: cloudprox {model} {surface} {'/'.join(aggs)}", len(aggs))
         # In the order of VARIANTS (the table's).
         answers = {m.variant_name(*v): answers[m.variant_name(*v)] for v in VARIANTS}
-        answers[NN] = [m.nn_gap_answer(d, q.poses) for d in draws]
-        answers[MAP] = [m.collision_map_answer(d, q.poses, spacing) for d in draws]
-        answers[SPHERES] = [
-            m.sphere_union_answer(d, q.poses, spacing / math.sqrt(2.0)) for d in draws
-        ]
+        answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
         if with_reconstruction:
             answers[RECON] = [m.reconstruct_answer(d, q.poses, spacing, sigma) for d in draws]
         tick(f"{name}: baselines", 1)
@@ -367,7 +370,7 @@ def run(
             "which needs Open3D"
         )
     if config.scan_poses > 0 and with_reconstruction:
-        scan = run_scan(config.scan_poses, config.seed, SCAN_VARIANTS, tick, many)
+        scan = run_scan(config.scan_poses, config.seed, SCAN_VARIANTS, tick, many, pool, workers)
         summary.scan_facts = scan.facts
         unit = scan.poses.signed_distance / scan.poses.sigma
         for method, sc in scan.scores.items():
