@@ -174,11 +174,48 @@ def test_one_points_query_answers_the_papers_three_aggregations() -> None:
     np.testing.assert_array_equal(by_max["union"].seconds, by_max["max"].seconds)
     assert np.isfinite(by_surface["max"].seconds).all()
     assert not np.array_equal(by_surface["max"].seconds, by_surface["surface"].seconds)
-    timed = timed_subset(5000)
-    assert len(timed) == 625 and timed[1] == 8
-    assert len(timed_subset(1000)) == 200 and len(timed_subset(100)) == 100
+    # Ranked by the other query's times: a systematic sample over them.
+    times = np.random.default_rng(1).lognormal(size=5000)
+    timed = timed_subset(times)
+    assert len(timed) == 625 and len(np.unique(timed)) == 625
+    ranks = np.argsort(np.argsort(times))[timed]
+    np.testing.assert_array_equal(np.sort(ranks), np.arange(4, 5000, 8))
+    assert np.median(times[timed]) == pytest.approx(np.median(times), rel=0.02)
+    assert len(timed_subset(times[:1000])) == 200 and len(timed_subset(times[:100])) == 100
     with pytest.raises(ValueError, match="only the points model"):
         cloudprox_answers(draw, poses, "quadric", ("max", "union"), model="elements")
+
+
+def test_paper_aggregates_off_the_timed_poses_have_no_time(monkeypatch, tmp_path) -> None:
+    from cloudprox.reproduce import methods
+    from cloudprox.reproduce.metrics import compute_metrics
+    from cloudprox.reproduce.run import Config, run
+
+    monkeypatch.setattr(methods, "TIMED_LEAST", 10)
+    rng = np.random.default_rng(4)
+    pts = rng.uniform(-0.1, 0.1, size=(300, 3))
+    cov = np.broadcast_to(1e-6 * np.eye(3), (300, 3, 3)).copy()
+    draw = Draw(pts, cov, pts + 1e-3, cov)
+    poses = np.tile(np.eye(4), (40, 1, 1))
+    poses[:, 0, 3] = np.linspace(-0.05, 0.3, 40)
+    got = methods.cloudprox_answers(draw, poses, "quadric", ("surface", "max", "union"))
+    timed = methods.timed_subset(got["surface"].seconds)
+    assert len(timed) == 10
+    for agg in ("max", "union"):
+        sec = got[agg].seconds
+        assert np.isfinite(sec[timed]).all() and (sec[timed] > 0.0).all()
+        assert np.isnan(np.delete(sec, timed)).all()
+    assert np.isfinite(got["surface"].seconds).all()
+    mt = compute_metrics(
+        got["max"].score[None],
+        got["max"].state[None],
+        got["max"].seconds[None],
+        poses[:, 0, 3] - 0.2,
+        0.01,
+    )
+    assert mt.median_ms == pytest.approx(1e3 * np.median(got["max"].seconds[timed]))
+    with pytest.raises(ValueError, match="workers must be >= 1, got 0"):
+        run(Config.quick(), tmp_path, workers=0)
 
 
 def test_point_baselines_in_a_process_pool_answer_as_in_one_process() -> None:

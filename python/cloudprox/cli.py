@@ -711,7 +711,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
-    from cloudprox.reproduce.run import Config, run, steps
+    from cloudprox.reproduce.run import Config, available_cpus, run, steps
 
     config = Config.quick() if args.quick else Config()
     if args.poses is not None:
@@ -773,7 +773,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
             out,
             lambda desc, n: bar.update(task, advance=n, description=desc),
             many,
-            args.workers,
+            args.workers or available_cpus(),
         )
     table = Table(
         title="Near-contact AUC / decided accuracy / undecided / hard flips / FP > 3 sigma / "

@@ -2,9 +2,10 @@
 
 Every method answers a batch of piano poses against one draw of the two clouds
 with a score (higher = more likely in collision), a state (``"free"``,
-``"contact"``, ``"collision"``) and a time per query (seconds). Preparation that a
-user does once per cloud (trees, hierarchies, reconstructions) is not timed per
-query.
+``"contact"``, ``"collision"``) and a time per query (seconds; ``nan`` for a query
+answered but not timed on its own, see :func:`cloudprox_answers`). Preparation
+that a user does once per cloud (trees, hierarchies, reconstructions) is not
+timed per query.
 
 Baselines, each with parameters set from the data, not tuned to the scene:
 
@@ -33,7 +34,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -68,6 +69,7 @@ __all__ = [
     "sphere_union_answer",
     "states_from",
     "timed_subset",
+    "variant_answers",
     "variant_name",
 ]
 
@@ -102,7 +104,8 @@ class MethodAnswer:
     state : ndarray of str, shape (m,)
         ``"free"``, ``"contact"`` or ``"collision"``.
     seconds : ndarray, shape (m,)
-        Time per query.
+        Time per query (``nan`` where a query was answered but not timed on
+        its own).
     """
 
     score: FloatArray
@@ -254,8 +257,8 @@ def cloudprox_answers(
     its ``point_aggregates``: exactly what a query asking for them returns (the
     points model trains the same surfaces under every aggregation). They share
     its time when it asks for ``max``; when it asks for ``surface`` (which
-    costs more), their time is that of their own ``max`` query on every
-    :func:`timed_subset` pose (``nan`` for the others). See
+    costs more), their time is that of their own ``max`` query on the
+    :func:`timed_subset` poses (``nan`` for the others). See
     :func:`cloudprox_answer`.
     """
     first, *rest = aggregations
@@ -276,7 +279,7 @@ def cloudprox_answers(
         )
     }
     if rest and first not in PAPER_AGGREGATIONS:
-        timed = timed_subset(len(poses))
+        timed = timed_subset(seconds)
         own = (many or collide_many)(
             piano,
             room,
@@ -291,16 +294,24 @@ def cloudprox_answers(
     return out
 
 
-def timed_subset(n: int) -> npt.NDArray[np.intp]:
-    """Return the indices of the poses (of ``n``) whose queries are timed on their own.
+def timed_subset(seconds: FloatArray) -> npt.NDArray[np.intp]:
+    """Return the poses whose queries are timed on their own, given another query's times.
 
-    Every :data:`TIMED_SHARE`-th pose, but at least :data:`TIMED_LEAST` (all of
-    fewer): query times spread over three decades, so a median needs a few
-    hundred of them (on 100 poses of the quick run, a third of them gave 0.3 to
-    1.8 times the median of all); the full run's 5000 poses time 625 per draw.
+    ``seconds`` are the times of a query that does the same work and more (the
+    points model's ``surface`` query for its ``max``). The poses are ranked by
+    them and every :data:`TIMED_SHARE`-th is taken from the middle of its run
+    of ranks, at least :data:`TIMED_LEAST` (all of fewer): a systematic sample
+    over a correlated time, whose median follows the median of all. Query
+    times spread over three decades, and the median of every 8th pose in
+    index order was 25% below to 19% above the median of all in the full
+    run's levels (of the ``surface`` query's own times); ranked by the other
+    surface family's times, within 5%. The full run's 5000 poses time 625
+    per draw.
     """
+    n = len(seconds)
     step = max(1, min(TIMED_SHARE, n // TIMED_LEAST))
-    return np.arange(0, n, step)
+    ranks = np.arange(step // 2, n, step)
+    return np.sort(np.argsort(seconds, kind="stable")[ranks])
 
 
 def query_groups(
@@ -309,7 +320,7 @@ def query_groups(
     """Group ``variants`` into queries, one per (model, surface, asked aggregation).
 
     One points-model query per surface family gives every aggregation: it asks
-    for ``surface`` (else ``max``), and the paper's ``max``, ``union`` and
+    for ``surface`` (else ``max``, else the first given), and the paper's ``max``, ``union`` and
     ``independent`` are its ``point_aggregates`` (the same numbers as their own
     queries; see :func:`cloudprox_answers` for their times).
     """
@@ -323,6 +334,30 @@ def query_groups(
         aggs.sort(key=lambda a: (a != "surface", a != "max"))
         out.append(((model, surface), tuple(aggs)))
     return out
+
+
+def variant_answers(
+    draws: list[Draw],
+    poses: FloatArray,
+    variants: tuple[tuple[str, str, str], ...],
+    many: Callable[..., list[CollisionResult]] | None,
+    tick: Callable[[str, int], None],
+    label: str,
+) -> dict[str, list[MethodAnswer]]:
+    """Answer every (model, surface, aggregation) of ``variants`` for every draw.
+
+    One query per :func:`query_groups` group and draw; keyed by
+    :func:`variant_name`, in the order of ``variants``. ``tick(description,
+    advance)`` reports each group (one step per variant), ``label`` starting
+    its description.
+    """
+    answers: dict[str, list[MethodAnswer]] = {}
+    for (model, surface), aggs in query_groups(variants):
+        per_draw = [cloudprox_answers(d, poses, surface, aggs, model, many) for d in draws]
+        for agg in aggs:
+            answers[variant_name(model, surface, agg)] = [x[agg] for x in per_draw]
+        tick(f"{label}: cloudprox {model} {surface} {'/'.join(aggs)}", len(aggs))
+    return {variant_name(*v): answers[variant_name(*v)] for v in variants}
 
 
 def variant_name(model: str, surface: str, aggregation: str) -> str:
@@ -422,20 +457,11 @@ def point_baseline_answers(
     is answered and timed on its own, so the answers are those of one process
     (the times are each worker's). Returns per method one answer per draw.
     """
-    if pool is None or workers <= 1:
+    if pool is None or workers <= 1 or len(poses) == 0:
         return {b: [_point_baseline(b, d, poses, spacing) for d in draws] for b in POINT_BASELINES}
     chunks = [c for c in np.array_split(np.arange(len(poses)), workers) if len(c)]
     # A draw's own arrays only (its cache of trees is rebuilt by each task).
-    bare = [
-        Draw(
-            d.piano_points,
-            d.piano_sensor_cov,
-            d.room_points,
-            d.room_sensor_cov,
-            d.room_noise_correlation,
-        )
-        for d in draws
-    ]
+    bare = [replace(d, _cache={}) for d in draws]
     futures = {
         (b, k, i): pool.submit(_point_baseline, b, d, poses[c], spacing)
         for b in POINT_BASELINES
@@ -443,15 +469,21 @@ def point_baseline_answers(
         for i, c in enumerate(chunks)
     }
     out: dict[str, list[MethodAnswer]] = {}
-    for b in POINT_BASELINES:
-        out[b] = []
-        for k in range(len(draws)):
-            parts = [futures[(b, k, i)].result() for i in range(len(chunks))]
-            out[b].append(
-                MethodAnswer(
-                    np.concatenate([x.score for x in parts]),
-                    np.concatenate([x.state for x in parts]),
-                    np.concatenate([x.seconds for x in parts]),
+    try:
+        for b in POINT_BASELINES:
+            out[b] = []
+            for k in range(len(draws)):
+                parts = [futures[(b, k, i)].result() for i in range(len(chunks))]
+                out[b].append(
+                    MethodAnswer(
+                        np.concatenate([x.score for x in parts]),
+                        np.concatenate([x.state for x in parts]),
+                        np.concatenate([x.seconds for x in parts]),
+                    )
                 )
-            )
+    except BaseException:
+        # A failed task (or Ctrl-C) ends the others not yet started.
+        for f in futures.values():
+            f.cancel()
+        raise
     return out

@@ -348,14 +348,7 @@ def run_scan(
             )
         )
     spacing = m.sampling_spacing(draws[0].room_points)
-    answers: dict[str, list[m.MethodAnswer]] = {}
-    for (model, surface), aggs in m.query_groups(variants):
-        per_draw = [m.cloudprox_answers(d, q.poses, surface, aggs, model, many) for d in draws]
-        for agg in aggs:
-            answers[m.variant_name(model, surface, agg)] = [x[agg] for x in per_draw]
-        tick(f"kinect: cloudprox {model} {surface} {'/'.join(aggs)}", len(aggs))
-    # In the order of `variants` (the table's).
-    answers = {m.variant_name(*v): answers[m.variant_name(*v)] for v in variants}
+    answers = m.variant_answers(draws, q.poses, variants, many, tick, "kinect")
     answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
     if reconstruction_available():
         answers["reconstruct"] = []

@@ -4,7 +4,8 @@ Outputs in the chosen directory:
 
 ``results.csv``
     One row per (level, pose, draw, method): exact signed distance, label, score,
-    state, seconds.
+    state, seconds (``nan`` for the paper's aggregations off the poses timed on
+    their own, see :func:`cloudprox.reproduce.methods.cloudprox_answers`).
 ``summary.md``
     The metrics table (markdown) and the headline claims with their verdicts.
 ``summary.json``
@@ -23,7 +24,6 @@ import os
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor, ProcessPoolExecutor
-from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,7 +39,7 @@ from cloudprox.reproduce.realscan import SCAN_STEPS, run_scan
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
 from cloudprox.scenes import piano, room
 
-__all__ = ["Claim", "Config", "Summary", "check_claims", "run"]
+__all__ = ["Claim", "Config", "Summary", "available_cpus", "check_claims", "run"]
 
 #: The method whose claims are checked, and the baselines.
 OURS = "cloudprox quadric surface"
@@ -246,7 +246,7 @@ def run(
     out: Path,
     progress: Callable[[str, int], None] | None = None,
     many: Callable[..., Any] | None = None,
-    workers: int | None = None,
+    workers: int = 1,
 ) -> Summary:
     """Run every method at every level and write the outputs into ``out``.
 
@@ -263,23 +263,35 @@ def run(
         Replaces :func:`cloudprox.collide_many` in cloudprox's queries (e.g.
         :func:`cloudprox.distributed.collide_many`, the same answers as Ray tasks).
     workers : int, optional
-        Processes for the Python baselines (default: the CPUs this process may
-        use; 1: in this process). The answers do not depend on it.
+        Processes for the Python baselines (default 1: in this process;
+        ``cloudprox reproduce`` uses :func:`available_cpus`). The answers do not
+        depend on it. More than one spawns processes, which re-import the
+        calling script: call it under ``if __name__ == "__main__":``.
 
     Returns
     -------
     Summary
     """
-    workers = workers or len(os.sched_getaffinity(0))
-    with ExitStack() as stack:
-        pool = (
-            stack.enter_context(
-                ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
-            )
-            if workers > 1
-            else None
-        )
-        return _run(config, out, progress, many, pool, workers)
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    if workers == 1:
+        return _run(config, out, progress, many, None, 1)
+    # Spawned, not forked: the parent's Rust thread pools do not survive a fork.
+    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        summary = _run(config, out, progress, many, pool, workers)
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+    return summary
+
+
+def available_cpus() -> int:
+    """Return the number of CPUs this process may use (all of the machine's where unknown)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
 
 
 def _run(
@@ -328,14 +340,7 @@ def _run(
             d.clouds()
             draws.append(d)
         tick(f"{name}: noise draws", 1)
-        answers: dict[str, list[m.MethodAnswer]] = {}
-        for (model, surface), aggs in m.query_groups(VARIANTS):
-            per_draw = [m.cloudprox_answers(d, q.poses, surface, aggs, model, many) for d in draws]
-            for agg in aggs:
-                answers[m.variant_name(model, surface, agg)] = [x[agg] for x in per_draw]
-            tick(f"{name}: cloudprox {model} {surface} {'/'.join(aggs)}", len(aggs))
-        # In the order of VARIANTS (the table's).
-        answers = {m.variant_name(*v): answers[m.variant_name(*v)] for v in VARIANTS}
+        answers = m.variant_answers(draws, q.poses, VARIANTS, many, tick, name)
         answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
         if with_reconstruction:
             answers[RECON] = [m.reconstruct_answer(d, q.poses, spacing, sigma) for d in draws]

@@ -112,7 +112,7 @@ impl NearRule {
 
     // Called for every candidate pair of `near_points`: the compiler's own
     // choice to inline it or not came and went with unrelated changes of the
-    // crate (the call cost the near-contact queries 5-10%; measured with
+    // crate (the call cost the near-contact queries 5-11%; measured with
     // `benches/query.rs`).
     #[allow(clippy::inline_always)]
     #[inline(always)]
