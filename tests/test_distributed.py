@@ -157,10 +157,14 @@ def test_reproduce_query_loop_on_ray(tmp_path, monkeypatch) -> None:
     # `cloudprox reproduce --ray` hands distributed.collide_many to the run.
     seen = {}
 
-    def fake_run(config, out, progress, many):
-        seen["many"] = many
+    def fake_run(config, out, progress, many, workers):
+        seen["many"], seen["workers"] = many, workers
         return run_module.Summary(config)
 
     monkeypatch.setattr(run_module, "run", fake_run)
     assert main(["reproduce", "--quick", "--ray", "--out", str(tmp_path / "cli")]) == 0
     assert seen["many"].func is distributed.collide_many
+    # The baselines' processes: every CPU by default, or as asked.
+    assert seen["workers"] == run_module.available_cpus()
+    assert main(["reproduce", "--quick", "--workers", "1", "--out", str(tmp_path / "w")]) == 0
+    assert seen["workers"] == 1
