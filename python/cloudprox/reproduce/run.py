@@ -43,7 +43,8 @@ __all__ = ["Claim", "Config", "Summary", "available_cpus", "check_claims", "run"
 
 #: The method whose claims are checked, and the baselines.
 OURS = "cloudprox quadric surface"
-NN, MAP, SPHERES, RECON = "nn-gap", "collision-map", "spheres", "reconstruct"
+NN, MAP, SPHERES = m.POINT_BASELINES
+RECON = "reconstruct"
 #: The surface-element model's row.
 ELEMENTS = "cloudprox elements quadric"
 #: cloudprox variants: (model, surface family, aggregation).
