@@ -387,7 +387,7 @@ class QueryStats:
         """Patches of the elements model pruned because no element faces the other side within the noise's reach."""
     @property
     def surface_crossings(self) -> int:
-        """Element surface pairs found crossing before any patch (``decide_only`` with elements: a collision decided without a classifier)."""
+        """Element surface pairs found crossing, 0 or 1 (elements model: before any patch with ``decide_only``, after the patches found no collision in the full query)."""
     @property
     def points_classified(self) -> int:
         """Points of both clouds that went into a classifier."""

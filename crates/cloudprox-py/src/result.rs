@@ -177,9 +177,10 @@ stats_class! {
         /// Patches of the elements model pruned without a classifier (no element
         /// faces the other side within the noise's reach).
         patches_beyond_reach: usize,
-        /// Element surface pairs found crossing before any patch
-        /// (``decide_only`` with the elements model: a collision decided without
-        /// a classifier; 0 or 1).
+        /// Element surface pairs found crossing (0 or 1): with the elements
+        /// model, ``decide_only`` looks for one before any patch (a collision
+        /// decided without a classifier), the full query where its patches
+        /// found no collision.
         surface_crossings: usize,
         /// Points of both clouds that went into a classifier.
         points_classified: usize,

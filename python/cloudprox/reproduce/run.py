@@ -39,7 +39,7 @@ from cloudprox.reproduce.realscan import SCAN_STEPS, run_scan
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
 from cloudprox.scenes import piano, room
 
-__all__ = ["Claim", "Config", "Summary", "available_cpus", "check_claims", "run"]
+__all__ = ["Claim", "Config", "Summary", "available_cpus", "check_claims", "level_name", "run"]
 
 #: The method whose claims are checked, and the baselines.
 OURS = "cloudprox quadric surface"
@@ -134,7 +134,8 @@ class Summary:
     scan_facts: dict[str, float] = field(default_factory=dict)
 
 
-def _level_name(share: float, anisotropic: bool) -> str:
+def level_name(share: float, anisotropic: bool) -> str:
+    """Return a noise level's name in the table: ``"0.5%"``, ``"1% aniso"``."""
     return f"{100 * share:g}%" + (" aniso" if anisotropic else "")
 
 
@@ -325,7 +326,7 @@ def _run(
     fig_roc: list[tuple[str, np.ndarray, dict[str, np.ndarray]]] = []
     levels = [(s, False) for s in config.levels] + [(s, True) for s in config.anisotropic_levels]
     for k, (share, aniso) in enumerate(levels):
-        name = _level_name(share, aniso)
+        name = level_name(share, aniso)
         sigma = share * p_obj.diagonal
         summary.sigmas[name] = sigma
         rng = np.random.default_rng(config.seed * 1000 + k)

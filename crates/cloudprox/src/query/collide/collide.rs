@@ -102,22 +102,24 @@ pub(crate) fn collide_with_workspace(
         }
         _ => false,
     };
-    // Deciding only, the elements model then looks for two element surfaces
-    // that cross: a collision, whichever side of either is inside, decided
-    // without a near set or a classifier.
-    if let (true, true, false, Some((ea, eb))) = (
-        request.decide_only,
-        request.use_hierarchy,
-        beyond_reach,
-        elements,
-    ) {
+    // Two element surfaces that cross (probes of one on both sides of the
+    // other, each beyond the noise) are a collision, whichever side of either
+    // is inside: no near set or classifier is needed to say so. Its
+    // probability, when they cross (the bound's confidence, at least the
+    // collision threshold).
+    let crossing = |stats: &mut QueryStats, workspace: &mut BvhWorkspace| -> Option<Real> {
+        let (ea, eb) = elements.filter(|_| request.use_hierarchy && !beyond_reach)?;
         let z = crossing_sds(reach, request.thresholds.collision);
         let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
         stats.counters.node_pairs_visited += visited;
-        if crossed {
+        crossed.then(|| {
             stats.counters.surface_crossings += 1;
-            // The bound's confidence (at least the collision threshold).
-            let probability = (1.0 - 2.0 * normal_cdf(-z)).max(request.thresholds.collision);
+            (1.0 - 2.0 * normal_cdf(-z)).max(request.thresholds.collision)
+        })
+    };
+    // Deciding only, a crossing decides before anything else.
+    if request.decide_only {
+        if let Some(probability) = crossing(&mut stats, workspace) {
             stats.time_seconds = start.elapsed().as_secs_f64();
             return Ok(CollisionResult {
                 probability,
@@ -360,6 +362,16 @@ pub(crate) fn collide_with_workspace(
                     .chain(core_values(indexed_inputs(&touched.1, &inputs_b), &core.1)),
             )
         });
+    // The full query reads the crossings too where its patches did not find a
+    // collision: a thin part passing through a thin solid (a leg through a
+    // floor) gives the patch's separating surface no side to put it on, and
+    // the crossing is what says the surfaces meet. Deciding only, the
+    // crossings were read first.
+    let probability = if request.decide_only || probability >= request.thresholds.collision {
+        probability
+    } else {
+        crossing(&mut stats, workspace).map_or(probability, |c| c.max(probability))
+    };
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,

@@ -59,9 +59,10 @@ pub struct QueryCounters {
     /// of either side faces the other within the noise's reach (their points
     /// keep `p_i = 0`).
     pub patches_beyond_reach: usize,
-    /// Element surface pairs found crossing by the hierarchies before any
-    /// patch (`decide_only` with the elements model: a collision decided
-    /// without a classifier; 0 or 1).
+    /// Element surface pairs found crossing by the hierarchies (0 or 1): with
+    /// the elements model, `decide_only` looks for one before any patch (a
+    /// collision decided without a classifier), and the full query where its
+    /// patches found no collision (a part through a thin solid).
     pub surface_crossings: usize,
     /// Points of both clouds that went into a classifier.
     pub points_classified: usize,
