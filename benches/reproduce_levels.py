@@ -9,7 +9,7 @@ each level's metrics (the columns of the reproduction's table) and the missed
 collisions deeper than 3 sigma (draw, pose, exact signed distance in sigma).
 
 Usage: ``python3 benches/reproduce_levels.py [--levels '0.5%,1%,2%,1% aniso']
-[--variant elements,quadric,max] [--save PREFIX]``; ``--save`` writes each
+[--variant elements,quadric,max] [--poses 5000] [--save PREFIX]``; ``--save`` writes each
 level's scores, states, times and exact distances to ``PREFIX_<level>.npz``.
 """
 
@@ -44,6 +44,12 @@ def main() -> None:
         default="elements,quadric,max",
         help="model,surface,aggregation (default: elements,quadric,max)",
     )
+    ap.add_argument(
+        "--poses",
+        type=int,
+        default=config.poses,
+        help=f"poses per level (default {config.poses}, the full run's; others are other poses)",
+    )
     ap.add_argument("--save", default=None, help="write PREFIX_<level>.npz per level")
     args = ap.parse_args()
     asked = [x.strip() for x in args.levels.split(",") if x.strip()]
@@ -54,6 +60,8 @@ def main() -> None:
     if len(parts) != 3:
         ap.error(f"--variant must be model,surface,aggregation, got {args.variant!r}")
     variant = (parts[0], parts[1], parts[2])
+    if args.poses < 1:
+        ap.error(f"--poses must be >= 1, got {args.poses}")
     p_obj, r_obj = piano(), room()
     density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
     piano_pts, _ = p_obj.sample(density, config.seed)
@@ -64,7 +72,7 @@ def main() -> None:
         # The reproduction's generator, advanced as `cloudprox reproduce` does.
         sigma = share * p_obj.diagonal
         rng = np.random.default_rng(config.seed * 1000 + k)
-        q = sample_poses(p_obj, r_obj, config.poses, sigma, rng)
+        q = sample_poses(p_obj, r_obj, args.poses, sigma, rng)
         axes = (0.0, -3.0, 2.0) if aniso else None
         noise_p, noise_r = NoiseModel(sigma, axes), NoiseModel(sigma, axes)
         draws = []
