@@ -297,7 +297,7 @@ fn a_leg_through_a_floor_sized_slab_collides_wherever_surfaces_cross() {
     let floor = Mesh::cuboid(3.1, 2.6, 0.05).unwrap();
     let leg_points = leg.sample_surface_density(density, 1).unwrap().points;
     let floor_points = floor.sample_surface_density(density, 2).unwrap().points;
-    // The leg's tip 2 cm beyond the slab's lower face.
+    // The leg's end 1.4-2.4 cm beyond the slab's lower face (its rim tilted).
     let pose = Pose::from_parts(
         nalgebra::Translation3::new(0.0, 0.0, 0.3 - 0.05 - 0.02),
         nalgebra::UnitQuaternion::from_euler_angles(0.2, 0.0, 0.0),
