@@ -333,6 +333,36 @@ fn a_leg_through_a_floor_sized_slab_collides_wherever_surfaces_cross() {
     assert!(by_crossing >= 3, "{by_crossing}");
 }
 
+/// A face tilted by `atan(0.5)` whose lower end lies just above a flat face,
+/// both sampled at 4 mm with 0.1 mm of noise: the fitted surfaces are
+/// located to a few hundredths of a millimetre, but where a sampled face
+/// ends is known only to about half a spacing, which moves its end by
+/// `sin(theta) h/2` (0.89 mm) towards the other face. At half that gap the
+/// query is undecided; at four times it, free.
+#[test]
+fn a_face_ending_at_an_angle_over_another_is_uncertain_by_half_a_spacing() {
+    let (h, sigma, slope): (f64, f64, f64) = (0.004, 0.0001, 0.5);
+    let k = 12;
+    let c = (k - 1) as f64 * h / 2.0;
+    let edge_sd = (slope / (1.0 + slope * slope).sqrt()) * h / 2.0;
+    // A's facing face at z = slope x (its body above it), B's flat and wider
+    // below it (its body below).
+    let a = slab(k, h, (slope, 0.0), slope * c + 0.02, sigma, 1);
+    let b = slab(3 * k, h, (0.0, 0.0), -0.02, sigma, 2);
+    let req = elements();
+    let lowest = -slope * c;
+    let near = collide_at_height(&a, &b, lowest - 0.5 * edge_sd, &req);
+    assert_eq!(
+        near.state,
+        CollisionState::Contact,
+        "P = {}",
+        near.probability
+    );
+    assert!(near.probability > 0.05, "P = {}", near.probability);
+    let far = collide_at_height(&a, &b, lowest - 4.0 * edge_sd, &req);
+    assert_eq!(far.state, CollisionState::Free, "P = {}", far.probability);
+}
+
 #[test]
 fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
     // A's slab face tilted by 0.2 rad about y through B's (flat) face: the

@@ -158,6 +158,31 @@ impl<'a> Posed<'a> {
         (u0..=u1).contains(&u) && (v0..=v1).contains(&v)
     }
 
+    /// The variance that the position of the element's sampled edges adds
+    /// along `dir` to its surface point `x`, when `x` lies within half a
+    /// spacing of an edge: a sampled surface ends somewhere between its last
+    /// samples and the next sample that would have been (the edge is known
+    /// to about half a spacing, the scale of the near rule's margin), and
+    /// moving the edge by that much along the tangent `t` across it moves the
+    /// surface's end by `t . dir` of it along `dir`. Zero for a single point
+    /// and for `dir` along the normal (two parallel faces: the edge does not
+    /// change their gap); it is what makes a face's end meeting another
+    /// surface at an angle uncertain by the sampling.
+    fn edge_var_along(&self, x: &Point3, dir: &Vector3) -> Real {
+        if self.e.is_point() {
+            return 0.0;
+        }
+        let half = HALF_SPACING * self.e.spacing;
+        let (u, v) = self.coordinates(x);
+        let [[u0, u1], [v0, v1]] = self.e.extent;
+        [(u - u0).min(u1 - u), (v - v0).min(v1 - v)]
+            .iter()
+            .zip(&self.tangents)
+            .filter(|(to_edge, _)| **to_edge <= half)
+            .map(|(_, t)| (t.dot(dir) * half).powi(2))
+            .sum()
+    }
+
     /// A bound on the variance along any direction.
     fn var_bound(&self, var: Real) -> Real {
         var + self.across.trace()
@@ -434,8 +459,10 @@ pub(crate) fn elements_within_reach(
 /// facing element's normal, turned from A towards B by the separating
 /// surface's normal at the pair's midpoint; see [`pair_direction`]), with the
 /// standard deviation
-/// `s = sqrt(u^T (Sigma_x + Sigma_y) u)` of the two fitted surfaces, and cross
-/// with probability `Phi(-g / s)`. A pair farther apart than the noise can
+/// `s = sqrt(u^T (Sigma_x + Sigma_y) u + e_x + e_y)` of the two fitted
+/// surfaces and of where their sampled edges are (`e`, for a point within
+/// half a spacing of its element's edge: see `Posed::edge_var_along`), and
+/// cross with probability `Phi(-g / s)`. A pair farther apart than the noise can
 /// reach (`|y - x| > h/2 + reach_sds s`, `h` the spacing) cannot cross there
 /// and counts 0: a deep crossing shows where the surfaces cross, not far from
 /// it. The element's value is the largest over its probes.
@@ -476,7 +503,17 @@ pub(crate) fn element_crossing_probabilities(
         let u_sep = g / (-gn);
         let (u, steep) = pair_direction(&po[f.own], &pt[f.other], f.key.0, &u_sep);
         let gap = own.label * (f.y - f.x).dot(&u);
-        let sd = (po[f.own].var_along(f.var_x, &u) + pt[f.other].var_along(f.var_y, &u))
+        let (own_e, other_e) = (&po[f.own], &pt[f.other]);
+        // Where the probe lies over the other element, the gap is measured
+        // across a surface, and the ends of the two sampled surfaces are
+        // uncertain along it; a probe beside it is measured between the two
+        // ends, whose distance is what the fitted surfaces give.
+        let edges = if f.key.0 {
+            0.0
+        } else {
+            own_e.edge_var_along(&f.x, &u) + other_e.edge_var_along(&f.y, &u)
+        };
+        let sd = (own_e.var_along(f.var_x, &u) + other_e.var_along(f.var_y, &u) + edges)
             .max(0.0)
             .sqrt();
         let span = (f.y - f.x).norm();
@@ -582,6 +619,52 @@ mod tests {
     use super::*;
 
     use crate::probability::normal_cdf;
+
+    #[test]
+    fn a_sampled_edge_is_uncertain_by_half_a_spacing_along_its_tangent() {
+        // A flat, nearly noiseless 20 x 20 grid at 4 mm spacing: one element.
+        use crate::cloud::PointCloud;
+        use nalgebra::{Translation3, UnitQuaternion};
+        let h = 0.004;
+        let pts: Vec<Point3> = (0..400)
+            .map(|i| Point3::new((i / 20) as Real * h, (i % 20) as Real * h, 0.0))
+            .collect();
+        let cloud = PointCloud::from_sigma(pts, 1e-5).unwrap();
+        let els = cloud.elements();
+        let (k, e) = els
+            .elements()
+            .iter()
+            .enumerate()
+            .max_by_key(|(_, e)| e.count)
+            .unwrap();
+        assert!(e.count > 300, "{} points", e.count);
+        let half = HALF_SPACING * e.spacing;
+        let turn = UnitQuaternion::from_euler_angles(0.3, -0.5, 1.1);
+        for pose in [
+            Pose::identity(),
+            Pose::from_parts(Translation3::new(0.1, 0.2, -0.3), turn),
+        ] {
+            let p = Posed::new((e, els.hulls().hull(k as u32)), &pose);
+            let [[u0, u1], [v0, v1]] = e.extent;
+            let (centre, _) = p.at(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+            let (side, _) = p.at(u1, 0.5 * (v0 + v1));
+            let (corner, _) = p.at(u0, v1);
+            let [t0, t1] = p.tangents;
+            let n = p.normal;
+            let close = |a: Real, b: Real| (a - b).abs() <= 1e-9 * half * half;
+            // Inside, or across the surface: the edge does not move the point.
+            assert_eq!(p.edge_var_along(&centre, &t0), 0.0);
+            assert!(close(p.edge_var_along(&side, &n), 0.0));
+            // At the side across t0: half a spacing along t0, none along t1.
+            assert!(close(p.edge_var_along(&side, &t0), half * half));
+            assert!(close(p.edge_var_along(&side, &t1), 0.0));
+            let diagonal = (t0 + n).normalize();
+            assert!(close(p.edge_var_along(&side, &diagonal), 0.5 * half * half));
+            // At a corner both edges count.
+            let both = (t0 + t1).normalize();
+            assert!(close(p.edge_var_along(&corner, &both), half * half));
+        }
+    }
 
     #[test]
     fn candidates_from_the_tree_are_the_nearest_means() {
