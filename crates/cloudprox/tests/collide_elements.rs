@@ -285,11 +285,12 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
 /// at 626 points per square metre with 14.5 mm of noise: a piano's leg through
 /// the floor at 0.5% of the piano's size in the reproduction's scene. The
 /// slab's faces are flat, so each becomes a few elements of thousands of
-/// points and metres across; the leg's points, a few sigma across, pass
-/// through both faces, and a patch's separating surface has no side to put
-/// them on (it wraps around the leg and runs across the faces). Its patches
-/// alone read no collision in many draws; the crossing of the leg's element
-/// surfaces with the faces' does.
+/// points and metres across, which five samples stand for in the near set:
+/// in most draws the leg's points inside the slab are near none of them and
+/// no patch forms at all (where one does, its separating surface has no side
+/// to put the leg on: it wraps around the leg and runs across the faces).
+/// The patches alone read no collision in many draws; the crossing of the
+/// leg's element surfaces with the faces' does.
 #[test]
 fn a_leg_through_a_floor_sized_slab_collides_wherever_surfaces_cross() {
     let (density, sigma) = (626.0, 0.0145);
