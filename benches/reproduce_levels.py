@@ -22,17 +22,14 @@ import numpy as np
 
 from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.metrics import compute_metrics
-from cloudprox.reproduce.noise import NoiseModel
-from cloudprox.reproduce.poses import sample_poses
-from cloudprox.reproduce.run import Config, level_name
+from cloudprox.reproduce.run import Config, config_levels, level_inputs, level_name
 from cloudprox.scenes import piano, room
 
 
 def main() -> None:
     """Run the variant on the levels asked for and print their metrics."""
     config = Config()
-    levels = [(s, False) for s in config.levels] + [(s, True) for s in config.anisotropic_levels]
-    names = [level_name(s, a) for s, a in levels]
+    names = [level_name(s, a) for s, a in config_levels(config)]
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument(
         "--levels",
@@ -66,22 +63,10 @@ def main() -> None:
     density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
     piano_pts, _ = p_obj.sample(density, config.seed)
     room_pts, _ = r_obj.sample(density, config.seed + 1)
-    for k, ((share, aniso), name) in enumerate(zip(levels, names, strict=True)):
+    for k, name in enumerate(names):
         if name not in asked:
             continue
-        # The reproduction's generator, advanced as `cloudprox reproduce` does.
-        sigma = share * p_obj.diagonal
-        rng = np.random.default_rng(config.seed * 1000 + k)
-        q = sample_poses(p_obj, r_obj, args.poses, sigma, rng)
-        axes = (0.0, -3.0, 2.0) if aniso else None
-        noise_p, noise_r = NoiseModel(sigma, axes), NoiseModel(sigma, axes)
-        draws = []
-        for _ in range(config.draws):
-            a, ca = noise_p.draw(piano_pts, rng)
-            b, cb = noise_r.draw(room_pts, rng)
-            d = m.Draw(a, ca, b, cb)
-            d.clouds()
-            draws.append(d)
+        sigma, q, draws = level_inputs(config, k, (p_obj, r_obj), (piano_pts, room_pts), args.poses)
         t0 = time.perf_counter()
         answers = m.variant_answers(draws, q.poses, (variant,), None, lambda *_: None, name)
         ans = answers[m.variant_name(*variant)]

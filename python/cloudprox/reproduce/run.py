@@ -39,7 +39,17 @@ from cloudprox.reproduce.realscan import SCAN_STEPS, run_scan
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
 from cloudprox.scenes import piano, room
 
-__all__ = ["Claim", "Config", "Summary", "available_cpus", "check_claims", "level_name", "run"]
+__all__ = [
+    "Claim",
+    "Config",
+    "Summary",
+    "available_cpus",
+    "check_claims",
+    "config_levels",
+    "level_inputs",
+    "level_name",
+    "run",
+]
 
 #: The method whose claims are checked, and the baselines.
 OURS = "cloudprox quadric surface"
@@ -137,6 +147,43 @@ class Summary:
 def level_name(share: float, anisotropic: bool) -> str:
     """Return a noise level's name in the table: ``"0.5%"``, ``"1% aniso"``."""
     return f"{100 * share:g}%" + (" aniso" if anisotropic else "")
+
+
+def config_levels(config: Config) -> list[tuple[float, bool]]:
+    """Return the levels of ``config`` in the run's order: ``(share, anisotropic)``."""
+    return [(s, False) for s in config.levels] + [(s, True) for s in config.anisotropic_levels]
+
+
+def level_inputs(
+    config: Config,
+    k: int,
+    objects: tuple[Any, Any],
+    points: tuple[np.ndarray, np.ndarray],
+    poses: int,
+) -> tuple[float, QueryPoses, list[m.Draw]]:
+    """Return level ``k``'s sigma, query poses and noise draws, as the run makes them.
+
+    ``objects`` are the piano and the room, ``points`` their sampled points;
+    ``poses`` query poses (``config.poses`` in the run). The level's generator
+    is seeded from ``config.seed`` and ``k``, so any one level can be made
+    alone with the run's poses and draws (``benches/reproduce_levels.py``).
+    """
+    share, aniso = config_levels(config)[k]
+    p_obj, r_obj = objects
+    piano_pts, room_pts = points
+    sigma = share * p_obj.diagonal
+    rng = np.random.default_rng(config.seed * 1000 + k)
+    q = sample_poses(p_obj, r_obj, poses, sigma, rng)
+    axes = (0.0, -3.0, 2.0) if aniso else None
+    noise_p, noise_r = NoiseModel(sigma, axes), NoiseModel(sigma, axes)
+    draws = []
+    for _ in range(config.draws):
+        a, ca = noise_p.draw(piano_pts, rng)
+        b, cb = noise_r.draw(room_pts, rng)
+        d = m.Draw(a, ca, b, cb)
+        d.clouds()
+        draws.append(d)
+    return sigma, q, draws
 
 
 def check_claims(summary: Summary) -> list[Claim]:
@@ -324,23 +371,13 @@ def _run(
     rows: list[tuple[object, ...]] = []
     fig_p: list[tuple[str, float, np.ndarray, dict[str, np.ndarray]]] = []
     fig_roc: list[tuple[str, np.ndarray, dict[str, np.ndarray]]] = []
-    levels = [(s, False) for s in config.levels] + [(s, True) for s in config.anisotropic_levels]
-    for k, (share, aniso) in enumerate(levels):
+    for k, (share, aniso) in enumerate(config_levels(config)):
         name = level_name(share, aniso)
-        sigma = share * p_obj.diagonal
+        sigma, q, draws = level_inputs(
+            config, k, (p_obj, r_obj), (piano_pts, room_pts), config.poses
+        )
         summary.sigmas[name] = sigma
-        rng = np.random.default_rng(config.seed * 1000 + k)
-        q: QueryPoses = sample_poses(p_obj, r_obj, config.poses, sigma, rng)
         tick(f"{name}: poses", 1)
-        noise_p = NoiseModel(sigma, (0.0, -3.0, 2.0) if aniso else None)
-        noise_r = NoiseModel(sigma, (0.0, -3.0, 2.0) if aniso else None)
-        draws = []
-        for _ in range(config.draws):
-            a, ca = noise_p.draw(piano_pts, rng)
-            b, cb = noise_r.draw(room_pts, rng)
-            d = m.Draw(a, ca, b, cb)
-            d.clouds()
-            draws.append(d)
         tick(f"{name}: noise draws", 1)
         answers = m.variant_answers(draws, q.poses, VARIANTS, many, tick, name)
         answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
