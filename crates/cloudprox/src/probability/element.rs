@@ -459,10 +459,10 @@ pub(crate) fn elements_within_reach(
 /// facing element's normal, turned from A towards B by the separating
 /// surface's normal at the pair's midpoint; see [`pair_direction`]), with the
 /// standard deviation
-/// `s = sqrt(u^T (Sigma_x + Sigma_y) u + e_x + e_y)` of the two fitted
-/// surfaces and of where their sampled edges are (`e`, for a point within
-/// half a spacing of its element's edge: see `Posed::edge_var_along`), and
-/// cross with probability `Phi(-g / s)`. A pair farther apart than the noise can
+/// `s = sqrt(u^T (Sigma_x + Sigma_y) u + e_x)` of the two fitted surfaces
+/// and of where the probe's sampled edge is (`e_x`, for a probe over the
+/// other element within half a spacing of its own element's edge: see
+/// `Posed::edge_var_along`), and cross with probability `Phi(-g / s)`. A pair farther apart than the noise can
 /// reach (`|y - x| > h/2 + reach_sds s`, `h` the spacing) cannot cross there
 /// and counts 0: a deep crossing shows where the surfaces cross, not far from
 /// it. The element's value is the largest over its probes.
@@ -505,13 +505,16 @@ pub(crate) fn element_crossing_probabilities(
         let gap = own.label * (f.y - f.x).dot(&u);
         let (own_e, other_e) = (&po[f.own], &pt[f.other]);
         // Where the probe lies over the other element, the gap is measured
-        // across a surface, and the ends of the two sampled surfaces are
-        // uncertain along it; a probe beside it is measured between the two
-        // ends, whose distance is what the fitted surfaces give.
+        // across that element's surface (along its normal), and where the
+        // probe's own sampled surface ends is uncertain along it; the other
+        // element's end moves within its own plane, which does not change a
+        // gap measured across it. A probe beside the other element is
+        // measured between the two ends, whose distance is what the fitted
+        // surfaces give.
         let edges = if f.key.0 {
             0.0
         } else {
-            own_e.edge_var_along(&f.x, &u) + other_e.edge_var_along(&f.y, &u)
+            own_e.edge_var_along(&f.x, &u)
         };
         let sd = (own_e.var_along(f.var_x, &u) + other_e.var_along(f.var_y, &u) + edges)
             .max(0.0)
