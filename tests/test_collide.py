@@ -33,6 +33,7 @@ def test_result_fields(spheres) -> None:
         "misfit_cuts",
         "patches_beyond_reach",
         "surface_crossings",
+        "surface_links",
         "points_classified",
         "solver_iterations",
         "clarabel_fallbacks",

@@ -140,6 +140,9 @@ def test_bad_states_are_refused() -> None:
         cp.RobotBatchResult._from_state(([0.5], ["maybe"], [False], [0.5], 1))
     with pytest.raises(cp.InvalidInputError, match="inconsistent lengths"):
         cp.RobotBatchResult._from_state(([0.5], ["free"], [False], [0.5, 0.1], 1))
+    # Statistics from an older build (one counter fewer) name what they lack.
+    with pytest.raises(cp.InvalidInputError, match=r"holds 12 counters, expected 13 \(node_pairs"):
+        cp.QueryStats._from_state(([0] * 12, 0.0))
 
 
 def test_request_stats_and_proximity_roundtrip() -> None:

@@ -389,6 +389,9 @@ class QueryStats:
     def surface_crossings(self) -> int:
         """Element surface pairs found crossing, 0 or 1 (elements model: before any patch with ``decide_only``, after the patches found no collision in the full query)."""
     @property
+    def surface_links(self) -> int:
+        """Element pairs whose surfaces face within the noise's reach although no sample of one of them was near the other (a metre-wide element a thin part passes through): each brought both elements into the near set."""
+    @property
     def points_classified(self) -> int:
         """Points of both clouds that went into a classifier."""
     @property

@@ -5,8 +5,9 @@
 /// A frozen Python class over a core statistics struct `$core` made of
 /// `counters: $counters` and `time_seconds`. The one list of counters given
 /// here makes the getters, `to_dict` (the counters, then `time_seconds`),
-/// pickling (the tuple of the counters in that order, then `time_seconds`:
-/// nested, so that a tuple stays within the 12 items pyo3 converts) and
+/// pickling (the counters in that order as exact 64-bit words, see
+/// `StateWord`, then `time_seconds`: a list, as more counters than the 12
+/// items of a tuple pyo3 converts) and
 /// `__repr__` (the fields
 /// named after `repr:`, then `time_seconds`); equality is the core's, which
 /// compares the counters. The counters are destructured without `..`, so a
@@ -21,9 +22,9 @@ macro_rules! stats_class {
             $( $(#[doc = $field_doc:literal])* $field:ident: $ty:ty, )+
         }
     ) => {
-        /// The pickled form of the statistics: the counters in order, then the
-        /// wall time.
-        type $state = (($($ty,)+), f64);
+        /// The pickled form of the statistics: the counters in order (as
+        /// exact 64-bit words), then the wall time.
+        type $state = (Vec<u64>, f64);
 
         $(#[doc = $doc])*
         #[pyclass(name = $py_name, frozen, module = "cloudprox._native")]
@@ -39,17 +40,33 @@ macro_rules! stats_class {
 
             /// The pickled form of `s`.
             pub(crate) fn state_of(s: &$core) -> $state {
+                use $crate::result::StateWord;
                 let $counters { $($field),+ } = &s.counters;
-                (($(*$field,)+), s.time_seconds)
+                (vec![$($field.to_word(),)+], s.time_seconds)
             }
 
-            /// Statistics from their pickled form.
-            pub(crate) fn from_state(state: $state) -> $core {
-                let (($($field,)+), time_seconds) = state;
-                $core {
-                    counters: $counters { $($field),+ },
-                    time_seconds,
+            /// Statistics from their pickled form; an error if it does not
+            /// hold one word per counter.
+            pub(crate) fn from_state(py: Python<'_>, state: $state) -> PyResult<$core> {
+                use $crate::result::StateWord;
+                let (words, time_seconds) = state;
+                let names = [$(stringify!($field),)+];
+                if words.len() != names.len() {
+                    return Err($crate::error::invalid_input(py, format!(
+                        concat!("a pickled ", $py_name, " holds {} counters, expected {} ({})"),
+                        words.len(),
+                        names.len(),
+                        names.join(", ")
+                    )));
                 }
+                let mut words = words.into_iter();
+                Ok($core {
+                    counters: $counters {
+                        // One word per counter: checked above.
+                        $($field: <$ty>::from_word(words.next().unwrap_or_default()),)+
+                    },
+                    time_seconds,
+                })
             }
         }
 
@@ -71,10 +88,10 @@ macro_rules! stats_class {
 
             /// The statistics as a dict of ``int`` and ``float``, ready for JSON.
             fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-                let (($($field,)+), time_seconds) = Self::state_of(&self.inner);
+                let c = &self.inner.counters;
                 let d = PyDict::new(py);
-                $( d.set_item(stringify!($field), $field)?; )+
-                d.set_item("time_seconds", time_seconds)?;
+                $( d.set_item(stringify!($field), c.$field)?; )+
+                d.set_item("time_seconds", self.inner.time_seconds)?;
                 Ok(d)
             }
 
@@ -94,8 +111,8 @@ macro_rules! stats_class {
 
             /// Rebuilds pickled statistics (see `__reduce__`).
             #[staticmethod]
-            fn _from_state(state: $state) -> Self {
-                Self::wrap(Self::from_state(state))
+            fn _from_state(py: Python<'_>, state: $state) -> PyResult<Self> {
+                Ok(Self::wrap(Self::from_state(py, state)?))
             }
 
             fn __repr__(&self) -> String {

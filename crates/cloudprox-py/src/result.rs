@@ -21,6 +21,41 @@ use crate::error::guard;
 type Evaluation<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// `x` with about 6 significant digits, like Python's `%.6g`.
+/// A statistics counter as an exact 64-bit word of its pickled form, and back.
+pub(crate) trait StateWord: Sized {
+    /// The word.
+    fn to_word(&self) -> u64;
+    /// The counter from its word.
+    fn from_word(word: u64) -> Self;
+}
+
+impl StateWord for usize {
+    fn to_word(&self) -> u64 {
+        *self as u64
+    }
+    fn from_word(word: u64) -> Self {
+        word as usize
+    }
+}
+
+impl StateWord for u64 {
+    fn to_word(&self) -> u64 {
+        *self
+    }
+    fn from_word(word: u64) -> Self {
+        word
+    }
+}
+
+impl StateWord for f64 {
+    fn to_word(&self) -> u64 {
+        self.to_bits()
+    }
+    fn from_word(word: u64) -> Self {
+        f64::from_bits(word)
+    }
+}
+
 pub(crate) fn fmt_g(x: f64) -> String {
     let a = x.abs();
     if x == 0.0 || !x.is_finite() {
@@ -182,6 +217,11 @@ stats_class! {
         /// decided without a classifier), the full query where its patches
         /// found no collision.
         surface_crossings: usize,
+        /// Element pairs whose surfaces face within the noise's reach although
+        /// no sample of one of them was near the other (a metre-wide element
+        /// that a thin part passes through): each brought both elements into
+        /// the near set.
+        surface_links: usize,
         /// Points of both clouds that went into a classifier.
         points_classified: usize,
         /// Interior-point iterations over all patches.
@@ -484,7 +524,7 @@ impl PyCollisionResult {
             probabilities_a,
             probabilities_b,
             patches,
-            stats: PyQueryStats::from_state(stats),
+            stats: PyQueryStats::from_state(py, stats)?,
             point_aggregates: aggregates,
             sides: None,
         })

@@ -10,10 +10,10 @@ use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{crossing_probabilities, normal_cdf, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
-    element_crossings, element_points, element_sides_within_reach, element_surfaces_cross,
-    element_surfaces_may_reach, has_surface_element,
+    element_crossings, element_pairs_within_reach, element_points, element_sample_range,
+    element_sides_within_reach, element_surfaces_cross, has_surface_element,
 };
-use crate::query::collide::near::{near_set, NearSet};
+use crate::query::collide::near::{near_set, NearSet, SampleLink};
 use crate::query::collide::probabilities::{
     core_values, indexed, point_probabilities, surface_probabilities,
 };
@@ -92,16 +92,16 @@ pub(crate) fn collide_with_workspace(
     };
     // The noise's reach in standard deviations: beyond it no surface crosses.
     let reach = -normal_quantile(0.5 * request.prune_epsilon);
-    // The elements model first bounds the element surfaces themselves: when no
-    // two can reach each other, the clouds are free.
-    let beyond_reach = match elements {
-        Some((ea, eb)) if request.use_hierarchy => {
-            let (may, visited) = element_surfaces_may_reach(ea, &rel, eb, reach, workspace);
-            stats.counters.node_pairs_visited += visited;
-            !may
-        }
-        _ => false,
-    };
+    // The elements model first reads the element surfaces themselves: when no
+    // two can reach each other, the clouds are free; the pairs that can are
+    // linked in the near set, whether or not their samples are near.
+    let within_reach = elements.map(|(ea, eb)| {
+        let pairs =
+            element_pairs_within_reach(ea, &rel, eb, reach, request.use_hierarchy, workspace);
+        stats.counters.node_pairs_visited += pairs.visited;
+        pairs
+    });
+    let beyond_reach = request.use_hierarchy && within_reach.as_ref().is_some_and(|p| !p.any);
     // Two element surfaces that cross (probes of one on both sides of the
     // other, each beyond the noise) are a collision, whichever side of either
     // is inside: no near set or classifier is needed to say so. Its
@@ -135,7 +135,18 @@ pub(crate) fn collide_with_workspace(
     let near = if beyond_reach {
         NearSet::empty(sa.len(), sb.len())
     } else {
-        near_set(&rel, sa, sb, request, workspace, &mut stats)
+        let links: Vec<SampleLink> = match (elements, &within_reach) {
+            (Some((ea, eb)), Some(pairs)) => pairs
+                .surface_pairs
+                .iter()
+                .map(|&(e, f)| SampleLink {
+                    a: element_sample_range(ea, e),
+                    b: element_sample_range(eb, f),
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        near_set(&rel, sa, sb, &links, request, workspace, &mut stats)
     };
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();

@@ -82,6 +82,77 @@ pub(crate) fn element_surfaces_may_reach(
     first_hull_pair(ea, rel, eb, reach_sds, workspace, faces)
 }
 
+/// The element pairs of `ea` (at `rel` in `eb`'s frame) and `eb` within the
+/// noise's reach of each other, read on the elements' surfaces over their
+/// extent, not on their samples.
+pub(crate) struct PairsWithinReach {
+    /// Whether any pair (of surfaces or single points) may reach: when none
+    /// may, the clouds are free.
+    pub any: bool,
+    /// The pairs with a surface element on at least one side whose surfaces
+    /// face within reach ([`element_pair_within_reach`]). Pairs of two single
+    /// points are left to the near rule on the samples.
+    pub surface_pairs: Vec<(u32, u32)>,
+    /// Node pairs tested.
+    pub visited: usize,
+}
+
+/// Every element pair of `ea` (at `rel` in `eb`'s frame) and `eb` that may
+/// come within `reach_sds` noise standard deviations, beyond half a sampling
+/// spacing, of each other: by the hierarchies over both clouds' element hulls,
+/// or (`use_hierarchy = false`) over every pair. A metre-wide element stands
+/// in the near set for five samples, which a thin part passing through its
+/// middle may be far from: these pairs are what bring such an element into
+/// the near set ([`crate::query::collide::near`]).
+pub(crate) fn element_pairs_within_reach(
+    ea: &SurfaceElements,
+    rel: &Pose,
+    eb: &SurfaceElements,
+    reach_sds: Real,
+    use_hierarchy: bool,
+    workspace: &mut BvhWorkspace,
+) -> PairsWithinReach {
+    let mut out = PairsWithinReach {
+        any: !reach_sds.is_finite(),
+        surface_pairs: Vec::new(),
+        visited: 0,
+    };
+    if !reach_sds.is_finite() {
+        return out;
+    }
+    let (ha, hb) = (ea.hulls(), eb.hulls());
+    let mut test = |i: u32, j: u32| {
+        let (a, b) = (&ea.elements()[i as usize], &eb.elements()[j as usize]);
+        if a.is_point() && b.is_point() {
+            out.any = true;
+        } else if element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds) {
+            out.any = true;
+            out.surface_pairs.push((i, j));
+        }
+        // Never stop: every pair is wanted.
+        false
+    };
+    if use_hierarchy {
+        out.visited = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, &mut test).1;
+    } else {
+        for i in 0..ea.elements().len() as u32 {
+            for j in 0..eb.elements().len() as u32 {
+                test(i, j);
+            }
+        }
+    }
+    out
+}
+
+/// The samples (a contiguous run of [`SurfaceElements::samples`], the
+/// element's centre first) that stand for element `e`.
+pub(crate) fn element_sample_range(elements: &SurfaceElements, e: u32) -> std::ops::Range<u32> {
+    let owner = elements.sample_owner();
+    let start = owner.partition_point(|&o| o < e);
+    let end = owner.partition_point(|&o| o <= e);
+    start as u32..end as u32
+}
+
 /// Whether the fitted surfaces of some element of `ea` (at `rel` in `eb`'s
 /// frame) and some element of `eb` cross, each beyond `z_sds` standard
 /// deviations on both sides of the other ([`element_pair_crosses`]), found by

@@ -1,7 +1,9 @@
 //! The near set: which points of the two clouds can touch, grouped into
 //! connected near regions.
 
-use crate::bvh::BvhWorkspace;
+use std::ops::Range;
+
+use crate::bvh::{Bvh, BvhWorkspace};
 use crate::cloud::PointCloud;
 use crate::math::Pose;
 use crate::query::collide::region::{
@@ -38,10 +40,17 @@ impl NearSet {
 /// the context margin of [`CollisionRequest::near_context`] spacings, so the
 /// classifier sees the surface around the core. With `use_hierarchy = false` the
 /// same rule runs on every point pair and all near points form one region.
+///
+/// `links` are runs of samples known to be near each other by other means
+/// (the surface elements' pairs within reach, whose samples may all be far
+/// from each other on a metre-wide element): where a run has no core sample,
+/// its first becomes one, each run's samples are kept, and the two runs are
+/// put in one region.
 pub(crate) fn near_set(
     rel: &Pose,
     a: &PointCloud,
     b: &PointCloud,
+    links: &[SampleLink],
     request: &CollisionRequest,
     workspace: &mut BvhWorkspace,
     stats: &mut QueryStats,
@@ -53,7 +62,8 @@ pub(crate) fn near_set(
         let mut t = a
             .bvh()
             .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-        let core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN);
+        let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN);
+        let links = add_links_to_core(links, &mut core);
         let any_near = core.0.iter().any(|&k| k);
         let mut keep = core.clone();
         if any_near && ctx > SAMPLING_MARGIN {
@@ -69,14 +79,23 @@ pub(crate) fn near_set(
         if !any_near {
             t.leaf_pairs.clear();
         }
+        if !links.is_empty() {
+            stats.counters.surface_links += links.len();
+            keep_links(&links, &mut keep);
+            t.leaf_pairs
+                .extend(linked_leaf_pairs(&links, a.bvh(), b.bvh()));
+        }
         let regions = near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep.0, &keep.1);
         NearSet { regions, core }
     } else {
-        let core = near_points_brute_force(rel, a, b, eps, SAMPLING_MARGIN);
+        let mut core = near_points_brute_force(rel, a, b, eps, SAMPLING_MARGIN);
+        let links = add_links_to_core(links, &mut core);
         let mut keep = core.clone();
         if keep.0.iter().any(|&k| k) && ctx > SAMPLING_MARGIN {
             keep = near_points_brute_force(rel, a, b, eps, ctx);
         }
+        stats.counters.surface_links += links.len();
+        keep_links(&links, &mut keep);
         let pick =
             |k: &[bool]| -> Vec<u32> { (0..k.len() as u32).filter(|&i| k[i as usize]).collect() };
         let region = Patch {
@@ -91,6 +110,76 @@ pub(crate) fn near_set(
         };
         NearSet { regions, core }
     }
+}
+
+/// Two runs of samples, one of each cloud, near each other by their surfaces
+/// (see [`near_set`]); the first sample of each run stands for it.
+#[derive(Debug, Clone)]
+pub(crate) struct SampleLink {
+    /// A's samples.
+    pub a: Range<u32>,
+    /// B's samples.
+    pub b: Range<u32>,
+}
+
+/// Makes the first sample of each run of `links` a core sample where the run
+/// has none, and returns the links that did so: a link whose runs both hold a
+/// core sample already is the near rule's own finding.
+fn add_links_to_core(links: &[SampleLink], core: &mut (Vec<bool>, Vec<bool>)) -> Vec<SampleLink> {
+    let lacks = |k: &[bool], run: &Range<u32>| !run.clone().any(|i| k[i as usize]);
+    let needed: Vec<SampleLink> = links
+        .iter()
+        .filter(|l| lacks(&core.0, &l.a) || lacks(&core.1, &l.b))
+        .cloned()
+        .collect();
+    for l in &needed {
+        for (k, run) in [(&mut core.0, &l.a), (&mut core.1, &l.b)] {
+            if lacks(k, run) && !run.is_empty() {
+                k[run.start as usize] = true;
+            }
+        }
+    }
+    needed
+}
+
+/// Keeps every sample of every run of `links`.
+fn keep_links(links: &[SampleLink], keep: &mut (Vec<bool>, Vec<bool>)) {
+    for link in links {
+        for (k, run) in [(&mut keep.0, &link.a), (&mut keep.1, &link.b)] {
+            for i in run.clone() {
+                k[i as usize] = true;
+            }
+        }
+    }
+}
+
+/// Leaf pairs that put each link's samples in one region: every leaf holding
+/// a sample of one run paired with the leaf of the other run's first sample.
+fn linked_leaf_pairs(links: &[SampleLink], bvh_a: &Bvh, bvh_b: &Bvh) -> Vec<(u32, u32)> {
+    let (leaf_a, leaf_b) = (leaf_of(bvh_a), leaf_of(bvh_b));
+    let mut pairs = Vec::new();
+    for l in links {
+        if l.a.is_empty() || l.b.is_empty() {
+            continue;
+        }
+        let (first_a, first_b) = (leaf_a[l.a.start as usize], leaf_b[l.b.start as usize]);
+        pairs.extend(l.a.clone().map(|i| (leaf_a[i as usize], first_b)));
+        pairs.extend(l.b.clone().map(|j| (first_a, leaf_b[j as usize])));
+    }
+    pairs
+}
+
+/// The leaf holding each point of a hierarchy.
+fn leaf_of(bvh: &Bvh) -> Vec<u32> {
+    let mut leaf = vec![0; bvh.indices().len()];
+    for (k, n) in bvh.nodes().iter().enumerate() {
+        if n.is_leaf() {
+            for &i in bvh.node_points(k as u32) {
+                leaf[i as usize] = k as u32;
+            }
+        }
+    }
+    leaf
 }
 
 /// Per-node margins of `spacings` sampling spacings.

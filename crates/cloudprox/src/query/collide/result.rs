@@ -64,6 +64,11 @@ pub struct QueryCounters {
     /// collision decided without a classifier), and the full query where its
     /// patches found no collision (a part through a thin solid).
     pub surface_crossings: usize,
+    /// Element pairs whose surfaces face within the noise's reach although
+    /// none of the samples that stand for one of them was near the other (a
+    /// metre-wide element that a thin part passes through): each brought
+    /// both elements into the near set.
+    pub surface_links: usize,
     /// Points of both clouds that went into a classifier.
     pub points_classified: usize,
     /// Interior-point iterations over all patches.
