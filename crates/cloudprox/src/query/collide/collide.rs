@@ -10,10 +10,10 @@ use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{crossing_probabilities, normal_cdf, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
-    element_crossings, element_pairs_within_reach, element_points, element_sample_range,
-    element_sides_within_reach, element_surfaces_cross, has_surface_element,
+    element_crossings, element_pairs_within_reach, element_points, element_sides_within_reach,
+    element_surfaces_cross, has_surface_element,
 };
-use crate::query::collide::near::{near_set, NearSet, SampleLink};
+use crate::query::collide::near::{near_set, NearSet};
 use crate::query::collide::probabilities::{
     core_values, indexed, point_probabilities, surface_probabilities,
 };
@@ -110,8 +110,14 @@ pub(crate) fn collide_with_workspace(
     let crossing = |stats: &mut QueryStats, workspace: &mut BvhWorkspace| -> Option<Real> {
         let (ea, eb) = elements.filter(|_| request.use_hierarchy && !beyond_reach)?;
         let z = crossing_sds(reach, request.thresholds.collision);
-        let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
-        stats.counters.node_pairs_visited += visited;
+        // The pairs within reach found above hold every pair that can cross
+        // when `z` is the reach (the usual case): no second descent.
+        let known = within_reach.as_ref().and_then(|p| p.cross(z));
+        let crossed = known.unwrap_or_else(|| {
+            let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
+            stats.counters.node_pairs_visited += visited;
+            crossed
+        });
         crossed.then(|| {
             stats.counters.surface_crossings += 1;
             (1.0 - 2.0 * normal_cdf(-z)).max(request.thresholds.collision)
@@ -135,18 +141,12 @@ pub(crate) fn collide_with_workspace(
     let near = if beyond_reach {
         NearSet::empty(sa.len(), sb.len())
     } else {
-        let links: Vec<SampleLink> = match (elements, &within_reach) {
-            (Some((ea, eb)), Some(pairs)) => pairs
-                .surface_pairs
-                .iter()
-                .map(|&(e, f)| SampleLink {
-                    a: element_sample_range(ea, e),
-                    b: element_sample_range(eb, f),
-                })
-                .collect(),
-            _ => Vec::new(),
+        let links = |core: &(Vec<bool>, Vec<bool>)| {
+            within_reach
+                .as_ref()
+                .map_or_else(Vec::new, |pairs| pairs.links(core))
         };
-        near_set(&rel, sa, sb, &links, request, workspace, &mut stats)
+        near_set(&rel, sa, sb, links, request, workspace, &mut stats)
     };
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();

@@ -10,6 +10,7 @@ use crate::probability::{
     element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
     elements_within_reach, ElementSide,
 };
+use crate::query::collide::near::SampleLink;
 use crate::Real;
 
 /// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
@@ -82,19 +83,82 @@ pub(crate) fn element_surfaces_may_reach(
     first_hull_pair(ea, rel, eb, reach_sds, workspace, faces)
 }
 
-/// The element pairs of `ea` (at `rel` in `eb`'s frame) and `eb` within the
-/// noise's reach of each other, read on the elements' surfaces over their
-/// extent, not on their samples.
-pub(crate) struct PairsWithinReach {
+/// The element pairs of `ea` (at `rel` in `eb`'s frame) and `eb` whose hulls
+/// may come within the noise's reach of each other: read on the elements'
+/// surfaces over their extent, not on their samples.
+pub(crate) struct PairsWithinReach<'a> {
+    ea: &'a SurfaceElements,
+    rel: Pose,
+    eb: &'a SurfaceElements,
+    reach_sds: Real,
     /// Whether any pair (of surfaces or single points) may reach: when none
     /// may, the clouds are free.
     pub any: bool,
-    /// The pairs with a surface element on at least one side whose surfaces
-    /// face within reach ([`element_pair_within_reach`]). Pairs of two single
-    /// points are left to the near rule on the samples.
-    pub surface_pairs: Vec<(u32, u32)>,
+    /// The pairs with a surface element on at least one side whose hulls
+    /// pass the hull test (pairs of two single points are left to the near
+    /// rule on the samples); whether they face within reach is asked only of
+    /// those the near rule missed ([`PairsWithinReach::links`]).
+    candidates: Vec<(u32, u32)>,
     /// Node pairs tested.
     pub visited: usize,
+}
+
+impl PairsWithinReach<'_> {
+    /// The pairs whose surfaces face within reach
+    /// ([`element_pair_within_reach`]) although one of the two elements has
+    /// no sample in `core` (the near rule's core samples of A and of B), as
+    /// runs of samples for the near set.
+    pub(crate) fn links(&self, core: &(Vec<bool>, Vec<bool>)) -> Vec<SampleLink> {
+        let (ea, eb) = (self.ea, self.eb);
+        let (ha, hb) = (ea.hulls(), eb.hulls());
+        // Which elements have a core sample.
+        let found = |els: &SurfaceElements, core: &[bool]| {
+            let mut found = vec![false; els.elements().len()];
+            for (&o, _) in els.sample_owner().iter().zip(core).filter(|(_, &c)| c) {
+                found[o as usize] = true;
+            }
+            found
+        };
+        let (found_a, found_b) = (found(ea, &core.0), found(eb, &core.1));
+        self.candidates
+            .iter()
+            .filter(|&&(e, f)| !found_a[e as usize] || !found_b[f as usize])
+            .filter(|&&(e, f)| {
+                let (a, b) = (&ea.elements()[e as usize], &eb.elements()[f as usize]);
+                element_pair_within_reach(
+                    (a, ha.hull(e)),
+                    &self.rel,
+                    (b, hb.hull(f)),
+                    self.reach_sds,
+                )
+            })
+            .map(|&(e, f)| SampleLink {
+                a: element_sample_range(ea, e),
+                b: element_sample_range(eb, f),
+            })
+            .collect()
+    }
+
+    /// Whether the surfaces of some candidate pair cross, each beyond `z_sds`
+    /// standard deviations on both sides of the other
+    /// ([`element_pair_crosses`]), as [`element_surfaces_cross`] finds it;
+    /// `None` when `z_sds` is beyond the reach the candidates were found at
+    /// (the hull test passes more pairs at more standard deviations, so the
+    /// candidates hold every pair that can cross only up to their own).
+    pub(crate) fn cross(&self, z_sds: Real) -> Option<bool> {
+        if !z_sds.is_finite() {
+            return Some(false);
+        }
+        if z_sds > self.reach_sds {
+            return None;
+        }
+        let (ea, eb) = (self.ea, self.eb);
+        let (ha, hb) = (ea.hulls(), eb.hulls());
+        Some(self.candidates.iter().any(|&(e, f)| {
+            let (a, b) = (&ea.elements()[e as usize], &eb.elements()[f as usize]);
+            element_pair_crosses((a, ha.hull(e)), &self.rel, (b, hb.hull(f)), z_sds)
+        }))
+    }
 }
 
 /// Every element pair of `ea` (at `rel` in `eb`'s frame) and `eb` that may
@@ -104,32 +168,40 @@ pub(crate) struct PairsWithinReach {
 /// in the near set for five samples, which a thin part passing through its
 /// middle may be far from: these pairs are what bring such an element into
 /// the near set ([`crate::query::collide::near`]).
-pub(crate) fn element_pairs_within_reach(
-    ea: &SurfaceElements,
+pub(crate) fn element_pairs_within_reach<'a>(
+    ea: &'a SurfaceElements,
     rel: &Pose,
-    eb: &SurfaceElements,
+    eb: &'a SurfaceElements,
     reach_sds: Real,
     use_hierarchy: bool,
     workspace: &mut BvhWorkspace,
-) -> PairsWithinReach {
+) -> PairsWithinReach<'a> {
     let mut out = PairsWithinReach {
+        ea,
+        rel: *rel,
+        eb,
+        reach_sds,
         any: !reach_sds.is_finite(),
-        surface_pairs: Vec::new(),
+        candidates: Vec::new(),
         visited: 0,
     };
     if !reach_sds.is_finite() {
         return out;
     }
     let (ha, hb) = (ea.hulls(), eb.hulls());
+    let (mut any, mut candidates) = (false, Vec::new());
     let mut test = |i: u32, j: u32| {
         let (a, b) = (&ea.elements()[i as usize], &eb.elements()[j as usize]);
         if a.is_point() && b.is_point() {
-            out.any = true;
-        } else if element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds) {
-            out.any = true;
-            out.surface_pairs.push((i, j));
+            any = true;
+        } else {
+            candidates.push((i, j));
+            // The exact test until one pair passes: enough to say the
+            // clouds are not beyond reach.
+            any =
+                any || element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds);
         }
-        // Never stop: every pair is wanted.
+        // Never stop: every candidate is wanted.
         false
     };
     if use_hierarchy {
@@ -141,12 +213,14 @@ pub(crate) fn element_pairs_within_reach(
             }
         }
     }
+    out.any = any;
+    out.candidates = candidates;
     out
 }
 
 /// The samples (a contiguous run of [`SurfaceElements::samples`], the
 /// element's centre first) that stand for element `e`.
-pub(crate) fn element_sample_range(elements: &SurfaceElements, e: u32) -> std::ops::Range<u32> {
+fn element_sample_range(elements: &SurfaceElements, e: u32) -> std::ops::Range<u32> {
     let owner = elements.sample_owner();
     let start = owner.partition_point(|&o| o < e);
     let end = owner.partition_point(|&o| o <= e);

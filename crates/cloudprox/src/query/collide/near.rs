@@ -41,16 +41,16 @@ impl NearSet {
 /// classifier sees the surface around the core. With `use_hierarchy = false` the
 /// same rule runs on every point pair and all near points form one region.
 ///
-/// `links` are runs of samples known to be near each other by other means
-/// (the surface elements' pairs within reach, whose samples may all be far
-/// from each other on a metre-wide element): where a run has no core sample,
-/// its first becomes one, each run's samples are kept, and the two runs are
-/// put in one region.
+/// `links`, given the core samples the near rule found, returns runs of
+/// samples known to be near each other by other means (the surface elements'
+/// pairs within reach, whose samples may all be far from each other on a
+/// metre-wide element): where a run has no core sample, its first becomes
+/// one, each run's samples are kept, and the two runs are put in one region.
 pub(crate) fn near_set(
     rel: &Pose,
     a: &PointCloud,
     b: &PointCloud,
-    links: &[SampleLink],
+    links: impl FnOnce(&(Vec<bool>, Vec<bool>)) -> Vec<SampleLink>,
     request: &CollisionRequest,
     workspace: &mut BvhWorkspace,
     stats: &mut QueryStats,
@@ -63,7 +63,7 @@ pub(crate) fn near_set(
             .bvh()
             .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
         let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN);
-        let links = add_links_to_core(links, &mut core);
+        let links = add_links_to_core(&links(&core), &mut core);
         let any_near = core.0.iter().any(|&k| k);
         let mut keep = core.clone();
         if any_near && ctx > SAMPLING_MARGIN {
@@ -89,7 +89,7 @@ pub(crate) fn near_set(
         NearSet { regions, core }
     } else {
         let mut core = near_points_brute_force(rel, a, b, eps, SAMPLING_MARGIN);
-        let links = add_links_to_core(links, &mut core);
+        let links = add_links_to_core(&links(&core), &mut core);
         let mut keep = core.clone();
         if keep.0.iter().any(|&k| k) && ctx > SAMPLING_MARGIN {
             keep = near_points_brute_force(rel, a, b, eps, ctx);
