@@ -85,19 +85,30 @@ pub(crate) fn fit_patch(
     // plate): offsets further apart than this belong to different surfaces.
     let split = (4.0 * sigma).max(0.5 * spacing);
     let stride = pts.len().div_ceil(64).max(1);
+    let frame = AxialFrame::new(axis);
+    let (side_a, side_b) = (
+        AxialSide::new(&frame, &pts[..na]),
+        AxialSide::new(&frame, &pts[na..]),
+    );
+    let mut scratch = Vec::new();
     let separation = pts
         .iter()
         .step_by(stride)
         .filter_map(|x| {
-            let sb = axial_offset(&pts[na..], x, axis, radius, -1.0, split)?;
-            let sa = axial_offset(&pts[..na], x, axis, radius, 1.0, split)?;
+            let x = frame.coordinates(x);
+            let sb = side_b.offset(&x, radius, -1.0, split, &mut scratch)?;
+            let sa = side_a.offset(&x, radius, 1.0, split, &mut scratch)?;
             Some(sb - sa)
         })
         .reduce(Real::min)
         .unwrap_or_else(|| {
-            let inf = Real::INFINITY;
-            axial_offset(&pts[na..], &mid, axis, inf, -1.0, split).unwrap_or(0.0)
-                - axial_offset(&pts[..na], &mid, axis, inf, 1.0, split).unwrap_or(0.0)
+            let (inf, mid) = (Real::INFINITY, frame.coordinates(&mid));
+            side_b
+                .offset(&mid, inf, -1.0, split, &mut scratch)
+                .unwrap_or(0.0)
+                - side_a
+                    .offset(&mid, inf, 1.0, split, &mut scratch)
+                    .unwrap_or(0.0)
         });
     Ok(PatchFit {
         classification,
@@ -123,41 +134,93 @@ pub(crate) fn mean(p: &[Point3]) -> Vector3 {
     p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }
 
-/// Where one side's surface crosses the line through `point` along `axis`: among
-/// the side's 12 points nearest that line (within `radius` of it), sorted by
-/// their offset along `axis` starting from the end that faces the other cloud
-/// (`facing = +1`: the largest offsets first), the median of the leading run of
-/// offsets less than `split` apart, i.e. of the surface nearest the other cloud;
-/// `None` with fewer than 3 points near the line or 2 in that run. Medians keep
-/// the estimate unbiased by the noise on a flat contact.
-fn axial_offset(
-    pts: &[Point3],
-    point: &Point3,
-    axis: &Vector3,
-    radius: Real,
-    facing: Real,
-    split: Real,
-) -> Option<Real> {
-    let r2 = radius * radius;
-    let mut by_lateral: Vec<(Real, Real)> = pts
-        .iter()
-        .filter_map(|x| {
-            let d = x - point;
-            let along = d.dot(axis);
-            let lat = (d - axis * along).norm_squared();
-            (lat <= r2).then_some((lat, along))
-        })
-        .collect();
-    if by_lateral.len() < 3 {
-        return None;
+/// Coordinates along an axis and across it: `(u, v)` in the plane normal to
+/// the axis, then the offset along it.
+struct AxialFrame {
+    axis: Vector3,
+    across: [Vector3; 2],
+}
+
+impl AxialFrame {
+    fn new(axis: &Vector3) -> Self {
+        // Any unit vector not parallel to the axis spans the plane with it.
+        let helper = if axis.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        let u = axis.cross(&helper).normalize();
+        let v = axis.cross(&u);
+        Self {
+            axis: *axis,
+            across: [u, v],
+        }
     }
-    let k = 12.min(by_lateral.len());
-    by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-    let mut along: Vec<Real> = by_lateral[..k].iter().map(|x| facing * x.1).collect();
-    along.sort_by(|a, b| b.total_cmp(a));
-    let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
-    if run < 2 {
-        return None;
+
+    fn coordinates(&self, x: &Point3) -> [Real; 3] {
+        let c = x.coords;
+        [
+            c.dot(&self.across[0]),
+            c.dot(&self.across[1]),
+            c.dot(&self.axis),
+        ]
     }
-    Some(facing * along[run / 2])
+}
+
+/// One side's points in an [`AxialFrame`], sorted by their first coordinate
+/// across the axis, so the points near a line along the axis are found in a
+/// slab of that coordinate.
+struct AxialSide {
+    coords: Vec<[Real; 3]>,
+}
+
+impl AxialSide {
+    fn new(frame: &AxialFrame, pts: &[Point3]) -> Self {
+        let mut coords: Vec<[Real; 3]> = pts.iter().map(|x| frame.coordinates(x)).collect();
+        coords.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]));
+        Self { coords }
+    }
+
+    /// Where this side's surface crosses the line through `line` (frame
+    /// coordinates) along the axis: among the side's 12 points nearest that
+    /// line (within `radius` of it), sorted by their offset along the axis
+    /// starting from the end that faces the other cloud (`facing = +1`: the
+    /// largest offsets first), the median of the leading run of offsets less
+    /// than `split` apart, i.e. of the surface nearest the other cloud; `None`
+    /// with fewer than 3 points near the line or 2 in that run. Medians keep
+    /// the estimate unbiased by the noise on a flat contact.
+    fn offset(
+        &self,
+        line: &[Real; 3],
+        radius: Real,
+        facing: Real,
+        split: Real,
+        by_lateral: &mut Vec<(Real, Real)>,
+    ) -> Option<Real> {
+        let r2 = radius * radius;
+        let lo = self.coords.partition_point(|c| c[0] < line[0] - radius);
+        let hi = self.coords.partition_point(|c| c[0] <= line[0] + radius);
+        by_lateral.clear();
+        by_lateral.extend(self.coords[lo..hi].iter().filter_map(|c| {
+            let (du, dv) = (c[0] - line[0], c[1] - line[1]);
+            let lat = du * du + dv * dv;
+            (lat <= r2).then_some((lat, c[2] - line[2]))
+        }));
+        if by_lateral.len() < 3 {
+            return None;
+        }
+        let k = 12.min(by_lateral.len());
+        by_lateral.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+        let mut along = [0.0; 12];
+        for (o, x) in along.iter_mut().zip(&by_lateral[..k]) {
+            *o = facing * x.1;
+        }
+        let along = &mut along[..k];
+        along.sort_unstable_by(|a, b| b.total_cmp(a));
+        let run = 1 + along.windows(2).take_while(|w| w[0] - w[1] < split).count();
+        if run < 2 {
+            return None;
+        }
+        Some(facing * along[run / 2])
+    }
 }
