@@ -9,13 +9,15 @@ each level's metrics (the columns of the reproduction's table) and the missed
 collisions deeper than 3 sigma (draw, pose, exact signed distance in sigma).
 
 Usage: ``python3 benches/reproduce_levels.py [--levels '0.5%,1%,2%,1% aniso']
-[--variant elements,quadric,max] [--poses 5000] [--save PREFIX]``; ``--save`` writes each
+[--variant elements,quadric,max] [--poses 5000] [--piano-points 10000] [--save PREFIX]``;
+``--piano-points 3000`` samples the scene as the quick run does; ``--save`` writes each
 level's scores, states, times and exact distances to ``PREFIX_<level>.npz``.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 import numpy as np
@@ -47,8 +49,17 @@ def main() -> None:
         default=config.poses,
         help=f"poses per level (default {config.poses}, the full run's; others are other poses)",
     )
+    ap.add_argument(
+        "--piano-points",
+        type=int,
+        default=config.piano_points,
+        help=f"points on the piano (default {config.piano_points}; the quick run's: 3000)",
+    )
     ap.add_argument("--save", default=None, help="write PREFIX_<level>.npz per level")
     args = ap.parse_args()
+    if args.piano_points < 1:
+        ap.error(f"--piano-points must be >= 1, got {args.piano_points}")
+    config = dataclasses.replace(config, piano_points=args.piano_points)
     asked = [x.strip() for x in args.levels.split(",") if x.strip()]
     unknown = [x for x in asked if x not in names]
     if unknown:
