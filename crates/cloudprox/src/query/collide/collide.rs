@@ -95,9 +95,20 @@ pub(crate) fn collide_with_workspace(
     // The elements model first reads the element surfaces themselves: when no
     // two can reach each other, the clouds are free; the pairs that can are
     // linked in the near set, whether or not their samples are near.
+    // Deciding only, the descent also looks for crossing surfaces (below) and
+    // stops at the first.
+    let z = crossing_sds(reach, request.thresholds.collision);
+    let stop_at_crossing = (request.decide_only && request.use_hierarchy).then_some(z);
     let within_reach = elements.map(|(ea, eb)| {
-        let pairs =
-            element_pairs_within_reach(ea, &rel, eb, reach, request.use_hierarchy, workspace);
+        let pairs = element_pairs_within_reach(
+            ea,
+            &rel,
+            eb,
+            reach,
+            request.use_hierarchy,
+            stop_at_crossing,
+            workspace,
+        );
         stats.counters.node_pairs_visited += pairs.visited;
         pairs
     });
@@ -109,9 +120,9 @@ pub(crate) fn collide_with_workspace(
     // collision threshold).
     let crossing = |stats: &mut QueryStats, workspace: &mut BvhWorkspace| -> Option<Real> {
         let (ea, eb) = elements.filter(|_| request.use_hierarchy && !beyond_reach)?;
-        let z = crossing_sds(reach, request.thresholds.collision);
         // The pairs within reach found above hold every pair that can cross
-        // when `z` is the reach (the usual case): no second descent.
+        // when `z` is the reach (the usual case): no second descent (and
+        // deciding only, the descent has tested them already).
         let known = within_reach.as_ref().and_then(|p| p.cross(z));
         let crossed = known.unwrap_or_else(|| {
             let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);

@@ -99,6 +99,10 @@ pub(crate) struct PairsWithinReach<'a> {
     /// rule on the samples); whether they face within reach is asked only of
     /// those the near rule missed ([`PairsWithinReach::links`]).
     candidates: Vec<(u32, u32)>,
+    /// The `z` at which every candidate met so far was tested for a crossing
+    /// during the descent (deciding only), and whether one crossed (the
+    /// descent then stopped there).
+    crossing: Option<(Real, bool)>,
     /// Node pairs tested.
     pub visited: usize,
 }
@@ -149,6 +153,11 @@ impl PairsWithinReach<'_> {
         if !z_sds.is_finite() {
             return Some(false);
         }
+        if let Some((z, crossed)) = self.crossing {
+            if z == z_sds {
+                return Some(crossed);
+            }
+        }
         if z_sds > self.reach_sds {
             return None;
         }
@@ -168,12 +177,18 @@ impl PairsWithinReach<'_> {
 /// in the near set for five samples, which a thin part passing through its
 /// middle may be far from: these pairs are what bring such an element into
 /// the near set ([`crate::query::collide::near`]).
+///
+/// With `stop_at_crossing = Some(z)` (deciding only, `z` at most the reach)
+/// each candidate is also tested for a crossing at `z` as it is met, and the
+/// descent stops at the first one: the query is then decided, and needs
+/// neither the other candidates nor the links.
 pub(crate) fn element_pairs_within_reach<'a>(
     ea: &'a SurfaceElements,
     rel: &Pose,
     eb: &'a SurfaceElements,
     reach_sds: Real,
     use_hierarchy: bool,
+    stop_at_crossing: Option<Real>,
     workspace: &mut BvhWorkspace,
 ) -> PairsWithinReach<'a> {
     let mut out = PairsWithinReach {
@@ -183,38 +198,50 @@ pub(crate) fn element_pairs_within_reach<'a>(
         reach_sds,
         any: !reach_sds.is_finite(),
         candidates: Vec::new(),
+        crossing: None,
         visited: 0,
     };
     if !reach_sds.is_finite() {
         return out;
     }
+    // A crossing test at more standard deviations than the reach needs pairs
+    // the hull test at the reach may not pass: not here.
+    let stop_at = stop_at_crossing.filter(|&z| z.is_finite() && z <= reach_sds);
     let (ha, hb) = (ea.hulls(), eb.hulls());
-    let (mut any, mut candidates) = (false, Vec::new());
+    let (mut any, mut candidates, mut crossed) = (false, Vec::new(), false);
     let mut test = |i: u32, j: u32| {
         let (a, b) = (&ea.elements()[i as usize], &eb.elements()[j as usize]);
         if a.is_point() && b.is_point() {
             any = true;
-        } else {
-            candidates.push((i, j));
-            // The exact test until one pair passes: enough to say the
-            // clouds are not beyond reach.
-            any =
-                any || element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds);
+            return false;
         }
-        // Never stop: every candidate is wanted.
+        candidates.push((i, j));
+        // The exact test until one pair passes: enough to say the clouds are
+        // not beyond reach.
+        any = any || element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds);
+        if let Some(z) = stop_at {
+            if element_pair_crosses((a, ha.hull(i)), rel, (b, hb.hull(j)), z) {
+                // Crossing surfaces are within reach of each other.
+                (any, crossed) = (true, true);
+                return true;
+            }
+        }
         false
     };
     if use_hierarchy {
         out.visited = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, &mut test).1;
     } else {
-        for i in 0..ea.elements().len() as u32 {
+        'all: for i in 0..ea.elements().len() as u32 {
             for j in 0..eb.elements().len() as u32 {
-                test(i, j);
+                if test(i, j) {
+                    break 'all;
+                }
             }
         }
     }
     out.any = any;
     out.candidates = candidates;
+    out.crossing = stop_at.map(|z| (z, crossed));
     out
 }
 
