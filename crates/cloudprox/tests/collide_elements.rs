@@ -594,3 +594,54 @@ proptest! {
         );
     }
 }
+
+/// A stray point with 5 mm of noise whose spacing (10 cm to its nearest
+/// neighbours, a scan's flying pixel) lets it stand for 5 cm of surface, over
+/// a plate: whether it is near is the near rule's to say, on the point itself,
+/// as in the points model. A single point's hull bounds its reach in every
+/// direction at once (`sqrt(3)` of its standard deviation for isotropic
+/// noise), looser than the near rule along the gap; read as a link, that
+/// bound made a near region at 7.4 and 7.6 cm, where the near rule keeps the
+/// point apart (the Kinect frame: regions of points 8 sigma from the gripper).
+#[test]
+fn a_stray_point_is_near_a_surface_only_by_the_near_rule() {
+    let plate = slab(40, 0.005, (0.0, 0.0), -0.02, 0.001, 7);
+    let points = CollisionRequest {
+        model: QueryModel::Points,
+        ..CollisionRequest::default()
+    };
+    for (d, near) in [
+        (0.05, true),
+        (0.06, true),
+        (0.074, false),
+        (0.076, false),
+        (0.09, false),
+    ] {
+        // A noisy parallel patch 10 cm above the point gives it its spacing.
+        let grid: Vec<Point3> = (0..900)
+            .map(|n| {
+                let (i, j) = ((n / 30) as f64, (n % 30) as f64);
+                Point3::new(i * 0.003 - 0.045, j * 0.003 - 0.045, d + 0.1)
+            })
+            .collect();
+        let mut pts = add_noise(&grid, 0.001, 11);
+        let mut sigmas = vec![0.001; pts.len()];
+        pts.push(Point3::new(0.0, 0.0, d));
+        sigmas.push(0.005);
+        let b = PointCloud::from_sigmas(pts, sigmas).unwrap();
+        let els = b.elements();
+        let owner = els.sample_owner();
+        assert!(
+            (0..owner.len()).any(|s| els.elements()[owner[s] as usize].is_point()),
+            "d {d}: the stray point is an element of its own"
+        );
+        let id = Pose::identity();
+        let r = collide(&id, &plate, &id, &b, &elements()).unwrap();
+        let p = collide(&id, &plate, &id, &b, &points).unwrap();
+        let (c, cp) = (&r.stats.counters, &p.stats.counters);
+        assert_eq!(c.surface_links, 0, "d {d}");
+        assert_eq!(cp.near_regions > 0, near, "d {d}: the near rule");
+        assert_eq!(c.near_regions > 0, near, "d {d}: {c:?}");
+        assert_eq!(r.state, CollisionState::Free, "d {d}");
+    }
+}

@@ -140,11 +140,64 @@ pub(crate) fn hull_gap(
 pub(crate) struct ElementHulls {
     hulls: Vec<Hull>,
     tree: Bvh,
-    /// Per node: the box of its elements' corners, the largest `sigma` and the
-    /// largest `margin` below it.
-    node_box: Vec<Aabb>,
-    node_sigma: Vec<Real>,
-    node_margin: Vec<Real>,
+    /// Per node, over all its elements.
+    all: NodeBounds,
+    /// Per node, over its surface elements only (single points left out):
+    /// a scan's stray points carry centimetres of noise from their sparse
+    /// sampling, and would otherwise widen every node above them.
+    surfaces: NodeBounds,
+}
+
+/// Per node of an [`ElementHulls`] hierarchy: the box of some of its elements'
+/// corners, the largest `sigma` and the largest `margin` among them, and
+/// whether it has any.
+#[derive(Debug, Clone)]
+struct NodeBounds {
+    boxes: Vec<Aabb>,
+    sigma: Vec<Real>,
+    margin: Vec<Real>,
+    any: Vec<bool>,
+}
+
+impl NodeBounds {
+    /// The bounds over the hulls for which `counts` holds.
+    fn new(tree: &Bvh, hulls: &[Hull], counts: impl Fn(&Hull) -> bool) -> Self {
+        let n = tree.nodes().len();
+        let mut out = Self {
+            boxes: vec![Aabb::empty(); n],
+            sigma: vec![0.0; n],
+            margin: vec![0.0; n],
+            any: vec![false; n],
+        };
+        for id in (0..n).rev() {
+            if let Some([l, r]) = tree.nodes()[id].children {
+                let (l, r) = (l as usize, r as usize);
+                out.boxes[id] = out.boxes[l].merged(&out.boxes[r]);
+                out.sigma[id] = out.sigma[l].max(out.sigma[r]);
+                out.margin[id] = out.margin[l].max(out.margin[r]);
+                out.any[id] = out.any[l] || out.any[r];
+                continue;
+            }
+            for &e in tree.node_points(id as u32) {
+                let h = &hulls[e as usize];
+                if !counts(h) {
+                    continue;
+                }
+                for c in &h.corners {
+                    out.boxes[id].take_point(c);
+                }
+                out.sigma[id] = out.sigma[id].max(h.sigma);
+                out.margin[id] = out.margin[id].max(h.margin);
+                out.any[id] = true;
+            }
+        }
+        out
+    }
+
+    /// The reach of node pair `(ia, ib)` at `k` standard deviations.
+    fn limit(a: &Self, ia: usize, b: &Self, ib: usize, k: Real) -> Real {
+        a.margin[ia].max(b.margin[ib]) + k * (a.sigma[ia] + b.sigma[ib])
+    }
 }
 
 impl ElementHulls {
@@ -166,30 +219,22 @@ impl ElementHulls {
         let sigmas: Vec<Real> = hulls.iter().map(|h| h.sigma).collect();
         let tree = Bvh::build(&means, &sigmas, &HULL_TREE)
             .expect("element means are finite and the default settings valid");
-        let n = tree.nodes().len();
-        let mut node_box = vec![Aabb::empty(); n];
-        for id in (0..n).rev() {
-            node_box[id] = if let Some([l, r]) = tree.nodes()[id].children {
-                node_box[l as usize].merged(&node_box[r as usize])
-            } else {
-                let mut b = Aabb::empty();
-                for &e in tree.node_points(id as u32) {
-                    for c in &hulls[e as usize].corners {
-                        b.take_point(c);
-                    }
-                }
-                b
-            };
-        }
-        let node_sigma = tree.node_max(&sigmas);
-        let margins: Vec<Real> = hulls.iter().map(|h| h.margin).collect();
-        let node_margin = tree.node_max(&margins);
+        let all = NodeBounds::new(&tree, &hulls, |_| true);
+        let surfaces = NodeBounds::new(&tree, &hulls, |h| !h.point);
         Self {
             hulls,
             tree,
-            node_box,
-            node_sigma,
-            node_margin,
+            all,
+            surfaces,
+        }
+    }
+
+    /// The node bounds over all elements, or over the surface elements alone.
+    fn bounds(&self, surfaces_only: bool) -> &NodeBounds {
+        if surfaces_only {
+            &self.surfaces
+        } else {
+            &self.all
         }
     }
 
@@ -225,13 +270,17 @@ struct PosedHull {
 /// of each other) and then `test(ea, eb)`, the caller's exact test of the pair
 /// (whether it faces the other within reach, or whether the two surfaces
 /// cross). The traversal stops at the first such pair; `false` proves that no
-/// pair passes both. Returns the answer and the number of node pairs tested.
+/// pair passes both. From the first node pair for which `surfaces_only()`
+/// holds on, single points are left out (the caller has learnt what it needed
+/// of them): node pairs are bounded by their surface elements alone. Returns
+/// the answer and the number of node pairs tested.
 pub(crate) fn surfaces_may_reach(
     a: &ElementHulls,
     rel: &Pose,
     b: &ElementHulls,
     reach_sds: Real,
     workspace: &mut BvhWorkspace,
+    surfaces_only: impl Fn() -> bool,
     mut test: impl FnMut(u32, u32) -> bool,
 ) -> (bool, usize) {
     // All of A as one box first: a node pair of the traversal below can only
@@ -251,18 +300,23 @@ pub(crate) fn surfaces_may_reach(
         &mut workspace.pair_stack,
         |ia, ib| {
             let (ia, ib) = (ia as usize, ib as usize);
-            let limit = a.node_margin[ia].max(b.node_margin[ib])
-                + reach_sds * (a.node_sigma[ia] + b.node_sigma[ib]);
-            !boxes.apart(&a.node_box[ia], &b.node_box[ib], limit)
+            let (na, nb) = (a.bounds(surfaces_only()), b.bounds(surfaces_only()));
+            na.any[ia]
+                && nb.any[ib]
+                && !boxes.apart(
+                    &na.boxes[ia],
+                    &nb.boxes[ib],
+                    NodeBounds::limit(na, ia, nb, ib, reach_sds),
+                )
         },
         // The node whose box, grown by its reach, is the larger first: hulls
         // differ in size and noise far more than points do.
         |ia, ib| {
-            let size = |h: &ElementHulls, i: u32| {
+            let size = |h: &NodeBounds, i: u32| {
                 let i = i as usize;
-                h.node_box[i].half_extents().norm() + h.node_margin[i] + reach_sds * h.node_sigma[i]
+                h.boxes[i].half_extents().norm() + h.margin[i] + reach_sds * h.sigma[i]
             };
-            size(a, ia) >= size(b, ib)
+            size(a.bounds(surfaces_only()), ia) >= size(b.bounds(surfaces_only()), ib)
         },
         |la, lb| {
             let own = a.tree.node_points(la);
@@ -279,6 +333,9 @@ pub(crate) fn surfaces_may_reach(
                 let h = &a.hulls[e as usize];
                 for &f in b.tree.node_points(lb) {
                     let g = &b.hulls[f as usize];
+                    if surfaces_only() && (h.point || g.point) {
+                        continue;
+                    }
                     if pair_may_reach(h, p, g, reach_sds) && test(e, f) {
                         found = true;
                         return false;
@@ -342,20 +399,22 @@ fn root_may_reach(
     reach_sds: Real,
     stack: &mut Vec<(u32, u32)>,
 ) -> (bool, usize) {
-    let root = &a.node_box[0];
+    let tree_b = &b.tree;
+    let (a, b) = (&a.all, &b.all);
+    let root = &a.boxes[0];
     let moved_root = root.moved(&boxes.motion);
-    let (sigma, margin) = (a.node_sigma[0], a.node_margin[0]);
+    let (sigma, margin) = (a.sigma[0], a.margin[0]);
     let mut visited = 0;
     stack.clear();
     stack.push((0, 0));
     while let Some((_, id)) = stack.pop() {
         visited += 1;
         let id = id as usize;
-        let limit = margin.max(b.node_margin[id]) + reach_sds * (sigma + b.node_sigma[id]);
-        if boxes.apart_moved(root, &moved_root, &b.node_box[id], limit) {
+        let limit = margin.max(b.margin[id]) + reach_sds * (sigma + b.sigma[id]);
+        if boxes.apart_moved(root, &moved_root, &b.boxes[id], limit) {
             continue;
         }
-        match b.tree.nodes()[id].children {
+        match tree_b.nodes()[id].children {
             None => return (true, visited),
             Some([l, r]) => {
                 stack.push((0, r));
@@ -397,6 +456,79 @@ mod tests {
         })
     }
 
+    /// Every pair of hulls that reach each other, without the hierarchy: by
+    /// [`pair_may_reach`] and by the boxes of their corners (the test of the
+    /// hierarchy's one-hull leaves; the two are lower bounds on their
+    /// distance, neither tighter than the other everywhere).
+    fn all_pairs(a: &ElementHulls, rel: &Pose, b: &ElementHulls, k: Real) -> Vec<(u32, u32)> {
+        let boxes = BoxGap::new(rel);
+        let corners_box = |h: &Hull| {
+            let mut x = Aabb::empty();
+            h.corners.iter().for_each(|c| x.take_point(c));
+            x
+        };
+        let mut out = Vec::new();
+        for (e, h) in a.hulls.iter().enumerate() {
+            let p = PosedHull {
+                mean: rel * h.mean,
+                normal: rel.rotation * h.normal,
+                corners: h.corners.map(|c| rel * c),
+            };
+            for (f, g) in b.hulls.iter().enumerate() {
+                let limit = h.margin.max(g.margin) + k * (h.sigma + g.sigma);
+                let apart = boxes.apart(&corners_box(h), &corners_box(g), limit);
+                if !apart && pair_may_reach(h, &p, g, k) {
+                    out.push((e as u32, f as u32));
+                }
+            }
+        }
+        out
+    }
+
+    /// Once told to leave single points out (here: after the first pair
+    /// met), the descent still meets every pair of surface elements within
+    /// reach, and no more pairs with a single point.
+    #[test]
+    fn the_descent_by_surfaces_alone_meets_every_surface_pair() {
+        let (sigma, k) = (0.001, 4.9);
+        let a = cloud(0.05, 3000, sigma, 5);
+        let b = cloud(0.04, 2000, sigma, 6);
+        let (ha, hb) = (a.elements().hulls(), b.elements().hulls());
+        let mut ws = BvhWorkspace::default();
+        let mut checked = 0;
+        for step in 0..24 {
+            let gap = -3.0 * sigma + step as Real * sigma;
+            let turn = UnitQuaternion::from_euler_angles(0.3, 0.1 * step as Real, 0.2);
+            let pose = Pose::from_parts(Translation3::new(0.09 + gap, 0.01, 0.0), turn);
+            let is_surface = |(e, f): &(u32, u32)| !ha.hull(*e).point && !hb.hull(*f).point;
+            let mut expected: Vec<(u32, u32)> = all_pairs(ha, &pose, hb, k)
+                .into_iter()
+                .filter(is_surface)
+                .collect();
+            let met = std::cell::RefCell::new(Vec::new());
+            let switched = || !met.borrow().is_empty();
+            surfaces_may_reach(ha, &pose, hb, k, &mut ws, switched, |e, f| {
+                met.borrow_mut().push((e, f));
+                false
+            });
+            let met = met.into_inner();
+            let points_met = met.iter().filter(|p| !is_surface(p)).count();
+            assert!(
+                points_met <= 1,
+                "gap {gap}: {points_met} pairs with a point"
+            );
+            let mut surfaces: Vec<(u32, u32)> = met.into_iter().filter(is_surface).collect();
+            surfaces.sort_unstable();
+            expected.sort_unstable();
+            assert_eq!(surfaces, expected, "gap {gap}");
+            checked += usize::from(!expected.is_empty());
+        }
+        assert!(
+            checked >= 6,
+            "only {checked} poses with surface pairs within reach"
+        );
+    }
+
     #[test]
     fn the_hierarchy_finds_a_reaching_pair_exactly_when_one_exists() {
         let (sigma, k) = (0.001, 4.9);
@@ -411,7 +543,7 @@ mod tests {
             let turn = UnitQuaternion::from_euler_angles(0.1 * step as Real, 0.4, -0.3);
             let dir = Vector3::new(1.0, 0.3 * (step % 5) as Real, -0.2).normalize();
             let pose = Pose::from_parts(Translation3::from(dir * (0.09 + gap)), turn);
-            let (fast, _) = surfaces_may_reach(ha, &pose, hb, k, &mut ws, |_, _| true);
+            let (fast, _) = surfaces_may_reach(ha, &pose, hb, k, &mut ws, || false, |_, _| true);
             assert_eq!(fast, brute_force(ha, &pose, hb, k), "gap {gap}");
             if fast {
                 reached += 1;

@@ -2,6 +2,8 @@
 //! stand for, whether their fitted surfaces can reach each other at all, and
 //! the probability that they cross ([`crate::probability::element`]).
 
+use std::cell::Cell;
+
 use crate::bvh::BvhWorkspace;
 use crate::classify::Separator;
 use crate::element::{surfaces_may_reach, Hull, SurfaceElement, SurfaceElements};
@@ -80,7 +82,7 @@ pub(crate) fn element_surfaces_may_reach(
     let faces = |a: ElementRef<'_>, b: ElementRef<'_>| {
         (a.1.point && b.1.point) || element_pair_within_reach(a, rel, b, reach_sds)
     };
-    first_hull_pair(ea, rel, eb, reach_sds, workspace, faces)
+    first_hull_pair(ea, rel, eb, reach_sds, workspace, false, faces)
 }
 
 /// The element pairs of `ea` (at `rel` in `eb`'s frame) and `eb` whose hulls
@@ -94,10 +96,13 @@ pub(crate) struct PairsWithinReach<'a> {
     /// Whether any pair (of surfaces or single points) may reach: when none
     /// may, the clouds are free.
     pub any: bool,
-    /// The pairs with a surface element on at least one side whose hulls
-    /// pass the hull test (pairs of two single points are left to the near
-    /// rule on the samples); whether they face within reach is asked only of
-    /// those the near rule missed ([`PairsWithinReach::links`]).
+    /// The pairs of two surface elements whose hulls pass the hull test;
+    /// whether they face within reach is asked only of those the near rule
+    /// missed ([`PairsWithinReach::links`]). A pair with a single point is
+    /// left to the near rule: the point is its own sample, and its hull's
+    /// reach is a bound, widest for a scan's stray points (centimetres of
+    /// noise from their sparse sampling), which as links made regions of
+    /// points 8 sigma from the other cloud (a Kinect frame).
     candidates: Vec<(u32, u32)>,
     /// The `z` at which every candidate met so far was tested for a crossing
     /// during the descent (deciding only), and whether one crossed (the
@@ -208,28 +213,39 @@ pub(crate) fn element_pairs_within_reach<'a>(
     // the hull test at the reach may not pass: not here.
     let stop_at = stop_at_crossing.filter(|&z| z.is_finite() && z <= reach_sds);
     let (ha, hb) = (ea.hulls(), eb.hulls());
-    let (mut any, mut candidates, mut crossed) = (false, Vec::new(), false);
+    let any = Cell::new(false);
+    let (mut candidates, mut crossed) = (Vec::new(), false);
     let mut test = |i: u32, j: u32| {
         let (a, b) = (&ea.elements()[i as usize], &eb.elements()[j as usize]);
-        if a.is_point() && b.is_point() {
-            any = true;
+        // The exact test until one pair passes: enough to say the clouds are
+        // not beyond reach. Two single points are left to the near rule.
+        let within = || {
+            (a.is_point() && b.is_point())
+                || element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds)
+        };
+        if !any.get() && within() {
+            any.set(true);
+        }
+        if a.is_point() || b.is_point() {
             return false;
         }
         candidates.push((i, j));
-        // The exact test until one pair passes: enough to say the clouds are
-        // not beyond reach.
-        any = any || element_pair_within_reach((a, ha.hull(i)), rel, (b, hb.hull(j)), reach_sds);
         if let Some(z) = stop_at {
             if element_pair_crosses((a, ha.hull(i)), rel, (b, hb.hull(j)), z) {
                 // Crossing surfaces are within reach of each other.
-                (any, crossed) = (true, true);
+                any.set(true);
+                crossed = true;
                 return true;
             }
         }
         false
     };
     if use_hierarchy {
-        out.visited = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, &mut test).1;
+        // Once some pair is within reach, single points matter no more (see
+        // [`PairsWithinReach::candidates`]): the descent then bounds its
+        // nodes by their surface elements alone.
+        let found = || any.get();
+        out.visited = surfaces_may_reach(ha, rel, hb, reach_sds, workspace, found, &mut test).1;
     } else {
         'all: for i in 0..ea.elements().len() as u32 {
             for j in 0..eb.elements().len() as u32 {
@@ -239,7 +255,7 @@ pub(crate) fn element_pairs_within_reach<'a>(
             }
         }
     }
-    out.any = any;
+    out.any = any.get();
     out.candidates = candidates;
     out.crossing = stop_at.map(|z| (z, crossed));
     out
@@ -274,7 +290,8 @@ pub(crate) fn element_surfaces_cross(
         return (false, 0);
     }
     let crosses = |a: ElementRef<'_>, b: ElementRef<'_>| element_pair_crosses(a, rel, b, z_sds);
-    first_hull_pair(ea, rel, eb, z_sds, workspace, crosses)
+    // Single points never cross anything: the descent reads surfaces alone.
+    first_hull_pair(ea, rel, eb, z_sds, workspace, true, crosses)
 }
 
 /// An element and its hull.
@@ -282,13 +299,14 @@ type ElementRef<'a> = (&'a SurfaceElement, &'a Hull);
 
 /// Whether some pair of elements of `ea` (at `rel` in `eb`'s frame) and `eb`
 /// passes the hull test at `sds` standard deviations and then `test`
-/// ([`surfaces_may_reach`]).
+/// ([`surfaces_may_reach`]); with `surfaces_only`, a pair of surface elements.
 fn first_hull_pair(
     ea: &SurfaceElements,
     rel: &Pose,
     eb: &SurfaceElements,
     sds: Real,
     workspace: &mut BvhWorkspace,
+    surfaces_only: bool,
     test: impl Fn(ElementRef<'_>, ElementRef<'_>) -> bool,
 ) -> (bool, usize) {
     let (ha, hb) = (ea.hulls(), eb.hulls());
@@ -298,7 +316,7 @@ fn first_hull_pair(
             (&eb.elements()[j as usize], hb.hull(j)),
         )
     };
-    surfaces_may_reach(ha, rel, hb, sds, workspace, pair)
+    surfaces_may_reach(ha, rel, hb, sds, workspace, || surfaces_only, pair)
 }
 
 /// Whether some sample of `samples` stands for an element of more than one point.
