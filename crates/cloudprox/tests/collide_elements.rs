@@ -285,13 +285,13 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
 /// at 626 points per square metre with 14.5 mm of noise: a piano's leg through
 /// the floor at 0.5% of the piano's size in the reproduction's scene. The
 /// slab's faces are flat, so each becomes a few elements of thousands of
-/// points and metres across, which five samples stand for: the leg's points
-/// inside the slab are near none of them by the near rule on the samples.
-/// The element pairs whose surfaces face within reach link them into the
-/// near set, and the patches then read the collision in every draw. (Before
-/// the links, no near region formed in most draws and the patches read a
-/// collision in 6 of these 12; the element surfaces' crossing, read after
-/// them, brought that to 11.)
+/// points and metres across. Five samples per element left the leg's points
+/// inside the slab near none of them (no near region in most draws; the
+/// patches read a collision in 6 of these 12, the surfaces' crossing read
+/// after them in 11); the element pairs whose surfaces face within reach
+/// then linked them into the near set (12 of 12). Now such elements are also
+/// sampled on a grid of four spacings, so the near rule on the samples finds
+/// the leg itself, and the patches read the collision in every draw.
 #[test]
 fn a_leg_through_a_floor_sized_slab_collides_in_every_draw() {
     let (density, sigma) = (626.0, 0.0145);
@@ -332,7 +332,7 @@ fn a_leg_through_a_floor_sized_slab_collides_in_every_draw() {
         );
         // The patches said so, not the crossing read after them.
         assert_eq!(c.surface_crossings, 0, "draw {seed}");
-        assert!(c.surface_links > 0 && c.near_regions > 0, "draw {seed}");
+        assert!(c.near_regions > 0, "draw {seed}");
     }
 }
 

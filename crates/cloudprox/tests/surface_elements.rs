@@ -189,3 +189,78 @@ fn an_element_covers_where_its_points_are_not_its_rectangle_corners() {
     }
     assert!(corners_outside > 0, "no rectangle corner left the disc");
 }
+
+/// One point 8 sigma off a flat patch of 900 is no sample of it: the sum of
+/// the squared residuals (about 900 + 64) stays below its own chi-square
+/// bound (about 993 at 1%), so only the test of each point keeps it out
+/// (before, it joined the patch's largest element). The patch stays in large
+/// elements.
+#[test]
+fn a_point_far_off_a_flat_patch_joins_none_of_its_elements() {
+    let sigma = 0.001;
+    let mut pts = add_noise(&grid(30, 0.005, 0.0), sigma, 3);
+    let off = pts.len() as u32;
+    pts.push(Point3::new(0.0725, 0.0725, 8.0 * sigma));
+    let cloud = PointCloud::from_sigma(pts, sigma).unwrap();
+    let el = cloud.elements();
+    let (k, owner) = el
+        .elements()
+        .iter()
+        .enumerate()
+        .find(|(k, _)| el.element_points(*k as u32).contains(&off))
+        .unwrap();
+    assert!(
+        owner.is_point() || owner.count <= 8,
+        "the point joined element {k} of {} points",
+        owner.count
+    );
+    let largest = el.elements().iter().map(|e| e.count).max().unwrap();
+    assert!(largest >= 100, "largest element {largest}");
+}
+
+/// A flat face 30 cm across with a 5 cm hole: its large elements are also
+/// sampled on a grid of about four spacings over where they were sampled, so
+/// every point of an element has one of its samples within two grid pitches,
+/// and no grid sample lies over the hole (the first five, the mean and the
+/// ends of the extent, are where they are: an element around the hole has
+/// its mean in it).
+#[test]
+fn a_large_element_is_sampled_on_a_grid_where_it_was_sampled() {
+    let (sigma, h) = (0.0005, 0.005);
+    let hole = |p: &Point3| (p.x - 0.15).abs() < 0.025 && (p.y - 0.15).abs() < 0.025;
+    let pts: Vec<Point3> = grid(61, h, 0.0).into_iter().filter(|p| !hole(p)).collect();
+    let cloud = PointCloud::from_sigma(add_noise(&pts, sigma, 5), sigma).unwrap();
+    let el = cloud.elements();
+    let samples = el.samples().points();
+    let owner = el.sample_owner();
+    let mut gridded = 0;
+    for (k, e) in el.elements().iter().enumerate() {
+        let own: Vec<&Point3> = (0..owner.len())
+            .filter(|&s| owner[s] as usize == k)
+            .map(|s| &samples[s])
+            .collect();
+        if e.is_point() {
+            assert_eq!(own.len(), 1);
+            continue;
+        }
+        assert!(own.len() >= 5, "element {k}: {} samples", own.len());
+        let across = (e.extent[0][1] - e.extent[0][0]).max(e.extent[1][1] - e.extent[1][0]);
+        if across < 8.0 * e.spacing {
+            continue;
+        }
+        gridded += 1;
+        assert!(own.len() > 5, "element {k}, {across} m across: {} samples", own.len());
+        for x in &own[5..] {
+            // Inside the hole (more than a spacing from its rim) nothing was sampled.
+            let deep = (x.x - 0.15).abs() < 0.025 - h && (x.y - 0.15).abs() < 0.025 - h;
+            assert!(!deep, "element {k}: a grid sample over the hole at {x:?}");
+        }
+        let pitch = 4.0 * e.spacing;
+        for &i in el.element_points(k as u32) {
+            let p = cloud.points()[i as usize];
+            let nearest = own.iter().map(|x| (*x - p).norm()).fold(f64::INFINITY, f64::min);
+            assert!(nearest <= 2.0 * pitch, "element {k}: point {i} {nearest} m from its samples");
+        }
+    }
+    assert!(gridded >= 1, "no element was more than 8 spacings across");
+}

@@ -109,7 +109,18 @@ pub(crate) fn fit_element(
     let Some(f) = weighted_fit(&local, quadric_row) else {
         return median();
     };
-    if f.residual > chi_square_quantile(m - 6, confidence) {
+    // Each point within its own noise too: one point far off a surface that
+    // the others fit (a flying pixel, the corner of another face) adds less
+    // to the sum than the sum's own spread over hundreds of points, but it
+    // samples no part of that surface. The largest standardized residual is
+    // tested against the largest of `m` standard normals (a Bonferroni bound
+    // at the same significance); the residuals' own variance is below the
+    // points', so the test errs towards keeping a group.
+    let z_max = normal_quantile(1.0 - 0.5 * settings.significance / m as Real);
+    let outlier = local
+        .iter()
+        .any(|&(u, v, h, var)| (h - quadric_row(u, v).dot(&f.coef)).powi(2) > z_max * z_max * var);
+    if outlier || f.residual > chi_square_quantile(m - 6, confidence) {
         // No smooth surface explains the points: where the residuals fall into
         // two groups, they sample two surfaces (the fit runs between them).
         let residuals: Vec<(Real, Real)> = local

@@ -3,6 +3,21 @@
 use crate::cloud::PointCloud;
 use crate::element::SurfaceElement;
 use crate::math::{Matrix3, Point3};
+use crate::Real;
+
+/// The pitch, in the element's sampling spacings, of the grid on which a large
+/// element is also sampled. Five samples cannot hold a separating surface to a
+/// face half a metre across where another object meets it between them (a
+/// gripper through a scanned table top, 7 sigma deep, was read free: the
+/// surface trained on them bent around the gripper). On a grid of pitch `p`
+/// the samples' own spacing is about `p sqrt 2`, so the near rule's half
+/// spacing reaches every point of the surface from some sample, and a large
+/// element costs the classifier at most one sample per `p^2` of its points'
+/// squares (a 16th at 4). On the reproduction's piano levels the grid halved
+/// the 0.5% and 1% queries' median time (fewer misfit cuts and links) with
+/// accuracy level or better; a pitch of 2 was measured on the Kinect frame
+/// only.
+pub(crate) const GRID_PITCH_SPACINGS: Real = 4.0;
 
 /// The samples of `elements` (see [`crate::element::SurfaceElements::samples`])
 /// and the element each stands for.
@@ -24,7 +39,8 @@ pub(crate) fn element_samples(
             owner.push(k as u32);
             continue;
         }
-        for (u, v) in e.sample_coordinates() {
+        let grid = grid_coordinates(e, GRID_PITCH_SPACINGS * e.spacing);
+        for (u, v) in e.sample_coordinates().into_iter().chain(grid) {
             let (p, var) = e.surface_point(u, v);
             let cov = e.surface_covariance(var);
             points.push(p);
@@ -37,4 +53,26 @@ pub(crate) fn element_samples(
         PointCloud::from_total_and_sensor(points, total, sensor),
         owner,
     )
+}
+
+/// Tangential coordinates of the centres of a grid of pitch about `pitch` over
+/// `e`'s extent (cells of equal size, at least two along some tangent), where
+/// the surface was sampled ([`SurfaceElement::covers`]); none for an element
+/// less than two pitches across either tangent.
+fn grid_coordinates(e: &SurfaceElement, pitch: Real) -> Vec<(Real, Real)> {
+    let [[u0, u1], [v0, v1]] = e.extent;
+    if !(pitch.is_finite() && pitch > 0.0) {
+        return Vec::new();
+    }
+    let cells = |lo: Real, hi: Real| ((hi - lo) / pitch).floor().max(1.0) as usize;
+    let (nu, nv) = (cells(u0, u1), cells(v0, v1));
+    if nu < 2 && nv < 2 {
+        return Vec::new();
+    }
+    let (du, dv) = ((u1 - u0) / nu as Real, (v1 - v0) / nv as Real);
+    (0..nu)
+        .flat_map(|i| (0..nv).map(move |j| (i, j)))
+        .map(|(i, j)| (u0 + (i as Real + 0.5) * du, v0 + (j as Real + 0.5) * dv))
+        .filter(|&(u, v)| e.covers(u, v))
+        .collect()
 }

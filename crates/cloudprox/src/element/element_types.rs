@@ -236,8 +236,11 @@ impl SurfaceElements {
 
     /// The cloud of samples standing for the elements (five per multi-point
     /// element: its mean and the four edges of its extent on the fitted plane,
-    /// each with the covariance of the plane's height there; the point itself for
-    /// a single-point element, with its own covariances).
+    /// then, for an element more than two grid pitches across, the centres of
+    /// a grid of four sampling spacings over where it was sampled; each with
+    /// the covariance of the plane's height there; the point itself for a
+    /// single-point element, with its own covariances). An element's samples
+    /// are contiguous, its mean first.
     pub fn samples(&self) -> &PointCloud {
         &self.samples
     }
