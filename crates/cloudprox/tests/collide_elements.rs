@@ -290,7 +290,7 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
 /// patches read a collision in 6 of these 12, the surfaces' crossing read
 /// after them in 11); the element pairs whose surfaces face within reach
 /// then linked them into the near set (12 of 12). Now such elements are also
-/// sampled on a grid of four spacings, so the near rule on the samples finds
+/// sampled on a grid of six spacings, so the near rule on the samples finds
 /// the leg itself, and the patches read the collision in every draw.
 #[test]
 fn a_leg_through_a_floor_sized_slab_collides_in_every_draw() {

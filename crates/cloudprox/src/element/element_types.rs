@@ -237,7 +237,7 @@ impl SurfaceElements {
     /// The cloud of samples standing for the elements (five per multi-point
     /// element: its mean and the four edges of its extent on the fitted plane,
     /// then, for an element more than two grid pitches across, the centres of
-    /// a grid of four sampling spacings over where it was sampled; each with
+    /// a grid of six sampling spacings over where it was sampled; each with
     /// the covariance of the plane's height there; the point itself for a
     /// single-point element, with its own covariances). An element's samples
     /// are contiguous, its mean first.
