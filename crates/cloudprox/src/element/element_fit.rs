@@ -116,17 +116,17 @@ pub(crate) fn fit_element(
     // tested against the largest of `m` standard normals (a Bonferroni bound
     // at the same significance); the residuals' own variance is below the
     // points', so the test errs towards keeping a group.
-    let z_max = normal_quantile(1.0 - 0.5 * settings.significance / m as Real);
-    let outlier = local
+    let residuals: Vec<(Real, Real)> = local
         .iter()
-        .any(|&(u, v, h, var)| (h - quadric_row(u, v).dot(&f.coef)).powi(2) > z_max * z_max * var);
+        .map(|&(u, v, h, var)| (h - quadric_row(u, v).dot(&f.coef), var))
+        .collect();
+    let z_max = -normal_quantile(0.5 * settings.significance / m as Real);
+    let outlier = residuals
+        .iter()
+        .any(|&(r, var)| r * r > z_max * z_max * var);
     if outlier || f.residual > chi_square_quantile(m - 6, confidence) {
         // No smooth surface explains the points: where the residuals fall into
         // two groups, they sample two surfaces (the fit runs between them).
-        let residuals: Vec<(Real, Real)> = local
-            .iter()
-            .map(|&(u, v, h, var)| (h - quadric_row(u, v).dot(&f.coef), var))
-            .collect();
         let at = two_surfaces(&residuals).filter(|&t| {
             let below = residuals.iter().filter(|(r, _)| *r < t).count();
             below >= 3 && m - below >= 3

@@ -4,7 +4,7 @@
 //! fitted surfaces.
 //!
 //! The points model finds its near set from single points, and so does the
-//! elements model from its elements' samples; but five samples of a large flat
+//! elements model from its elements' samples; but the samples of a large flat
 //! element are a spacing of several millimetres apart, and the half spacing by
 //! which sampled surfaces may come closer than their samples then keeps two
 //! clouds "near" far beyond their noise (two 10 000-point spheres at 1 mm of
@@ -300,7 +300,8 @@ pub(crate) fn surfaces_may_reach(
         &mut workspace.pair_stack,
         |ia, ib| {
             let (ia, ib) = (ia as usize, ib as usize);
-            let (na, nb) = (a.bounds(surfaces_only()), b.bounds(surfaces_only()));
+            let only = surfaces_only();
+            let (na, nb) = (a.bounds(only), b.bounds(only));
             na.any[ia]
                 && nb.any[ib]
                 && !boxes.apart(
@@ -316,7 +317,8 @@ pub(crate) fn surfaces_may_reach(
                 let i = i as usize;
                 h.boxes[i].half_extents().norm() + h.margin[i] + reach_sds * h.sigma[i]
             };
-            size(a.bounds(surfaces_only()), ia) >= size(b.bounds(surfaces_only()), ib)
+            let only = surfaces_only();
+            size(a.bounds(only), ia) >= size(b.bounds(only), ib)
         },
         |la, lb| {
             let own = a.tree.node_points(la);
@@ -492,19 +494,27 @@ mod tests {
     fn the_descent_by_surfaces_alone_meets_every_surface_pair() {
         let (sigma, k) = (0.001, 4.9);
         let a = cloud(0.05, 3000, sigma, 5);
-        let b = cloud(0.04, 2000, sigma, 6);
+        // B with stray points off its surface towards A (single-point
+        // elements in the contact zone).
+        let mut pts = cloud(0.04, 2000, sigma, 6).points().to_vec();
+        for j in 0..12 {
+            let t = 0.15 * (j as Real - 5.5);
+            let dir = Vector3::new(1.0, 0.6 * t, 0.4 * t.sin()).normalize();
+            pts.push(Point3::from(dir * (0.04 + (3 + j % 4) as Real * sigma)));
+        }
+        let b = PointCloud::from_sigma(pts, sigma).unwrap();
         let (ha, hb) = (a.elements().hulls(), b.elements().hulls());
         let mut ws = BvhWorkspace::default();
-        let mut checked = 0;
+        let (mut checked, mut with_points) = (0, 0);
         for step in 0..24 {
             let gap = -3.0 * sigma + step as Real * sigma;
             let turn = UnitQuaternion::from_euler_angles(0.3, 0.1 * step as Real, 0.2);
             let pose = Pose::from_parts(Translation3::new(0.09 + gap, 0.01, 0.0), turn);
             let is_surface = |(e, f): &(u32, u32)| !ha.hull(*e).point && !hb.hull(*f).point;
-            let mut expected: Vec<(u32, u32)> = all_pairs(ha, &pose, hb, k)
-                .into_iter()
-                .filter(is_surface)
-                .collect();
+            let every = all_pairs(ha, &pose, hb, k);
+            // Pairs with a single point the switch must leave out.
+            with_points += usize::from(every.iter().filter(|p| !is_surface(p)).count() >= 2);
+            let mut expected: Vec<(u32, u32)> = every.into_iter().filter(is_surface).collect();
             let met = std::cell::RefCell::new(Vec::new());
             let switched = || !met.borrow().is_empty();
             surfaces_may_reach(ha, &pose, hb, k, &mut ws, switched, |e, f| {
@@ -526,6 +536,10 @@ mod tests {
         assert!(
             checked >= 6,
             "only {checked} poses with surface pairs within reach"
+        );
+        assert!(
+            with_points >= 3,
+            "only {with_points} poses with pairs of a single point"
         );
     }
 

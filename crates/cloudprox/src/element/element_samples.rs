@@ -12,7 +12,7 @@ use crate::Real;
 /// surface trained on them bent around the gripper). On a grid of pitch `p`
 /// the samples' own spacing is about `p sqrt 2`, so the near rule's half
 /// spacing reaches every point of the surface from some sample, and a large
-/// element costs the classifier at most one sample per `p^2` of its points.
+/// element costs the classifier about one sample per `p^2` of its points.
 /// Measured at 4, 6 and 8 (the reproduction's piano levels, the Kinect frame,
 /// the criterion spheres): at 4 the 5 mm spheres 3 sigma into each other
 /// took 2.8x as long (grid samples over their curved elements cut the region
@@ -59,7 +59,7 @@ pub(crate) fn element_samples(
 /// Tangential coordinates of the centres of a grid of pitch about `pitch` over
 /// `e`'s extent (cells of equal size, at least two along some tangent), where
 /// the surface was sampled ([`SurfaceElement::covers`]); none for an element
-/// less than two pitches across either tangent.
+/// less than two pitches across along both tangents.
 fn grid_coordinates(e: &SurfaceElement, pitch: Real) -> Vec<(Real, Real)> {
     let [[u0, u1], [v0, v1]] = e.extent;
     if !(pitch.is_finite() && pitch > 0.0) {

@@ -197,9 +197,10 @@ impl SurfaceElement {
         across * self.cov_mean * across + nn * var
     }
 
-    /// The tangential coordinates of the five samples that stand for the element
-    /// in a classifier: over the mean, and at the ends of its range along each
-    /// tangent.
+    /// The tangential coordinates of the five standard samples that stand for
+    /// the element in a classifier: over the mean, and at the ends of its range
+    /// along each tangent (a large element's grid samples follow them in
+    /// [`SurfaceElements::samples`]).
     pub fn sample_coordinates(&self) -> [(Real, Real); 5] {
         let [[u0, u1], [v0, v1]] = self.extent;
         [(0.0, 0.0), (u1, 0.0), (u0, 0.0), (0.0, v1), (0.0, v0)]

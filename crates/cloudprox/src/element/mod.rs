@@ -8,15 +8,18 @@
 //! a top-down split (at the median along the largest principal axis, or between
 //! two surfaces where the points along the normal fall into two groups further
 //! apart than the noise, as the two faces of a thin plate do); a group is an
-//! element as soon as two statistical tests at the significance level
+//! element as soon as three statistical tests at the significance level
 //! [`ElementSettings::significance`] and a coverage test accept it:
 //!
 //! 1. **Residual test.** A quadric height field `h(u, v)` over the group's
 //!    principal plane is fitted by weighted least squares, each point weighted by
 //!    its sensor variance along the normal. The weighted residual sum follows a
 //!    chi-square law with `m - 6` degrees of freedom when the points sample one
-//!    smooth surface with the stated noise; two faces, an edge, a corner or an
-//!    outlier make it too large.
+//!    smooth surface with the stated noise; two faces, an edge or a corner make
+//!    it too large. Each point's standardized residual must also stay below
+//!    the largest of `m` standard normals (a Bonferroni bound): one point far
+//!    off a surface the others fit adds less to the sum than the sum's own
+//!    spread over hundreds of points.
 //! 2. **Curvature test.** The quadric's three curvature coefficients, against
 //!    their covariance from the fit (a Wald statistic, chi-square with 3 degrees
 //!    of freedom): where curvature is significant the group is larger than the
@@ -53,7 +56,8 @@
 //! slopes' uncertainty included
 //! ([`SurfaceElement::surface_point`]). In a query it is represented by five
 //! samples of that surface ([`SurfaceElements::samples`]): over its mean and at
-//! the ends of its points' range along each tangent.
+//! the ends of its points' range along each tangent; a large element also by
+//! a grid of six sampling spacings over where it was sampled.
 //!
 //! Each element also has a *hull*: its fitted surface at the four corners of
 //! the extent (the surface is a plane over the extent, so it lies in their

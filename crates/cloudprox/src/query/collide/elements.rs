@@ -175,13 +175,14 @@ impl PairsWithinReach<'_> {
     }
 }
 
-/// Every element pair of `ea` (at `rel` in `eb`'s frame) and `eb` that may
+/// Whether any element pair of `ea` (at `rel` in `eb`'s frame) and `eb` may
 /// come within `reach_sds` noise standard deviations, beyond half a sampling
-/// spacing, of each other: by the hierarchies over both clouds' element hulls,
-/// or (`use_hierarchy = false`) over every pair. A metre-wide element stands
-/// in the near set for five samples, which a thin part passing through its
-/// middle may be far from: these pairs are what bring such an element into
-/// the near set ([`crate::query::collide::near`]).
+/// spacing, of each other, and every such pair of two surface elements (the
+/// candidates): by the hierarchies over both clouds' element hulls, or
+/// (`use_hierarchy = false`) over every pair. A wide element stands in the
+/// near set for its samples, which a thin part passing between them may be
+/// far from: these pairs are what bring such an element into the near set
+/// ([`crate::query::collide::near`]).
 ///
 /// With `stop_at_crossing = Some(z)` (deciding only, `z` at most the reach)
 /// each candidate is also tested for a crossing at `z` as it is met, and the
