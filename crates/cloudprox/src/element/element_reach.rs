@@ -265,6 +265,17 @@ struct PosedHull {
     corners: [Point3; 4],
 }
 
+impl PosedHull {
+    /// Hull `h` moved by `rel`.
+    fn new(h: &Hull, rel: &Pose) -> Self {
+        Self {
+            mean: rel * h.mean,
+            normal: rel.rotation * h.normal,
+            corners: h.corners.map(|c| rel * c),
+        }
+    }
+}
+
 /// Whether some pair of elements, `ea` of `a` (at `rel` in `b`'s frame) and
 /// `eb` of `b`, passes [`pair_may_reach`] (its surfaces may lie within reach
 /// of each other) and then `test(ea, eb)`, the caller's exact test of the pair
@@ -323,14 +334,10 @@ pub(crate) fn surfaces_may_reach(
         |la, lb| {
             let own = a.tree.node_points(la);
             posed.clear();
-            posed.extend(own.iter().map(|&e| {
-                let h = &a.hulls[e as usize];
-                PosedHull {
-                    mean: rel * h.mean,
-                    normal: rel.rotation * h.normal,
-                    corners: h.corners.map(|c| rel * c),
-                }
-            }));
+            posed.extend(
+                own.iter()
+                    .map(|&e| PosedHull::new(&a.hulls[e as usize], rel)),
+            );
             for (&e, p) in own.iter().zip(&posed) {
                 let h = &a.hulls[e as usize];
                 for &f in b.tree.node_points(lb) {
@@ -449,11 +456,7 @@ mod tests {
     /// Every pair of hulls, without the hierarchy.
     fn brute_force(a: &ElementHulls, rel: &Pose, b: &ElementHulls, k: Real) -> bool {
         a.hulls.iter().any(|h| {
-            let p = PosedHull {
-                mean: rel * h.mean,
-                normal: rel.rotation * h.normal,
-                corners: h.corners.map(|c| rel * c),
-            };
+            let p = PosedHull::new(h, rel);
             b.hulls.iter().any(|g| pair_may_reach(h, &p, g, k))
         })
     }
@@ -471,11 +474,7 @@ mod tests {
         };
         let mut out = Vec::new();
         for (e, h) in a.hulls.iter().enumerate() {
-            let p = PosedHull {
-                mean: rel * h.mean,
-                normal: rel.rotation * h.normal,
-                corners: h.corners.map(|c| rel * c),
-            };
+            let p = PosedHull::new(h, rel);
             for (f, g) in b.hulls.iter().enumerate() {
                 let limit = h.margin.max(g.margin) + k * (h.sigma + g.sigma);
                 let apart = boxes.apart(&corners_box(h), &corners_box(g), limit);
