@@ -24,6 +24,10 @@ def test_result_fields(spheres) -> None:
     assert r.probability == pytest.approx(
         max(r.probabilities_a.max(), r.probabilities_b.max()), abs=0.0
     )
+    for (idx, val), dense in ((r.nonzero_a, r.probabilities_a), (r.nonzero_b, r.probabilities_b)):
+        assert idx.dtype == np.int64 and val.dtype == np.float64
+        np.testing.assert_array_equal(idx, np.flatnonzero(dense))
+        np.testing.assert_array_equal(val, dense[idx])
     assert isinstance(r.stats, cp.QueryStats)
     assert set(r.stats.to_dict()) == {
         "node_pairs_visited",
@@ -187,3 +191,25 @@ def test_elements_model_rejects_the_surface_aggregation(spheres) -> None:
         cp.collide(a, b, model="elements", aggregation="surface")
     with pytest.raises(cp.InvalidInputError, match="unknown model 'surfels'"):
         cp.collide(a, b, model="surfels")
+
+
+def test_a_batch_of_results_holds_the_contacts_not_the_clouds() -> None:
+    # A small sphere touching a 200 000-point floor: each result keeps the
+    # probabilities of the points near the contact, not 200 000 zeros.
+    import pickle
+
+    rng = np.random.default_rng(3)
+    floor = cp.PointCloud(
+        np.column_stack([rng.uniform(-2, 2, (200_000, 2)), rng.normal(0, 1e-3, 200_000)]),
+        sigma=1e-3,
+    )
+    d = rng.normal(size=(500, 3))
+    ball = cp.PointCloud(0.05 * d / np.linalg.norm(d, axis=1, keepdims=True), sigma=1e-3)
+    poses = [from_translation([0.0, 0.0, 0.05 + gap]) for gap in (0.0, 0.001, 0.003)]
+    results = cp.collide_many(ball, floor, poses, model="points")
+    for r in results:
+        idx, val = r.nonzero_b
+        assert 0 < len(idx) < 5_000
+        assert r.probabilities_b.shape == (200_000,)
+        assert np.count_nonzero(r.probabilities_b) == len(idx)
+        assert len(pickle.dumps(r)) < 200_000

@@ -324,11 +324,23 @@ class CollisionResult:
     def probabilities_a(self) -> _FloatArray:
         """Per-point probability of A's points being on the wrong side, shape ``(n_a,)``.
 
-        Points outside every near region get 0.
+        Points outside every near region get 0. The result stores only the
+        near regions' points (a batch of results of a large cloud holds memory
+        in proportion to its contacts): each read builds a new array.
         """
     @property
     def probabilities_b(self) -> _FloatArray:
         """Per-point probability of B's points being on the wrong side, shape ``(n_b,)``."""
+    @property
+    def nonzero_a(self) -> tuple[_IntArray, _FloatArray]:
+        """A's points with a non-zero probability, by index, and their probabilities.
+
+        ``(indices (m,) int64, probabilities (m,))``: what ``probabilities_a``
+        holds without its zeros, without building the ``(n_a,)`` array.
+        """
+    @property
+    def nonzero_b(self) -> tuple[_IntArray, _FloatArray]:
+        """The same for B."""
     @property
     def points_a(self) -> _FloatArray | None:
         """Side A's points as queried (a mesh side: its samples), world frame, ``(n_a, 3)``.

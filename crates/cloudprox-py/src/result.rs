@@ -7,7 +7,9 @@ use cloudprox::classify::{Separator, SolveStatus, Surface};
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
 use cloudprox::math::{Point3, Vector3};
-use cloudprox::query::{CollisionResult, ContactPatch, QueryCounters, QueryStats};
+use cloudprox::query::{
+    CollisionResult, ContactPatch, PointProbabilities, QueryCounters, QueryStats,
+};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -15,7 +17,7 @@ use pyo3::types::{PyDict, PyList, PyTuple};
 use crate::convert::{
     indices_to_py, points_from, points_to_py, rows3_to_py, vec_to_py, vector3_to_py,
 };
-use crate::error::guard;
+use crate::error::{guard, CoreResultExt};
 
 /// The values `(m,)` and gradients `(m, 3)` of a separating surface.
 type Evaluation<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
@@ -104,12 +106,27 @@ type PatchState = (
     u32,
 );
 
+/// The pickled form of per-point probabilities: the points, the stored
+/// indices and their values.
+type SparseState = (usize, Vec<u32>, Vec<f64>);
+
+fn sparse_to_state(p: &PointProbabilities) -> SparseState {
+    (p.len(), p.indices().to_vec(), p.values().to_vec())
+}
+
+fn sparse_from_state(
+    py: Python<'_>,
+    (len, indices, values): SparseState,
+) -> PyResult<PointProbabilities> {
+    PointProbabilities::from_sparse(len, indices, values).or_py(py)
+}
+
 /// The pickled form of a `CollisionResult` (without the clouds it was computed on).
 type ResultState = (
     f64,
     String,
-    Vec<f64>,
-    Vec<f64>,
+    SparseState,
+    SparseState,
     Vec<PatchState>,
     StatsState,
     Option<[f64; 3]>,
@@ -364,8 +381,8 @@ impl PyContactPatch {
 pub struct PyCollisionResult {
     probability: f64,
     state: &'static str,
-    probabilities_a: Vec<f64>,
-    probabilities_b: Vec<f64>,
+    probabilities_a: PointProbabilities,
+    probabilities_b: PointProbabilities,
     patches: Vec<Py<PyContactPatch>>,
     stats: QueryStats,
     /// The points model's `max`, `union` and `independent` aggregates.
@@ -445,16 +462,39 @@ impl PyCollisionResult {
         self.state
     }
 
-    /// Per-point probability of A's points being on the wrong side, shape `(n_a,)`.
+    /// Per-point probability of A's points being on the wrong side, shape `(n_a,)`
+    /// (a new array each time: the result stores the near regions' points only).
     #[getter]
     fn probabilities_a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vec_to_py(py, &self.probabilities_a)
+        PyArray1::from_vec(py, self.probabilities_a.to_dense())
     }
 
     /// Per-point probability of B's points being on the wrong side, shape `(n_b,)`.
     #[getter]
     fn probabilities_b<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vec_to_py(py, &self.probabilities_b)
+        PyArray1::from_vec(py, self.probabilities_b.to_dense())
+    }
+
+    /// The points of A with a non-zero probability and their probabilities:
+    /// `(indices (m,) int64, probabilities (m,))`, by index; what
+    /// `probabilities_a` holds without its zeros.
+    #[getter]
+    fn nonzero_a<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>) {
+        let p = &self.probabilities_a;
+        (indices_to_py(py, p.indices()), vec_to_py(py, p.values()))
+    }
+
+    /// The same for B.
+    #[getter]
+    fn nonzero_b<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>) {
+        let p = &self.probabilities_b;
+        (indices_to_py(py, p.indices()), vec_to_py(py, p.values()))
     }
 
     /// Side A's points as queried (a mesh side: its samples), world frame, shape
@@ -500,8 +540,8 @@ impl PyCollisionResult {
         let state = (
             me.probability,
             me.state.to_string(),
-            me.probabilities_a.clone(),
-            me.probabilities_b.clone(),
+            sparse_to_state(&me.probabilities_a),
+            sparse_to_state(&me.probabilities_b),
             patches,
             PyQueryStats::state_of(&me.stats),
             me.point_aggregates,
@@ -521,8 +561,8 @@ impl PyCollisionResult {
         Ok(Self {
             probability,
             state: state_name(py, &state_text)?,
-            probabilities_a,
-            probabilities_b,
+            probabilities_a: sparse_from_state(py, probabilities_a)?,
+            probabilities_b: sparse_from_state(py, probabilities_b)?,
             patches,
             stats: PyQueryStats::from_state(py, stats)?,
             point_aggregates: aggregates,

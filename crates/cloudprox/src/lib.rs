@@ -81,7 +81,7 @@ pub mod prelude {
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
         collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
-        MeshSampling, QueryModel, QueryStats,
+        MeshSampling, PointProbabilities, QueryModel, QueryStats,
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{

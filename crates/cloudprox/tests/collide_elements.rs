@@ -209,7 +209,8 @@ fn decide_only_gives_the_full_querys_state() {
             let r = collide(&Pose::identity(), &a, &pb, &b, &full).unwrap();
             let q = collide(&Pose::identity(), &a, &pb, &b, &quick).unwrap();
             assert_eq!(r.state, q.state, "{model:?} gap {gap}");
-            assert!(q.probabilities_a.iter().all(|&p| p == 0.0));
+            assert!(q.probabilities_a.to_dense().iter().all(|&p| p == 0.0));
+            assert_eq!(q.probabilities_a.len(), a.len());
             crossings += q.stats.counters.surface_crossings;
         }
         // The elements' deepest pose (4 sigma, 8 mm) is decided by a crossing
@@ -401,7 +402,7 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
         let x = a.points()[i as usize];
         let (f, g) = region.separator.value_and_gradient(&x);
         let p = point_probability(f, &g, &a.covariances()[i as usize], 1.0);
-        assert!((p - r.probabilities_a[i as usize]).abs() < 1e-9);
+        assert!((p - r.probabilities_a.get(i as usize)).abs() < 1e-9);
     }
     for &i in &region.indices_b {
         let x = pb * b.points()[i as usize];
@@ -409,13 +410,13 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
         let cov = rot.matrix() * b.covariances()[i as usize] * rot.matrix().transpose();
         let (f, g) = region.separator.value_and_gradient(&x);
         let p = point_probability(f, &g, &cov, -1.0);
-        assert!((p - r.probabilities_b[i as usize]).abs() < 1e-9);
+        assert!((p - r.probabilities_b.get(i as usize)).abs() < 1e-9);
     }
     // The region holds tens of samples, not thousands of points.
     assert!(r.stats.counters.points_classified < 400, "{:?}", r.stats);
     // Every point of the patch's elements is reported, none outside it.
     let inside: std::collections::HashSet<u32> = region.indices_a.iter().copied().collect();
-    for (i, &p) in r.probabilities_a.iter().enumerate() {
+    for (i, &p) in r.probabilities_a.to_dense().iter().enumerate() {
         if !inside.contains(&(i as u32)) {
             assert_eq!(p, 0.0, "point {i} outside the patch");
         }
@@ -423,7 +424,7 @@ fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     assert!(region
         .indices_a
         .iter()
-        .any(|&i| r.probabilities_a[i as usize] > 0.0));
+        .any(|&i| r.probabilities_a.get(i as usize) > 0.0));
 }
 
 #[test]
@@ -471,8 +472,9 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
         assert_eq!(r.state, CollisionState::Free);
         assert!(r
             .probabilities_a
+            .to_dense()
             .iter()
-            .chain(&r.probabilities_b)
+            .chain(&r.probabilities_b.to_dense())
             .all(|&p| p == 0.0));
     }
     assert!(pruned >= 1, "no gap between 3 and 7 sigma was pruned");

@@ -10,5 +10,5 @@ pub mod exact;
 
 pub use collide::{
     collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
-    MeshSampling, PointAggregates, QueryCounters, QueryModel, QueryStats,
+    MeshSampling, PointAggregates, PointProbabilities, QueryCounters, QueryModel, QueryStats,
 };

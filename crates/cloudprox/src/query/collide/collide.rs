@@ -19,7 +19,8 @@ use crate::query::collide::probabilities::{
 };
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
-    CollisionRequest, CollisionResult, ContactPatch, PointAggregates, QueryModel, QueryStats,
+    CollisionRequest, CollisionResult, ContactPatch, PointAggregates, PointProbabilities,
+    QueryModel, QueryStats,
 };
 use crate::Real;
 
@@ -141,8 +142,8 @@ pub(crate) fn collide_with_workspace(
             return Ok(CollisionResult {
                 probability,
                 state: request.thresholds.state(probability),
-                probabilities_a: vec![0.0; a.len()],
-                probabilities_b: vec![0.0; b.len()],
+                probabilities_a: PointProbabilities::zeros(a.len()),
+                probabilities_b: PointProbabilities::zeros(b.len()),
                 patches: Vec::new(),
                 point_aggregates: None,
                 stats,
@@ -162,8 +163,11 @@ pub(crate) fn collide_with_workspace(
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();
 
+    // Every point's probability while the patches are read (the pages a query
+    // never writes are never touched); the result keeps the points written.
     let mut probabilities_a: Vec<Real> = vec![0.0; a.len()];
     let mut probabilities_b: Vec<Real> = vec![0.0; b.len()];
+    let mut written: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     // What the aggregation reads per sample: p_i, the surface probability q_i,
     // or the pair crossing probability.
     let mut inputs_a: Vec<Real> = vec![0.0; sa.len()];
@@ -336,6 +340,10 @@ pub(crate) fn collide_with_workspace(
                     (ia, ib)
                 }
             };
+            if !request.decide_only {
+                written.0.extend_from_slice(&indices_a);
+                written.1.extend_from_slice(&indices_b);
+            }
             let mut separator = fit.classification.separator;
             separator.frame = *pose_b;
             patches.push(ContactPatch {
@@ -398,8 +406,8 @@ pub(crate) fn collide_with_workspace(
     Ok(CollisionResult {
         probability,
         state: request.thresholds.state(probability),
-        probabilities_a,
-        probabilities_b,
+        probabilities_a: PointProbabilities::gather(&probabilities_a, written.0),
+        probabilities_b: PointProbabilities::gather(&probabilities_b, written.1),
         patches,
         point_aggregates,
         stats,

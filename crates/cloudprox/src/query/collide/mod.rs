@@ -41,4 +41,6 @@ pub use collide_mesh_cloud::{
 };
 pub(crate) use elements::element_surfaces_may_reach;
 pub use request::{CollisionRequest, QueryModel};
-pub use result::{CollisionResult, ContactPatch, PointAggregates, QueryCounters, QueryStats};
+pub use result::{
+    CollisionResult, ContactPatch, PointAggregates, PointProbabilities, QueryCounters, QueryStats,
+};

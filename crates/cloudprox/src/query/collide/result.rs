@@ -1,6 +1,7 @@
 //! What a collision query returns: plain data with documented conventions.
 
 use crate::classify::{Separator, SolveStatus, Surface};
+use crate::error::{Error, Result};
 use crate::math::{Point3, Vector3};
 use crate::probability::{Aggregation, CollisionState};
 use crate::Real;
@@ -38,6 +39,134 @@ pub struct ContactPatch {
     pub status: SolveStatus,
     /// Interior-point iterations of the solve.
     pub iterations: u32,
+}
+
+/// Per-point probabilities of one cloud's `len` points: 0 but at the points of
+/// the near regions, which alone are stored (a query near a few hundred points
+/// of a cloud of millions keeps a few hundred values, so a batch of results
+/// holds memory in proportion to the contacts, not to the clouds). Zeros are
+/// never stored, so equal probabilities compare equal.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PointProbabilities {
+    len: usize,
+    indices: Vec<u32>,
+    values: Vec<Real>,
+}
+
+impl PointProbabilities {
+    /// `len` zeros.
+    pub fn zeros(len: usize) -> Self {
+        Self {
+            len,
+            indices: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    /// The probabilities at `indices` (strictly increasing, each below `len`)
+    /// and 0 elsewhere.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] if `indices` and `values` differ in length, the
+    /// indices are not strictly increasing or not below `len`, or a value is
+    /// not a probability (in `[0, 1]`).
+    pub fn from_sparse(len: usize, indices: Vec<u32>, values: Vec<Real>) -> Result<Self> {
+        if indices.len() != values.len() {
+            return Err(Error::invalid(format!(
+                "{} indices but {} values",
+                indices.len(),
+                values.len()
+            )));
+        }
+        if indices.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(Error::invalid("indices are not strictly increasing"));
+        }
+        if let Some(&last) = indices.last() {
+            if last as usize >= len {
+                return Err(Error::invalid(format!(
+                    "index {last} is not below the {len} points"
+                )));
+            }
+        }
+        if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+            return Err(Error::invalid(format!("{v} is not a probability")));
+        }
+        let (indices, values) = indices
+            .into_iter()
+            .zip(values)
+            .filter(|&(_, v)| v != 0.0)
+            .unzip();
+        Ok(Self {
+            len,
+            indices,
+            values,
+        })
+    }
+
+    /// The non-zero entries of `dense` at `indices` (any order, repeats
+    /// allowed; every other entry of `dense` must be 0).
+    pub(crate) fn gather(dense: &[Real], mut indices: Vec<u32>) -> Self {
+        indices.sort_unstable();
+        indices.dedup();
+        let (indices, values) = indices
+            .into_iter()
+            .map(|i| (i, dense[i as usize]))
+            .filter(|&(_, v)| v != 0.0)
+            .unzip();
+        Self {
+            len: dense.len(),
+            indices,
+            values,
+        }
+    }
+
+    /// Number of points (stored or not).
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the cloud has no points.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Point `i`'s probability (0 for a point outside every near region).
+    ///
+    /// # Panics
+    /// If `i >= len`.
+    pub fn get(&self, i: usize) -> Real {
+        assert!(i < self.len, "point {i} of {}", self.len);
+        self.indices
+            .binary_search(&(i as u32))
+            .map_or(0.0, |k| self.values[k])
+    }
+
+    /// The stored points' indices, increasing.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// The stored points' probabilities, in the order of [`Self::indices`].
+    pub fn values(&self) -> &[Real] {
+        &self.values
+    }
+
+    /// `(index, probability)` of the stored points, by index.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, Real)> + '_ {
+        self.indices
+            .iter()
+            .copied()
+            .zip(self.values.iter().copied())
+    }
+
+    /// Every point's probability, `len` values.
+    pub fn to_dense(&self) -> Vec<Real> {
+        let mut out = vec![0.0; self.len];
+        for (i, p) in self.iter() {
+            out[i as usize] = p;
+        }
+        out
+    }
 }
 
 /// The counters of one query: everything in [`QueryStats`] but the wall
@@ -109,10 +238,11 @@ pub struct CollisionResult {
     /// The decided state from `P` and the thresholds.
     pub state: CollisionState,
     /// Per-point probability of cloud A's points lying on the wrong side (0 for
-    /// points outside every near region).
-    pub probabilities_a: Vec<Real>,
+    /// points outside every near region), stored for the near regions' points
+    /// only.
+    pub probabilities_a: PointProbabilities,
     /// The same for cloud B.
-    pub probabilities_b: Vec<Real>,
+    pub probabilities_b: PointProbabilities,
     /// The classified patches of the near regions.
     pub patches: Vec<ContactPatch>,
     /// With the points model (not `decide_only`): `P` under each of the
@@ -159,5 +289,53 @@ impl PointAggregates {
             Aggregation::Independent => Some(self.independent),
             Aggregation::Surface => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sparse_probabilities_read_as_their_dense_values() {
+        let dense = [0.0, 0.25, 0.0, 0.0, 1.0, 0.0];
+        // Indices out of order, repeated, and one at a zero: only the non-zero
+        // values are kept, in index order.
+        let p = PointProbabilities::gather(&dense, vec![4, 1, 4, 2]);
+        assert_eq!(p.len(), 6);
+        assert_eq!(p.indices(), &[1, 4]);
+        assert_eq!(p.values(), &[0.25, 1.0]);
+        assert_eq!(p.to_dense(), dense.to_vec());
+        assert_eq!((0..6).map(|i| p.get(i)).collect::<Vec<_>>(), dense.to_vec());
+        // The same probabilities given with a stored zero compare equal.
+        let q = PointProbabilities::from_sparse(6, vec![1, 3, 4], vec![0.25, 0.0, 1.0]).unwrap();
+        assert_eq!(p, q);
+        assert!(PointProbabilities::zeros(0).is_empty());
+        assert_eq!(PointProbabilities::zeros(3).to_dense(), vec![0.0; 3]);
+    }
+
+    #[test]
+    fn malformed_sparse_probabilities_are_refused() {
+        let bad = [
+            (vec![1, 2], vec![0.5]),
+            (vec![2, 1], vec![0.5, 0.5]),
+            (vec![1, 1], vec![0.5, 0.5]),
+            (vec![5], vec![0.5]),
+            (vec![1], vec![1.5]),
+            (vec![1], vec![Real::NAN]),
+        ];
+        for (indices, values) in bad {
+            let e = PointProbabilities::from_sparse(5, indices.clone(), values.clone());
+            assert!(
+                matches!(e, Err(Error::InvalidInput(_))),
+                "{indices:?} {values:?}"
+            );
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "point 3 of 3")]
+    fn reading_past_the_cloud_panics() {
+        PointProbabilities::zeros(3).get(3);
     }
 }
