@@ -121,6 +121,13 @@ fn sparse_from_state(
     PointProbabilities::from_sparse(len, indices, values).or_py(py)
 }
 
+/// The stored points of per-point probabilities: `(indices, probabilities)`.
+type Nonzero<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>);
+
+fn nonzero_to_py<'py>(py: Python<'py>, p: &PointProbabilities) -> Nonzero<'py> {
+    (indices_to_py(py, p.indices()), vec_to_py(py, p.values()))
+}
+
 /// The pickled form of a `CollisionResult` (without the clouds it was computed on).
 type ResultState = (
     f64,
@@ -479,22 +486,14 @@ impl PyCollisionResult {
     /// `(indices (m,) int64, probabilities (m,))`, by index; what
     /// `probabilities_a` holds without its zeros.
     #[getter]
-    fn nonzero_a<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>) {
-        let p = &self.probabilities_a;
-        (indices_to_py(py, p.indices()), vec_to_py(py, p.values()))
+    fn nonzero_a<'py>(&self, py: Python<'py>) -> Nonzero<'py> {
+        nonzero_to_py(py, &self.probabilities_a)
     }
 
     /// The same for B.
     #[getter]
-    fn nonzero_b<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>) {
-        let p = &self.probabilities_b;
-        (indices_to_py(py, p.indices()), vec_to_py(py, p.values()))
+    fn nonzero_b<'py>(&self, py: Python<'py>) -> Nonzero<'py> {
+        nonzero_to_py(py, &self.probabilities_b)
     }
 
     /// Side A's points as queried (a mesh side: its samples), world frame, shape
