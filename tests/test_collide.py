@@ -24,6 +24,13 @@ def test_result_fields(spheres) -> None:
     assert r.probability == pytest.approx(
         max(r.probabilities_a.max(), r.probabilities_b.max()), abs=0.0
     )
+    # Far apart (decided by the bounds) and deciding only: every point still counted.
+    for far in (
+        cp.collide(a, b, pose_b=sphere_gap_pose(50.0)),
+        cp.collide(a, b, pose_b=sphere_gap_pose(1.0), decide_only=True),
+    ):
+        assert far.probabilities_a.shape == (len(a),)
+        assert far.probabilities_b.shape == (len(b),)
     for (idx, val), dense in ((r.nonzero_a, r.probabilities_a), (r.nonzero_b, r.probabilities_b)):
         assert idx.dtype == np.int64 and val.dtype == np.float64
         np.testing.assert_array_equal(idx, np.flatnonzero(dense))
@@ -209,7 +216,7 @@ def test_a_batch_of_results_holds_the_contacts_not_the_clouds() -> None:
     results = cp.collide_many(ball, floor, poses, model="points")
     for r in results:
         idx, val = r.nonzero_b
-        assert 0 < len(idx) < 5_000
+        assert 0 < len(idx) < 5_000 and np.all(val > 0.0)
         assert r.probabilities_b.shape == (200_000,)
         assert np.count_nonzero(r.probabilities_b) == len(idx)
         assert len(pickle.dumps(r)) < 200_000

@@ -476,6 +476,10 @@ fn surfaces_that_cannot_reach_are_decided_free_without_a_classifier() {
             .iter()
             .chain(&r.probabilities_b.to_dense())
             .all(|&p| p == 0.0));
+        assert_eq!(
+            (r.probabilities_a.len(), r.probabilities_b.len()),
+            (a.len(), b.len())
+        );
     }
     assert!(pruned >= 1, "no gap between 3 and 7 sigma was pruned");
     let near = collide(&Pose::identity(), &a, &sphere_pose(SIGMA), &b, &elements()).unwrap();

@@ -163,15 +163,15 @@ pub(crate) fn collide_with_workspace(
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();
 
-    // Every point's probability while the patches are read (the pages a query
-    // never writes are never touched); the result keeps the points written.
-    let mut probabilities_a: Vec<Real> = vec![0.0; a.len()];
-    let mut probabilities_b: Vec<Real> = vec![0.0; b.len()];
+    // Every point's probability while the patches are read; the result keeps
+    // the points written.
+    let mut probabilities_a: Vec<Real> = Vec::new();
+    let mut probabilities_b: Vec<Real> = Vec::new();
     let mut written: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     // What the aggregation reads per sample: p_i, the surface probability q_i,
     // or the pair crossing probability.
-    let mut inputs_a: Vec<Real> = vec![0.0; sa.len()];
-    let mut inputs_b: Vec<Real> = vec![0.0; sb.len()];
+    let mut inputs_a: Vec<Real> = Vec::new();
+    let mut inputs_b: Vec<Real> = Vec::new();
     let mut patches = Vec::new();
     // The samples given an input: every other input is 0, which changes no
     // aggregate, so `P` reads these alone (a query against a cloud of 10^7
@@ -293,6 +293,14 @@ pub(crate) fn collide_with_workspace(
                     fit.probabilities[na..].to_vec(),
                 ),
             };
+            // The four arrays are made for the first patch read: a query that
+            // reads none (decided by its bounds) allocates none.
+            if inputs_a.is_empty() {
+                inputs_a = vec![0.0; sa.len()];
+                inputs_b = vec![0.0; sb.len()];
+                probabilities_a = vec![0.0; a.len()];
+                probabilities_b = vec![0.0; b.len()];
+            }
             // A sample of a sparse cloud can be in several patches
             // ([`split_patches`]): it keeps its largest value.
             for (&i, &q) in ia.iter().zip(&qa) {
@@ -406,8 +414,8 @@ pub(crate) fn collide_with_workspace(
     Ok(CollisionResult {
         probability,
         state: request.thresholds.state(probability),
-        probabilities_a: PointProbabilities::gather(&probabilities_a, written.0),
-        probabilities_b: PointProbabilities::gather(&probabilities_b, written.1),
+        probabilities_a: PointProbabilities::gather(a.len(), &probabilities_a, written.0),
+        probabilities_b: PointProbabilities::gather(b.len(), &probabilities_b, written.1),
         patches,
         point_aggregates,
         stats,

@@ -104,8 +104,9 @@ impl PointProbabilities {
     }
 
     /// The non-zero entries of `dense` at `indices` (any order, repeats
-    /// allowed; every other entry of `dense` must be 0).
-    pub(crate) fn gather(dense: &[Real], mut indices: Vec<u32>) -> Self {
+    /// allowed; every other entry of `dense` must be 0) among `len` points
+    /// (`dense` may be empty when `indices` is).
+    pub(crate) fn gather(len: usize, dense: &[Real], mut indices: Vec<u32>) -> Self {
         indices.sort_unstable();
         indices.dedup();
         let (indices, values) = indices
@@ -114,7 +115,7 @@ impl PointProbabilities {
             .filter(|&(_, v)| v != 0.0)
             .unzip();
         Self {
-            len: dense.len(),
+            len,
             indices,
             values,
         }
@@ -301,7 +302,7 @@ mod tests {
         let dense = [0.0, 0.25, 0.0, 0.0, 1.0, 0.0];
         // Indices out of order, repeated, and one at a zero: only the non-zero
         // values are kept, in index order.
-        let p = PointProbabilities::gather(&dense, vec![4, 1, 4, 2]);
+        let p = PointProbabilities::gather(dense.len(), &dense, vec![4, 1, 4, 2]);
         assert_eq!(p.len(), 6);
         assert_eq!(p.indices(), &[1, 4]);
         assert_eq!(p.values(), &[0.25, 1.0]);
@@ -312,6 +313,11 @@ mod tests {
         assert_eq!(p, q);
         assert!(PointProbabilities::zeros(0).is_empty());
         assert_eq!(PointProbabilities::zeros(3).to_dense(), vec![0.0; 3]);
+        // Nothing written: no dense array was made, the points are still counted.
+        assert_eq!(
+            PointProbabilities::gather(7, &[], Vec::new()),
+            PointProbabilities::zeros(7)
+        );
     }
 
     #[test]
