@@ -293,13 +293,16 @@ pub(crate) fn collide_with_workspace(
                     fit.probabilities[na..].to_vec(),
                 ),
             };
-            // The four arrays are made for the first patch read: a query that
-            // reads none (decided by its bounds) allocates none.
+            // The arrays are made for the first patch read: a query that reads
+            // none (decided by its bounds) allocates none, and one deciding
+            // only no per-point array.
             if inputs_a.is_empty() {
                 inputs_a = vec![0.0; sa.len()];
                 inputs_b = vec![0.0; sb.len()];
-                probabilities_a = vec![0.0; a.len()];
-                probabilities_b = vec![0.0; b.len()];
+                if !request.decide_only {
+                    probabilities_a = vec![0.0; a.len()];
+                    probabilities_b = vec![0.0; b.len()];
+                }
             }
             // A sample of a sparse cloud can be in several patches
             // ([`split_patches`]): it keeps its largest value.
