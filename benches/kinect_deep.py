@@ -10,8 +10,8 @@ with both models on both clouds: missed collisions (``free``) among the poses
 the frame shows and among those only the reference shows.
 
 The poses are placed as the full run places them (11 minutes on 2 idle
-cores for 5000, 33 beside other work; the queries take seconds). ``trimesh`` decides which frame
-points lie inside the gripper (``pip install -e '.[bench]'``).
+cores for 5000, 33 beside other work; the queries take seconds). ``trimesh``
+decides which frame points lie inside the gripper (``pip install -e '.[bench]'``).
 
 Usage: ``python3 benches/kinect_deep.py [--poses 5000] [--seed 0]``
 """

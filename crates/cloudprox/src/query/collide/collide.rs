@@ -164,10 +164,9 @@ pub(crate) fn collide_with_workspace(
     stats.counters.near_regions = near.regions.len();
 
     // Every point's probability while the patches are read; the result keeps
-    // the points written.
+    // the patches' points.
     let mut probabilities_a: Vec<Real> = Vec::new();
     let mut probabilities_b: Vec<Real> = Vec::new();
-    let mut written: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     // What the aggregation reads per sample: p_i, the surface probability q_i,
     // or the pair crossing probability.
     let mut inputs_a: Vec<Real> = Vec::new();
@@ -351,10 +350,6 @@ pub(crate) fn collide_with_workspace(
                     (ia, ib)
                 }
             };
-            if !request.decide_only {
-                written.0.extend_from_slice(&indices_a);
-                written.1.extend_from_slice(&indices_b);
-            }
             let mut separator = fit.classification.separator;
             separator.frame = *pose_b;
             patches.push(ContactPatch {
@@ -413,12 +408,19 @@ pub(crate) fn collide_with_workspace(
     } else {
         crossing(&mut stats, workspace).map_or(probability, |c| c.max(probability))
     };
+    // The points given a probability are the patches' points (none deciding only).
+    let per_point = |len: usize, dense: &[Real], side: fn(&ContactPatch) -> &[u32]| {
+        let written = patches.iter().filter(|_| !request.decide_only);
+        PointProbabilities::gather(len, dense, written.flat_map(side).copied().collect())
+    };
+    let probabilities_a = per_point(a.len(), &probabilities_a, |p| &p.indices_a);
+    let probabilities_b = per_point(b.len(), &probabilities_b, |p| &p.indices_b);
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,
         state: request.thresholds.state(probability),
-        probabilities_a: PointProbabilities::gather(a.len(), &probabilities_a, written.0),
-        probabilities_b: PointProbabilities::gather(b.len(), &probabilities_b, written.1),
+        probabilities_a,
+        probabilities_b,
         patches,
         point_aggregates,
         stats,

@@ -91,16 +91,18 @@ impl PointProbabilities {
         if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
             return Err(Error::invalid(format!("{v} is not a probability")));
         }
-        let (indices, values) = indices
-            .into_iter()
-            .zip(values)
-            .filter(|&(_, v)| v != 0.0)
-            .unzip();
-        Ok(Self {
+        Ok(Self::nonzero(len, indices.into_iter().zip(values)))
+    }
+
+    /// The non-zero `(index, probability)` pairs of `pairs` (by index) among
+    /// `len` points.
+    fn nonzero(len: usize, pairs: impl Iterator<Item = (u32, Real)>) -> Self {
+        let (indices, values) = pairs.filter(|&(_, v)| v != 0.0).unzip();
+        Self {
             len,
             indices,
             values,
-        })
+        }
     }
 
     /// The non-zero entries of `dense` at `indices` (any order, repeats
@@ -109,16 +111,7 @@ impl PointProbabilities {
     pub(crate) fn gather(len: usize, dense: &[Real], mut indices: Vec<u32>) -> Self {
         indices.sort_unstable();
         indices.dedup();
-        let (indices, values) = indices
-            .into_iter()
-            .map(|i| (i, dense[i as usize]))
-            .filter(|&(_, v)| v != 0.0)
-            .unzip();
-        Self {
-            len,
-            indices,
-            values,
-        }
+        Self::nonzero(len, indices.into_iter().map(|i| (i, dense[i as usize])))
     }
 
     /// Number of points (stored or not).
