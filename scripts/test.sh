@@ -18,7 +18,14 @@ step "cargo doc (core crate, warnings as errors: missing docs, broken links)"
 RUSTDOCFLAGS="-D warnings" cargo doc -p cloudprox --no-deps --quiet
 
 step "cargo test (core crate: unit, integration, doc tests; the fuzz smoke run, tests/fuzz_smoke.rs)"
-cargo test -p cloudprox
+if cargo nextest --version >/dev/null 2>&1; then
+    # Every test binary's tests side by side (cargo test runs the binaries one
+    # after another), then the doc tests, which nextest does not run.
+    cargo nextest run -p cloudprox --cargo-profile test --no-fail-fast --status-level fail
+    cargo test -p cloudprox --doc
+else
+    cargo test -p cloudprox
+fi
 
 step "system packages (Open3D's libraries, apt lists for the Kinect frame)"
 bash scripts/system-deps.sh
