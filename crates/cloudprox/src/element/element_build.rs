@@ -100,8 +100,11 @@ impl SurfaceElements {
             elements.push(e);
         }
         let (samples, sample_owner) = element_samples(cloud, &elements, &indices);
+        let covariances = cloud.covariances();
         Ok(SurfaceElements {
             elements,
+            points: indices.iter().map(|&i| points[i as usize]).collect(),
+            covariances: indices.iter().map(|&i| covariances[i as usize]).collect(),
             indices,
             samples,
             sample_owner,

@@ -212,6 +212,11 @@ impl SurfaceElement {
 pub struct SurfaceElements {
     pub(crate) elements: Vec<SurfaceElement>,
     pub(crate) indices: Vec<u32>,
+    /// The cloud's points and covariances in the order of `indices`: an
+    /// element's points lie together in memory, so a query reading a region's
+    /// points streams through them instead of gathering them from the cloud.
+    pub(crate) points: Vec<Point3>,
+    pub(crate) covariances: Vec<Matrix3>,
     pub(crate) samples: PointCloud,
     pub(crate) sample_owner: Vec<u32>,
     /// The elements' hulls and a hierarchy over them, built on first use.
@@ -231,8 +236,25 @@ impl SurfaceElements {
 
     /// The point indices of element `e`.
     pub fn element_points(&self, e: u32) -> &[u32] {
+        &self.indices[self.range(e)]
+    }
+
+    /// The positions of element `e`'s points in [`indices`](Self::indices).
+    pub(crate) fn range(&self, e: u32) -> std::ops::Range<usize> {
         let el = &self.elements[e as usize];
-        &self.indices[el.first as usize..(el.first + el.count) as usize]
+        el.first as usize..(el.first + el.count) as usize
+    }
+
+    /// Element `e`'s points: `(index, point, covariance)` each, the point and
+    /// covariance read from the element's own contiguous copy.
+    pub(crate) fn members(&self, e: u32) -> impl Iterator<Item = (u32, &Point3, &Matrix3)> {
+        let r = self.range(e);
+        self.indices[r.clone()]
+            .iter()
+            .copied()
+            .zip(&self.points[r.clone()])
+            .zip(&self.covariances[r])
+            .map(|((i, p), c)| (i, p, c))
     }
 
     /// The cloud of samples standing for the elements (five per multi-point

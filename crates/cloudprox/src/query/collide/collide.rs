@@ -11,7 +11,7 @@ use crate::probability::{crossing_probabilities, normal_cdf, normal_quantile, Ag
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
     element_crossings, element_pairs_within_reach, element_points, element_sides_within_reach,
-    element_surfaces_cross, has_surface_element,
+    element_surfaces_cross, has_surface_element, unique_owners,
 };
 use crate::query::collide::near::{near_set, NearSet};
 use crate::query::collide::probabilities::{
@@ -341,13 +341,13 @@ pub(crate) fn collide_with_workspace(
                     (ia, ib)
                 }
                 Some((ea, eb)) => {
-                    let (ia, ib) = (element_points(ea, &ia), element_points(eb, &ib));
+                    let (oa, ob) = (unique_owners(ea, &ia), unique_owners(eb, &ib));
                     if !request.decide_only {
-                        point_probabilities(sep, &rel, a, &ia, 1.0, &mut probabilities_a);
+                        point_probabilities(sep, &rel, ea, &oa, 1.0, &mut probabilities_a);
                         let id = Pose::identity();
-                        point_probabilities(sep, &id, b, &ib, -1.0, &mut probabilities_b);
+                        point_probabilities(sep, &id, eb, &ob, -1.0, &mut probabilities_b);
                     }
-                    (ia, ib)
+                    (element_points(ea, &oa), element_points(eb, &ob))
                 }
             };
             let mut separator = fit.classification.separator;

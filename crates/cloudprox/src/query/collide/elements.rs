@@ -362,7 +362,7 @@ fn element_side<'a>(
 }
 
 /// The elements (sorted, each once) that the samples `samples` stand for.
-fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
+pub(crate) fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
     let owner = elements.sample_owner();
     let mut unique: Vec<u32> = samples.iter().map(|&s| owner[s as usize]).collect();
     unique.sort_unstable();
@@ -370,10 +370,9 @@ fn unique_owners(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
     unique
 }
 
-/// The point indices of the elements that the samples `samples` stand for, each
-/// element once, in the order of first appearance.
-pub(crate) fn element_points(elements: &SurfaceElements, samples: &[u32]) -> Vec<u32> {
-    unique_owners(elements, samples)
+/// The point indices of the elements `owners`, element by element.
+pub(crate) fn element_points(elements: &SurfaceElements, owners: &[u32]) -> Vec<u32> {
+    owners
         .iter()
         .flat_map(|&e| elements.element_points(e).iter().copied())
         .collect()

@@ -3,7 +3,7 @@
 //! values count towards the pair's `P` (core points only).
 
 use crate::classify::Separator;
-use crate::cloud::PointCloud;
+use crate::element::SurfaceElements;
 use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{point_probability, surface_probability};
 use crate::uncertainty::directional_std_of;
@@ -12,25 +12,24 @@ use crate::Real;
 /// Neighbours behind a surface probability: the point and its 6 nearest.
 const SURFACE_NEIGHBOURS: usize = 7;
 
-/// Eq. 3 of each point `idx` of `cloud` (moved by `pose` into the separator's
-/// frame) against `sep`, with label `label`; the larger of it and what `out`
-/// already holds (a point can be in several patches).
+/// Eq. 3 of each point of the elements `owners` of `elements` (moved by `pose`
+/// into the separator's frame) against `sep`, with label `label`; the larger
+/// of it and what `out` already holds (a point can be in several patches).
 pub(crate) fn point_probabilities(
     sep: &Separator,
     pose: &Pose,
-    cloud: &PointCloud,
-    idx: &[u32],
+    elements: &SurfaceElements,
+    owners: &[u32],
     label: Real,
     out: &mut [Real],
 ) {
     // The surface is turned into the cloud's frame rather than every point
     // and covariance into the separator's.
     let form = sep.quadratic_form(pose);
-    for &i in idx {
-        let i = i as usize;
-        let (f, g) = form.value_and_gradient(&cloud.points()[i]);
-        let p = point_probability(f, &g, &cloud.covariances()[i], label);
-        out[i] = out[i].max(p);
+    for (i, x, cov) in owners.iter().flat_map(|&e| elements.members(e)) {
+        let (f, g) = form.value_and_gradient(x);
+        let p = point_probability(f, &g, cov, label);
+        out[i as usize] = out[i as usize].max(p);
     }
 }
 
