@@ -17,7 +17,9 @@ python-fcl (``pip install python-fcl``), when installed, answers the same
 poses on the exact meshes in the same run: its ``distance()`` and ``collide()``
 median times are the anchor of the speed column.
 
-Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02]``
+Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02] [--save F.npz]``
+(``--save``: every method's scores, states, seconds and the exact signed
+distances per level, for a closer look at where the methods err or flip).
 """
 
 from __future__ import annotations
@@ -138,6 +140,7 @@ def main() -> None:
     ap.add_argument("--poses", type=int, default=100)
     ap.add_argument("--levels", default="0.005,0.02")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--save", type=Path, default=None, help="write the per-pose arrays (.npz)")
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
     rows: dict[tuple[float, str], list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = {}
@@ -187,11 +190,22 @@ def main() -> None:
         "| level | method | AUC near | decided acc. | undecided | hard flips "
         "| FP > 3σ | FN < -3σ | ms |\n|---|---|---|---|---|---|---|---|---|"
     )
+    saved: dict[str, np.ndarray] = {}
     for (level, name), parts in rows.items():
         sc = np.concatenate([p[0] for p in parts], axis=1)
         st = np.concatenate([p[1] for p in parts], axis=1)
         se = np.concatenate([p[2] for p in parts], axis=1)
         d = np.concatenate([p[3] for p in parts])
+        key = f"{level:g}/{name}"
+        saved.update(
+            {
+                f"{key}/score": sc,
+                f"{key}/state": st.astype(str),
+                f"{key}/seconds": se,
+                f"{key}/distance": d,
+                f"{key}/sigma": np.array(np.sqrt(2.0) * sigmas[level]),
+            }
+        )
         mt = compute_metrics(sc, st, se, d, np.sqrt(2.0) * sigmas[level])
         print(
             f"| {level:.1%} | {name} | {mt.auc_near:.3f} | {mt.decided_accuracy:.3f} | "
@@ -204,6 +218,9 @@ def main() -> None:
             f"| {level:.1%} | python-fcl on the exact meshes: distance() {1e3 * d:.3f} ms, "
             f"collide() {1e3 * c:.3f} ms (medians of the pairs' medians) | | | | | | | |"
         )
+    if args.save is not None:
+        np.savez_compressed(args.save, **saved)
+        print(f"per-pose arrays: {args.save}", file=sys.stderr)
 
 
 if __name__ == "__main__":
