@@ -827,10 +827,8 @@ mod tests {
         assert_eq!(got, vec![1; 2]);
     }
 
-    /// Checks `for_each_knn` against a brute-force search: the same squared
-    /// distances (bit for bit), distinct valid neighbours, never the query.
     /// The `k` smallest of `values`, ascending (a selection, then a sort of
-    /// those alone: the references below scan every pair).
+    /// those alone: the reference below scans every pair).
     fn smallest(mut values: Vec<f64>, k: usize) -> Vec<f64> {
         if k < values.len() {
             values.select_nth_unstable_by(k, f64::total_cmp);
@@ -840,6 +838,8 @@ mod tests {
         values
     }
 
+    /// Checks `for_each_knn` against a brute-force search: the same squared
+    /// distances (bit for bit), distinct valid neighbours, never the query.
     fn check_against_brute_force(points: &[Point3], k: usize) {
         let got = for_each_knn(points, k, |_, nb| nb.to_vec());
         for (i, nb) in got.iter().enumerate() {
