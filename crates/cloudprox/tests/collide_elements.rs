@@ -440,6 +440,19 @@ fn moved_points_give_the_elements_of_a_fresh_cloud() {
     moved.set_points(shifted.clone()).unwrap();
     let fresh = PointCloud::from_sigma(shifted, SIGMA).unwrap();
     assert_eq!(moved.elements().elements(), fresh.elements().elements());
+    // The elements' own copies of their points moved too: a query near
+    // contact reads the same per-point probabilities from either cloud.
+    let (_, b) = spheres(2000);
+    let pose = sphere_pose(0.01 + SIGMA);
+    let r = collide(&Pose::identity(), &moved, &pose, &b, &elements()).unwrap();
+    let f = collide(&Pose::identity(), &fresh, &pose, &b, &elements()).unwrap();
+    assert!(
+        !r.probabilities_a.indices().is_empty(),
+        "no point near contact"
+    );
+    assert_eq!(r.probability, f.probability);
+    assert_eq!(r.probabilities_a, f.probabilities_a);
+    assert_eq!(r.probabilities_b, f.probabilities_b);
 }
 
 #[test]
