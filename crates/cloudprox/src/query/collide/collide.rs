@@ -410,8 +410,10 @@ pub(crate) fn collide_with_workspace(
     };
     // The points given a probability are the patches' points (none deciding only).
     let per_point = |len: usize, dense: &[Real], side: fn(&ContactPatch) -> &[u32]| {
-        let written = patches.iter().filter(|_| !request.decide_only);
-        PointProbabilities::gather(len, dense, written.flat_map(side).copied().collect())
+        if request.decide_only {
+            return PointProbabilities::zeros(len);
+        }
+        PointProbabilities::gather(len, dense, patches.iter().flat_map(side).copied().collect())
     };
     let probabilities_a = per_point(a.len(), &probabilities_a, |p| &p.indices_a);
     let probabilities_b = per_point(b.len(), &probabilities_b, |p| &p.indices_b);
