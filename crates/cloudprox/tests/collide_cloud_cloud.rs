@@ -1,7 +1,7 @@
 //! The collide query between two noisy clouds: analytic cases, invariances, the
 //! hierarchy against brute force.
 
-mod common;
+use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::probability::normal_cdf;

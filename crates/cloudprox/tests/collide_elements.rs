@@ -2,7 +2,7 @@
 //! invariances, the hierarchy against brute force, decide-only, per-point
 //! probabilities.
 
-mod common;
+use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::probability::{normal_cdf, normal_quantile, point_probability};

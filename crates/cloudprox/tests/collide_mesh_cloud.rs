@@ -1,6 +1,6 @@
 //! Meshes as query objects: an exact mesh against a noisy cloud.
 
-mod common;
+use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::query::collide::{mesh_sampling_spacing, MESH_SPACING_FACTOR};

@@ -3,7 +3,7 @@
 //! hierarchy and elements are built on first use, possibly by several threads
 //! at once).
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 

@@ -1,7 +1,7 @@
 //! `exact_time_of_impact`: travel along a direction until a target signed
 //! distance, on cases with closed-form answers, and its refusals of bad input.
 
-mod common;
+use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::query::exact::{exact_time_of_impact, exact_time_of_impact_many};

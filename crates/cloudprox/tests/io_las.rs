@@ -1,7 +1,7 @@
 //! LAS and LAZ: files written with the `las` crate read back exactly; corrupt
 //! and truncated files are format errors.
 
-mod common;
+use crate::common;
 
 use std::io::Cursor;
 

@@ -1,6 +1,6 @@
 //! NPY reading and writing.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::npy::{read_npy, write_npy};
 use cloudprox::io::CloudData;

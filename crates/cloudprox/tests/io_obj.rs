@@ -1,6 +1,6 @@
 //! OBJ: reading every corner form, writing, corrupt inputs.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::obj::{read_obj_mesh, write_obj_mesh};
 use cloudprox::io::{read_mesh_bytes, MeshData, MeshFormat};

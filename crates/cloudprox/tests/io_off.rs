@@ -1,6 +1,6 @@
 //! OFF: reading the variants, writing, corrupt inputs.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::off::{read_off_mesh, write_off_mesh};
 use cloudprox::io::{read_mesh_bytes, MeshData, MeshFormat};

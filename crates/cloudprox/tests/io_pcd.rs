@@ -2,7 +2,7 @@
 //! hand-written files (organized with NaN holes, VIEWPOINT, v0.6 headers,
 //! descriptors, a hand-made LZF stream), corrupt inputs.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::pcd::{read_pcd, write_pcd};
 use cloudprox::io::{CloudData, Encoding, Grid};

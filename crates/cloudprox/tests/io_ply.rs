@@ -1,7 +1,7 @@
 //! PLY reading and writing: round-trips, hand-written files of every variant,
 //! meshes, corrupt inputs.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::ply::{read_ply, read_ply_mesh, write_ply, write_ply_mesh};
 use cloudprox::io::{CloudData, Encoding};

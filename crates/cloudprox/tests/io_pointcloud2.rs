@@ -1,6 +1,6 @@
 //! ROS PointCloud2 reading and encoding.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::pointcloud2::{
     read_pointcloud2, write_pointcloud2, PointCloud2Layout, PointField, FLOAT32, FLOAT64, INT16,

@@ -1,6 +1,6 @@
 //! STL: ascii and binary reading, writing, detection, corrupt inputs.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::stl::{read_stl_mesh, write_stl_mesh};
 use cloudprox::io::{read_mesh_bytes, Encoding, MeshData, MeshFormat};

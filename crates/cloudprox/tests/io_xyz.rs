@@ -1,6 +1,6 @@
 //! XYZ / CSV reading and writing.
 
-mod common;
+use crate::common;
 
 use cloudprox::io::xyz::{read_xyz, write_xyz};
 use cloudprox::io::CloudData;

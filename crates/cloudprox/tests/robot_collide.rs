@@ -1,7 +1,7 @@
 //! The robot against environment clouds: contact, broad phase, invariance,
 //! per-link equivalence, batches, motions, self-collision and the self-filter.
 
-mod robot_common;
+use crate::robot_common;
 
 use cloudprox::prelude::*;
 use cloudprox::query::collide::mesh_sampling_spacing;

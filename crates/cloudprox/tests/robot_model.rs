@@ -1,7 +1,7 @@
 //! URDF loading, forward kinematics against hand-computed poses, mesh URIs,
 //! and bad input.
 
-mod robot_common;
+use crate::robot_common;
 
 use std::path::PathBuf;
 

@@ -1,7 +1,7 @@
 //! Meshes, their sampling and exact mesh-vs-mesh proximity, on cases with known
 //! answers.
 
-mod common;
+use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::query::exact::{exact_proximity_many, ExactPart};
