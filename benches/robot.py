@@ -5,7 +5,7 @@ mushroom) seen by the simulated Kinect at 1.63 times its image size (522 x 391:
 about 100 000 points, Nguyen et al. 2012 noise). In one run:
 
 * **Cost per configuration**, one thread (``RAYON_NUM_THREADS=1``): cloudprox's
-  ``collide_robot`` with each model (surface elements, the default, and points;
+  ``collide_robot`` with each model (surface elements, and points, the default;
   its own ``stats.time_seconds``: forward kinematics, broad phase and
   queries, self-collision off) against python-fcl's ``collide()`` of
   the robot's exact link meshes (a ``DynamicAABBTreeCollisionManager``) against
@@ -57,7 +57,7 @@ import cloudprox as cp
 #: Image scale of the simulated camera: 1.63^2 x the 37 539 points of the planning scan.
 SCALE = 1.63
 ARM = slice(0, 7)
-#: cloudprox's query models, the default (surface elements) first.
+#: cloudprox's query models: the surface elements first, then the points model (the default).
 MODELS = ("elements", "points")
 
 
