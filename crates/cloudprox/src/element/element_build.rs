@@ -101,6 +101,10 @@ impl SurfaceElements {
         }
         let (samples, sample_owner) = element_samples(cloud, &elements, &indices);
         let covariances = cloud.covariances();
+        let sample_is_point = sample_owner
+            .iter()
+            .map(|&e| elements[e as usize].is_point())
+            .collect();
         Ok(SurfaceElements {
             elements,
             points: indices.iter().map(|&i| points[i as usize]).collect(),
@@ -108,6 +112,7 @@ impl SurfaceElements {
             indices,
             samples,
             sample_owner,
+            sample_is_point,
             hulls: std::sync::OnceLock::new(),
         })
     }

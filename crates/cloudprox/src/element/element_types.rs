@@ -219,6 +219,9 @@ pub struct SurfaceElements {
     pub(crate) covariances: Vec<Matrix3>,
     pub(crate) samples: PointCloud,
     pub(crate) sample_owner: Vec<u32>,
+    /// Per sample: whether it stands for a single-point element (a point that
+    /// fits no surface with its neighbours; see the near rule's context).
+    pub(crate) sample_is_point: Vec<bool>,
     /// The elements' hulls and a hierarchy over them, built on first use.
     pub(crate) hulls: OnceLock<ElementHulls>,
 }
@@ -271,6 +274,11 @@ impl SurfaceElements {
     /// The element each sample stands for.
     pub fn sample_owner(&self) -> &[u32] {
         &self.sample_owner
+    }
+
+    /// Per sample: whether it stands for a single-point element.
+    pub(crate) fn sample_is_point(&self) -> &[bool] {
+        &self.sample_is_point
     }
 
     /// The elements' hulls and the hierarchy over them ([`ElementHulls`]),

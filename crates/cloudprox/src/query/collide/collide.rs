@@ -158,7 +158,10 @@ pub(crate) fn collide_with_workspace(
                 .as_ref()
                 .map_or_else(Vec::new, |pairs| pairs.links(core))
         };
-        near_set(&rel, sa, sb, links, request, workspace, &mut stats)
+        let own = elements.map_or((None, None), |(ea, eb)| {
+            (Some(ea.sample_is_point()), Some(eb.sample_is_point()))
+        });
+        near_set(&rel, sa, sb, own, links, request, workspace, &mut stats)
     };
     let core = &near.core;
     stats.counters.near_regions = near.regions.len();

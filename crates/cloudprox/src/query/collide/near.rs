@@ -7,10 +7,14 @@ use crate::bvh::{Bvh, BvhWorkspace};
 use crate::cloud::PointCloud;
 use crate::math::Pose;
 use crate::query::collide::region::{
-    near_points, near_points_brute_force, near_regions, Patch, SAMPLING_MARGIN,
+    near_points, near_points_brute_force, near_regions, OwnContext, Patch, SAMPLING_MARGIN,
 };
 use crate::query::collide::{CollisionRequest, QueryStats};
 use crate::Real;
+
+/// The core stage's rule has no context beyond the sampling margin, which the
+/// noise part covers for every sample alike.
+const NONE: OwnContext<'static> = (None, None);
 
 /// The near regions of a query and which of their points are *core* points.
 pub(crate) struct NearSet {
@@ -46,10 +50,13 @@ impl NearSet {
 /// pairs within reach, whose samples may all be far from each other on a
 /// metre-wide element): where a run has no core sample, its first becomes
 /// one, each run's samples are kept, and the two runs are put in one region.
+/// `own_context` marks the samples whose context is measured in their own
+/// spacing (see `NearRule`).
 pub(crate) fn near_set(
     rel: &Pose,
     a: &PointCloud,
     b: &PointCloud,
+    own_context: OwnContext<'_>,
     links: impl FnOnce(&(Vec<bool>, Vec<bool>)) -> Vec<SampleLink>,
     request: &CollisionRequest,
     workspace: &mut BvhWorkspace,
@@ -62,7 +69,7 @@ pub(crate) fn near_set(
         let mut t = a
             .bvh()
             .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-        let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN);
+        let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE);
         let links = add_links_to_core(&links(&core), &mut core);
         let any_near = core.0.iter().any(|&k| k);
         let mut keep = core.clone();
@@ -71,7 +78,7 @@ pub(crate) fn near_set(
             t = a
                 .bvh()
                 .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx);
+            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context);
         }
         stats.counters.node_pairs_visited += t.node_pairs_visited;
         stats.counters.leaf_pairs = t.leaf_pairs.len();
@@ -88,11 +95,11 @@ pub(crate) fn near_set(
         let regions = near_regions(&t.leaf_pairs, a.bvh(), b.bvh(), &keep.0, &keep.1);
         NearSet { regions, core }
     } else {
-        let mut core = near_points_brute_force(rel, a, b, eps, SAMPLING_MARGIN);
+        let mut core = near_points_brute_force(rel, a, b, eps, SAMPLING_MARGIN, NONE);
         let links = add_links_to_core(&links(&core), &mut core);
         let mut keep = core.clone();
         if keep.0.iter().any(|&k| k) && ctx > SAMPLING_MARGIN {
-            keep = near_points_brute_force(rel, a, b, eps, ctx);
+            keep = near_points_brute_force(rel, a, b, eps, ctx, own_context);
         }
         stats.counters.surface_links += links.len();
         keep_links(&links, &mut keep);

@@ -44,6 +44,17 @@ pub const SAMPLING_MARGIN: Real = 0.5;
 /// The bound is evaluated through its inverse, `max(0, d - h/2) <= (s_i + s_j)
 /// k` with `k = Phi^-1(1 - epsilon / 2)` ([`NearRule::new`]), so no
 /// transcendental function runs per pair.
+///
+/// A sample marked to measure its context in its *own* spacing (the elements
+/// model's single-point elements: points that fit no surface with their
+/// neighbours) joins as context only when `d <= context * h_i`; its partner
+/// keeps `context * h`. A noise-free robot link sampled from its mesh is such
+/// points only (its covariance across the surface is the discretization's
+/// alone, so every curvature is significant), while a scanned table top is
+/// large elements whose grid samples lie six spacings apart: measured in the
+/// larger spacing, the context took every point of the link within two grid
+/// pitches of the table (regions of 1 000-2 000 samples where the points
+/// model reads 200-400).
 #[derive(Debug, Clone, Copy)]
 struct NearRule {
     k: Real,
@@ -55,6 +66,7 @@ struct NearRule {
 /// frame into the cloud's own.
 struct CloudNoise<'a> {
     spacing: &'a [Real],
+    own_context: Option<&'a [bool]>,
     sigma_min: &'a [Real],
     sigma_max: &'a [Real],
     cov: &'a [Matrix3],
@@ -62,9 +74,10 @@ struct CloudNoise<'a> {
 }
 
 impl<'a> CloudNoise<'a> {
-    fn new(cloud: &'a PointCloud, to_own_frame: Matrix3) -> Self {
+    fn new(cloud: &'a PointCloud, to_own_frame: Matrix3, own_context: Option<&'a [bool]>) -> Self {
         Self {
             spacing: cloud.spacing(),
+            own_context,
             sigma_min: cloud.sensor_sigma_min(),
             sigma_max: cloud.sensor_sigma_max(),
             cov: cloud.sensor_covariances(),
@@ -77,6 +90,7 @@ impl<'a> CloudNoise<'a> {
         PointNoise {
             x,
             spacing: self.spacing[i],
+            own_context: self.own_context.is_some_and(|o| o[i]),
             sigma_min: self.sigma_min[i],
             sigma_max: self.sigma_max[i],
             cov: &self.cov[i],
@@ -89,6 +103,7 @@ impl<'a> CloudNoise<'a> {
 struct PointNoise<'a> {
     x: Point3,
     spacing: Real,
+    own_context: bool,
     sigma_min: Real,
     sigma_max: Real,
     cov: &'a Matrix3,
@@ -116,14 +131,39 @@ impl NearRule {
     // `benches/query.rs`).
     #[allow(clippy::inline_always)]
     #[inline(always)]
-    fn is_near(&self, i: &PointNoise<'_>, j: &PointNoise<'_>) -> bool {
+    fn near_sides(&self, i: &PointNoise<'_>, j: &PointNoise<'_>) -> (bool, bool) {
         let diff = j.x - i.x;
         let d2 = diff.norm_squared();
         let h = i.spacing.max(j.spacing);
-        let context = self.context * h;
-        if d2 <= context * context {
-            return true;
+        if !(i.own_context || j.own_context) {
+            let context = self.context * h;
+            let near = d2 <= context * context || self.noise_reaches(i, j, diff, d2, h);
+            return (near, near);
         }
+        let within = |p: &PointNoise<'_>| {
+            let r = self.context * if p.own_context { p.spacing } else { h };
+            d2 <= r * r
+        };
+        let (ci, cj) = (within(i), within(j));
+        if ci && cj {
+            return (true, true);
+        }
+        let near = self.noise_reaches(i, j, diff, d2, h);
+        (ci || near, cj || near)
+    }
+
+    /// The rule's noise part, `max(0, d - h/2) <= (s_i + s_j) k` (`diff = x_j
+    /// - x_i`, `d2` its squared norm, `h` the larger spacing).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn noise_reaches(
+        &self,
+        i: &PointNoise<'_>,
+        j: &PointNoise<'_>,
+        diff: Vector3,
+        d2: Real,
+        h: Real,
+    ) -> bool {
         // `max(0, d - h/2) > s k` with `s >= 0` is `d > s k + h/2`: most pairs
         // are decided on the squared distance, without a square root.
         let reach_max = (i.sigma_max + j.sigma_max) * self.k + SAMPLING_MARGIN * h;
@@ -153,13 +193,19 @@ pub fn near_points(
     b: &PointCloud,
     epsilon: Real,
     context: Real,
+    own_context: OwnContext<'_>,
 ) -> (Vec<bool>, Vec<bool>) {
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
     let blocks = leaf_pairs
         .iter()
         .map(|&(la, lb)| (bvh_a.node_points(la), bvh_b.node_points(lb)));
-    near_points_in_blocks(blocks, rel, a, b, NearRule::new(epsilon, context))
+    let rule = NearRule::new(epsilon, context);
+    near_points_in_blocks(blocks, rel, a, b, rule, own_context)
 }
+
+/// Per sample of A and of B, whether it measures its context in its own
+/// spacing ([`NearRule`]); `None`: none does (the points model).
+pub type OwnContext<'a> = (Option<&'a [bool]>, Option<&'a [bool]>);
 
 /// The brute-force reference of [`near_points`]: the same rule tested on every
 /// pair of points, `O(n_a n_b)`, without the hierarchy.
@@ -169,11 +215,13 @@ pub fn near_points_brute_force(
     b: &PointCloud,
     epsilon: Real,
     context: Real,
+    own_context: OwnContext<'_>,
 ) -> (Vec<bool>, Vec<bool>) {
     let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
     let (ia, ib) = (all(a.len()), all(b.len()));
     let blocks = std::iter::once((&ia[..], &ib[..]));
-    near_points_in_blocks(blocks, rel, a, b, NearRule::new(epsilon, context))
+    let rule = NearRule::new(epsilon, context);
+    near_points_in_blocks(blocks, rel, a, b, rule, own_context)
 }
 
 /// The near rule over every pair `(i, j)` of each block of point indices.
@@ -183,10 +231,12 @@ fn near_points_in_blocks<'a>(
     a: &PointCloud,
     b: &PointCloud,
     rule: NearRule,
+    own_context: OwnContext<'_>,
 ) -> (Vec<bool>, Vec<bool>) {
     // Directions in B's frame, rotated into A's own frame for A's covariances.
-    let noise_a = CloudNoise::new(a, rel.rotation.inverse().to_rotation_matrix().into_inner());
-    let noise_b = CloudNoise::new(b, Matrix3::identity());
+    let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
+    let noise_a = CloudNoise::new(a, to_a, own_context.0);
+    let noise_b = CloudNoise::new(b, Matrix3::identity(), own_context.1);
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     for (block_a, block_b) in blocks {
@@ -198,10 +248,9 @@ fn near_points_in_blocks<'a>(
                 if near_a[i] && near_b[j] {
                     continue;
                 }
-                if rule.is_near(&pi, &noise_b.point(j, b.points()[j])) {
-                    near_a[i] = true;
-                    near_b[j] = true;
-                }
+                let (ni, nj) = rule.near_sides(&pi, &noise_b.point(j, b.points()[j]));
+                near_a[i] |= ni;
+                near_b[j] |= nj;
             }
         }
     }
@@ -417,6 +466,46 @@ mod tests {
             }
         }
         c
+    }
+
+    #[test]
+    fn a_sample_marked_own_context_measures_it_in_its_own_spacing() {
+        // A plane sampled every 5 mm, 20 mm under one sampled every 10 mm,
+        // without noise: the rule's noise part is `d <= h / 2` (`h` the larger
+        // spacing of the pair), its context `d <= 2 h`, or `d <= 2 h_i` for a
+        // sample `i` marked to measure it in its own spacing.
+        let a = PointCloud::from_sigma(grid(9, 0.005, 0.0), 0.0).unwrap();
+        let b = PointCloud::from_sigma(grid(5, 0.01, 0.02), 0.0).unwrap();
+        let id = Pose::identity();
+        let (ctx, eps) = (2.0, 1e-3);
+        let (ha, hb) = (a.spacing(), b.spacing());
+        let d = |i: usize, j: usize| (a.points()[i] - b.points()[j]).norm();
+        let h = |i: usize, j: usize| ha[i].max(hb[j]);
+        // Every other sample of A marked.
+        let marked: Vec<bool> = (0..a.len()).map(|i| i % 2 == 0).collect();
+        let mut kept = Vec::new();
+        for own in [None, Some(&marked[..])] {
+            let (ka, kb) = near_points_brute_force(&id, &a, &b, eps, ctx, (own, None));
+            let (ta, tb) = near_points(&[(0, 0)], &id, &a, &b, eps, ctx, (own, None));
+            assert_eq!((&ka, &kb), (&ta, &tb), "one leaf pair is every pair");
+            let is_marked = |i: usize| own.is_some_and(|o| o[i]);
+            for i in 0..a.len() {
+                let reach = |j: usize| ctx * if is_marked(i) { ha[i] } else { h(i, j) };
+                let want = (0..b.len()).any(|j| d(i, j) <= 0.5 * h(i, j) || d(i, j) <= reach(j));
+                assert_eq!(ka[i], want, "a {i} marked {}", is_marked(i));
+            }
+            // B's samples keep the larger spacing, marked partners or not.
+            for j in 0..b.len() {
+                let want = (0..a.len()).any(|i| d(i, j) <= ctx * h(i, j));
+                assert_eq!(kb[j], want, "b {j}");
+            }
+            kept.push((0..a.len()).filter(|&i| ka[i] && marked[i]).count());
+        }
+        // Two sparse spacings of context reach every marked sample; two of
+        // their own, fewer than half of them.
+        let n_marked = marked.iter().filter(|&&m| m).count();
+        assert_eq!(kept[0], n_marked);
+        assert!(kept[1] < n_marked / 2, "{kept:?} of {n_marked}");
     }
 
     #[test]
