@@ -73,7 +73,9 @@ pub struct CollisionRequest {
     /// of points is near when the noise reaches across its distance less half a
     /// spacing (sampled surfaces can meet between samples); once some pair is,
     /// pairs closer than `near_context` spacings join too, so that sparse clouds
-    /// still give the classifier a surface to fit.
+    /// still give the classifier a surface to fit (the larger spacing of the
+    /// pair; with the elements model, a single-point element's sample counts
+    /// in its own spacing).
     pub near_context: Real,
     /// Near regions with more points than this are split into patches along the
     /// contact, each with its own surface (default 2000): a bound on the cost of
