@@ -283,6 +283,22 @@ def main() -> None:
             + f" | {np.median(t_cp[(MODELS[0], False)]) / np.median(t_ex):.1f}x |"
         )
 
+    # What a planner calling `collide_robot` once per configuration waits for:
+    # the call's wall time, the Python call and the lookup of the link samples
+    # included (far configurations: where the query itself takes microseconds).
+    walls = {}
+    for model in MODELS:
+        w = []
+        for q in far:
+            t = time.perf_counter()
+            cp.collide_robot(robot, q, cloud, self_collision=False, model=model)
+            w.append(time.perf_counter() - t)
+        walls[model] = np.asarray(w)
+    print(
+        "\nOne `collide_robot` call's wall time, far configurations (median): "
+        + ", ".join(f"{m} {us(w)}" for m, w in walls.items())
+    )
+
     seconds = {k: many_seconds(k, args.many, args.seed) for k in (1, 2)}
     print(
         f"\n`collide_robot_many`, {args.many} random configurations: "

@@ -158,3 +158,30 @@ fn bad_spacing_is_named() {
         other => panic!("expected InvalidInput, got {other:?}"),
     }
 }
+
+/// The spacing's middle values, kept with the spacings: the mesh sampling
+/// spacing is `MESH_SPACING_FACTOR` times the upper middle of the sorted
+/// spacings, `cell_side` takes numpy's median; both follow `set_points`.
+#[test]
+fn sampling_spacing_and_cell_side_are_the_spacings_median() {
+    for n in [1999, 2000] {
+        let pts = add_noise(&sphere(&Point3::origin(), RADIUS, n), SIGMA, 5);
+        let mut cloud = PointCloud::from_sigma(pts, SIGMA).unwrap();
+        for round in 0..2 {
+            let mut s = cloud.spacing().to_vec();
+            s.sort_by(f64::total_cmp);
+            let upper = s[n / 2];
+            let median = if n % 2 == 1 {
+                upper
+            } else {
+                0.5 * (s[n / 2 - 1] + upper)
+            };
+            assert_eq!(mesh_sampling_spacing(&cloud), MESH_SPACING_FACTOR * upper);
+            let side = median * (std::f64::consts::PI / 6.0).sqrt();
+            assert_eq!(cloud.cell_side(), side, "n {n} round {round}");
+            // Moved points, twice as far apart: the cached median moves too.
+            let scaled: Vec<Point3> = cloud.points().iter().map(|p| p * 2.0).collect();
+            cloud.set_points(scaled).unwrap();
+        }
+    }
+}

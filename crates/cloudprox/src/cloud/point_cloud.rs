@@ -46,6 +46,10 @@ pub struct PointCloud {
 struct Spacing {
     per_point: Vec<Real>,
     per_node: Vec<Real>,
+    /// The two middle values of `per_point` in sorted order (equal for an odd
+    /// count): its median, read by every query that samples a mesh or a
+    /// robot's links against the cloud, without a pass over the cloud each.
+    middle: (Real, Real),
 }
 
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
@@ -335,17 +339,20 @@ impl PointCloud {
     /// of 6 points in a disc of radius `d_6`, `6 / (pi d_6^2)` points per square
     /// metre). A regular grid of pitch `h` gives `h sqrt(2 pi / 6)`.
     pub fn cell_side(&self) -> Real {
-        let mut s = self.spacing().to_vec();
-        let mid = s.len() / 2;
-        s.select_nth_unstable_by(mid, Real::total_cmp);
-        let median = if s.len() % 2 == 1 {
-            s[mid]
+        // The mean of the two middle values, as numpy's median.
+        let (lower, upper) = self.spacing_data().middle;
+        let median = if lower == upper {
+            upper
         } else {
-            // The mean of the two middle values, as numpy's median.
-            let lower = s[..mid].iter().copied().fold(Real::NEG_INFINITY, Real::max);
-            0.5 * (lower + s[mid])
+            0.5 * (lower + upper)
         };
         median * (std::f64::consts::PI / SPACING_NEIGHBOURS as Real).sqrt()
+    }
+
+    /// The upper of the two middle values of [`PointCloud::spacing`] in sorted
+    /// order (the median for an odd count), computed once with the spacings.
+    pub(crate) fn spacing_upper_median(&self) -> Real {
+        self.spacing_data().middle.1
     }
 
     /// The largest [`PointCloud::spacing`] below every node of [`PointCloud::bvh`].
@@ -382,9 +389,22 @@ impl PointCloud {
                     .collect()
             };
             let per_node = bvh.node_max(&per_point);
+            let mut sorted = per_point.clone();
+            let mid = sorted.len() / 2;
+            sorted.select_nth_unstable_by(mid, Real::total_cmp);
+            let upper = sorted[mid];
+            let lower = if sorted.len() % 2 == 1 {
+                upper
+            } else {
+                sorted[..mid]
+                    .iter()
+                    .copied()
+                    .fold(Real::NEG_INFINITY, Real::max)
+            };
             Spacing {
                 per_point,
                 per_node,
+                middle: (lower, upper),
             }
         })
     }

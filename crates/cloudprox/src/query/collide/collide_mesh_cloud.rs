@@ -45,10 +45,7 @@ pub const MESH_SPACING_FACTOR: Real = 0.5;
 /// nearest neighbour), so that the mesh side never is the coarser one and its
 /// discretization error stays below the cloud's.
 pub fn mesh_sampling_spacing(cloud: &PointCloud) -> Real {
-    let mut s: Vec<Real> = cloud.spacing().to_vec();
-    let mid = s.len() / 2;
-    let (_, m, _) = s.select_nth_unstable_by(mid, Real::total_cmp);
-    MESH_SPACING_FACTOR * *m
+    MESH_SPACING_FACTOR * cloud.spacing_upper_median()
 }
 
 /// The probabilistic collision query between an exact mesh at `pose_mesh` and a
