@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 
-use crate::bvh::Bvh;
+use crate::bvh::{Aabb, Bvh};
 use crate::cloud::PointCloud;
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::normal_quantile;
@@ -152,6 +152,16 @@ impl NearRule {
         (ci || near, cj || near)
     }
 
+    /// The largest distance at which point `i` can be near, or context of,
+    /// any point `j` whose spacing is at most `spacing_max` and whose largest
+    /// sensor standard deviation is at most `sigma_max`: the larger of the
+    /// context radius `context h` and the noise's reach `(s_i + s_j) k + h/2`,
+    /// with `h` the larger spacing.
+    fn block_reach(&self, i: &PointNoise<'_>, spacing_max: Real, sigma_max: Real) -> Real {
+        let h = i.spacing.max(spacing_max);
+        (self.context * h).max((i.sigma_max + sigma_max) * self.k + SAMPLING_MARGIN * h)
+    }
+
     /// The rule's noise part, `max(0, d - h/2) <= (s_i + s_j) k` (`diff = x_j
     /// - x_i`, `d2` its squared norm, `h` the larger spacing).
     #[allow(clippy::inline_always)]
@@ -196,11 +206,24 @@ pub fn near_points(
     own_context: OwnContext<'_>,
 ) -> (Vec<bool>, Vec<bool>) {
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
-    let blocks = leaf_pairs
+    // Each leaf is in many pairs: it is read once.
+    let leaves = |side: fn(&(u32, u32)) -> u32| {
+        let mut ids: Vec<u32> = leaf_pairs.iter().map(side).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    };
+    let (ids_a, ids_b) = (leaves(|p| p.0), leaves(|p| p.1));
+    // Every id is found: `ids` was made from the pairs.
+    let position = |ids: &[u32], id: u32| ids.binary_search(&id).unwrap_or_default() as u32;
+    let pairs: Vec<(u32, u32)> = leaf_pairs
         .iter()
-        .map(|&(la, lb)| (bvh_a.node_points(la), bvh_b.node_points(lb)));
+        .map(|&(la, lb)| (position(&ids_a, la), position(&ids_b, lb)))
+        .collect();
+    let blocks_a: Vec<&[u32]> = ids_a.iter().map(|&l| bvh_a.node_points(l)).collect();
+    let blocks_b: Vec<&[u32]> = ids_b.iter().map(|&l| bvh_b.node_points(l)).collect();
     let rule = NearRule::new(epsilon, context);
-    near_points_in_blocks(blocks, rel, a, b, rule, own_context)
+    near_points_in_blocks((&blocks_a, &blocks_b), &pairs, rel, a, b, rule, own_context)
 }
 
 /// Per sample of A and of B, whether it measures its context in its own
@@ -219,14 +242,23 @@ pub fn near_points_brute_force(
 ) -> (Vec<bool>, Vec<bool>) {
     let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
     let (ia, ib) = (all(a.len()), all(b.len()));
-    let blocks = std::iter::once((&ia[..], &ib[..]));
     let rule = NearRule::new(epsilon, context);
-    near_points_in_blocks(blocks, rel, a, b, rule, own_context)
+    let blocks = (&[&ia[..]][..], &[&ib[..]][..]);
+    near_points_in_blocks(blocks, &[(0, 0)], rel, a, b, rule, own_context)
 }
 
-/// The near rule over every pair `(i, j)` of each block of point indices.
-fn near_points_in_blocks<'a>(
-    blocks: impl Iterator<Item = (&'a [u32], &'a [u32])>,
+/// The near rule over every pair `(i, j)` of the blocks of point indices
+/// paired by `pairs` (positions in `blocks.0` and `blocks.1`).
+///
+/// Each block's points are read once into a compact list with their noise,
+/// and in each pair a point farther from the other block's box than the
+/// rule's widest reach towards any point of that block
+/// ([`NearRule::block_reach`]) is left out of the pair tests: it is near none
+/// of them, and none of them near it, so the result is that of testing every
+/// pair.
+fn near_points_in_blocks(
+    blocks: (&[&[u32]], &[&[u32]]),
+    pairs: &[(u32, u32)],
     rel: &Pose,
     a: &PointCloud,
     b: &PointCloud,
@@ -237,26 +269,77 @@ fn near_points_in_blocks<'a>(
     let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
     let noise_a = CloudNoise::new(a, to_a, own_context.0);
     let noise_b = CloudNoise::new(b, Matrix3::identity(), own_context.1);
+    let read_a: Vec<Block<'_>> = blocks
+        .0
+        .iter()
+        .map(|idx| Block::read(idx, |i| noise_a.point(i, rel * a.points()[i])))
+        .collect();
+    let read_b: Vec<Block<'_>> = blocks
+        .1
+        .iter()
+        .map(|idx| Block::read(idx, |j| noise_b.point(j, b.points()[j])))
+        .collect();
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
-    for (block_a, block_b) in blocks {
-        for &i in block_a {
-            let i = i as usize;
-            let pi = noise_a.point(i, rel * a.points()[i]);
-            for &j in block_b {
-                let j = j as usize;
-                if near_a[i] && near_b[j] {
+    let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
+    for &(ka, kb) in pairs {
+        let (block_a, block_b) = (&read_a[ka as usize], &read_b[kb as usize]);
+        block_a.within_reach_of(block_b, &rule, &mut kept_a);
+        block_b.within_reach_of(block_a, &rule, &mut kept_b);
+        for &ka in &kept_a {
+            let (i, pi) = &block_a.points[ka];
+            for &kb in &kept_b {
+                let (j, pj) = &block_b.points[kb];
+                if near_a[*i] && near_b[*j] {
                     continue;
                 }
-                let (ni, nj) = rule.near_sides(&pi, &noise_b.point(j, b.points()[j]));
-                near_a[i] |= ni;
-                near_b[j] |= nj;
+                let (ni, nj) = rule.near_sides(pi, pj);
+                near_a[*i] |= ni;
+                near_b[*j] |= nj;
             }
         }
     }
     (near_a, near_b)
 }
 
+/// One block's points with their noise, the box of their positions, and
+/// their largest spacing and sensor standard deviation.
+struct Block<'a> {
+    points: Vec<(usize, PointNoise<'a>)>,
+    aabb: Aabb,
+    spacing_max: Real,
+    sigma_max: Real,
+}
+
+impl<'a> Block<'a> {
+    /// Reads the points `idx` (`point(i)`: point `i` with its noise).
+    fn read(idx: &[u32], point: impl Fn(usize) -> PointNoise<'a>) -> Self {
+        let mut block = Self {
+            points: Vec::with_capacity(idx.len()),
+            aabb: Aabb::empty(),
+            spacing_max: 0.0,
+            sigma_max: 0.0,
+        };
+        for &i in idx {
+            let p = point(i as usize);
+            block.aabb.take_point(&p.x);
+            block.spacing_max = block.spacing_max.max(p.spacing);
+            block.sigma_max = block.sigma_max.max(p.sigma_max);
+            block.points.push((i as usize, p));
+        }
+        block
+    }
+
+    /// Into `out`, the positions in `self.points` of the points that lie
+    /// within the rule's reach of `other`'s box.
+    fn within_reach_of(&self, other: &Block<'_>, rule: &NearRule, out: &mut Vec<usize>) {
+        out.clear();
+        out.extend(self.points.iter().enumerate().filter_map(|(k, (_, p))| {
+            let r = rule.block_reach(p, other.spacing_max, other.sigma_max);
+            (other.aabb.distance_squared_to_point(&p.x) <= r * r).then_some(k)
+        }));
+    }
+}
 /// Merges kept leaf pairs into connected components: two leaf pairs are connected
 /// when they share a leaf. Returns one patch per component with the leaves'
 /// points for which `keep_a` / `keep_b` hold (all points when empty), components
@@ -466,6 +549,79 @@ mod tests {
             }
         }
         c
+    }
+
+    #[test]
+    fn every_leaf_pair_finds_what_the_rule_written_out_finds() {
+        // Two noisy grids with anisotropic sensor covariances (a camera's
+        // noise along its rays, stronger for B), B turned and lifted to a
+        // few sigma over part of A: leaves of 4 points, so most points of a leaf pair
+        // lie beyond the other leaf's reach and are left out of its tests.
+        use crate::sample::add_noise;
+        use nalgebra::{Translation3, UnitQuaternion};
+        let ray = |s_across: Real, s_along: Real, axis: Vector3| {
+            let u = axis.normalize();
+            Matrix3::identity() * s_across.powi(2)
+                + u * u.transpose() * (s_along.powi(2) - s_across.powi(2))
+        };
+        let cloud = |n: usize, h: Real, cov: Matrix3, seed: u64| {
+            let pts = add_noise(&grid(n, h, 0.0), cov.trace().sqrt() / 3.0, seed);
+            let mut c = PointCloud::from_covariances(pts.clone(), vec![cov; pts.len()]).unwrap();
+            c.set_bvh_settings(crate::bvh::BvhSettings { leaf_max_points: 4 })
+                .unwrap();
+            c
+        };
+        let a = cloud(
+            14,
+            0.004,
+            ray(0.0005, 0.002, Vector3::new(0.2, 0.1, 1.0)),
+            1,
+        );
+        let b = cloud(8, 0.005, ray(0.001, 0.004, Vector3::new(-0.3, 0.0, 1.0)), 2);
+        let (ctx, eps) = (2.0, 1e-3);
+        let k = -normal_quantile(0.5 * eps);
+        for (lift, turn) in [(0.006, 0.0), (0.012, 0.4), (0.02, -0.3)] {
+            let rel = Pose::from_parts(
+                Translation3::new(-0.03, 0.003, lift),
+                UnitQuaternion::from_euler_angles(turn, 0.5 * turn, 0.1),
+            );
+            let xa: Vec<Point3> = a.points().iter().map(|p| rel * p).collect();
+            let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
+            let std = |c: &Matrix3, u: &Vector3| u.dot(&(c * u)).max(0.0).sqrt();
+            let near = |i: usize, j: usize| {
+                let diff = b.points()[j] - xa[i];
+                let d = diff.norm();
+                let h = a.spacing()[i].max(b.spacing()[j]);
+                let u = diff / d;
+                let s = std(&a.sensor_covariances()[i], &(to_a * u))
+                    + std(&b.sensor_covariances()[j], &u);
+                d <= ctx * h || (d - SAMPLING_MARGIN * h).max(0.0) <= s * k
+            };
+            let want_a: Vec<bool> = (0..a.len())
+                .map(|i| (0..b.len()).any(|j| near(i, j)))
+                .collect();
+            let want_b: Vec<bool> = (0..b.len())
+                .map(|j| (0..a.len()).any(|i| near(i, j)))
+                .collect();
+            let leaves = |c: &PointCloud| -> Vec<u32> {
+                let nodes = c.bvh().nodes();
+                (0..nodes.len() as u32)
+                    .filter(|&n| nodes[n as usize].is_leaf())
+                    .collect()
+            };
+            let pairs: Vec<(u32, u32)> = leaves(&a)
+                .iter()
+                .flat_map(|&la| leaves(&b).into_iter().map(move |lb| (la, lb)))
+                .collect();
+            assert!(pairs.len() > 1000);
+            let got = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None));
+            assert_eq!(got, (want_a.clone(), want_b.clone()), "lift {lift}");
+            let brute = near_points_brute_force(&rel, &a, &b, eps, ctx, (None, None));
+            assert_eq!(brute, (want_a.clone(), want_b), "lift {lift}");
+            // Some points near and some not: the test can tell.
+            let n = want_a.iter().filter(|&&x| x).count();
+            assert!(0 < n && n < a.len(), "lift {lift}: {n} of {}", a.len());
+        }
     }
 
     #[test]
