@@ -339,14 +339,10 @@ impl PointCloud {
     /// of 6 points in a disc of radius `d_6`, `6 / (pi d_6^2)` points per square
     /// metre). A regular grid of pitch `h` gives `h sqrt(2 pi / 6)`.
     pub fn cell_side(&self) -> Real {
-        // The mean of the two middle values, as numpy's median.
+        // The mean of the two middle values, as numpy's median (the one
+        // middle value, exactly, for an odd count: both are it).
         let (lower, upper) = self.spacing_data().middle;
-        let median = if lower == upper {
-            upper
-        } else {
-            0.5 * (lower + upper)
-        };
-        median * (std::f64::consts::PI / SPACING_NEIGHBOURS as Real).sqrt()
+        0.5 * (lower + upper) * (std::f64::consts::PI / SPACING_NEIGHBOURS as Real).sqrt()
     }
 
     /// The upper of the two middle values of [`PointCloud::spacing`] in sorted
