@@ -269,27 +269,19 @@ fn near_points_in_blocks(
     let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
     let noise_a = CloudNoise::new(a, to_a, own_context.0);
     let noise_b = CloudNoise::new(b, Matrix3::identity(), own_context.1);
-    let read_a: Vec<Block<'_>> = blocks
-        .0
-        .iter()
-        .map(|idx| Block::read(idx, |i| noise_a.point(i, rel * a.points()[i])))
-        .collect();
-    let read_b: Vec<Block<'_>> = blocks
-        .1
-        .iter()
-        .map(|idx| Block::read(idx, |j| noise_b.point(j, b.points()[j])))
-        .collect();
+    let read_a = Blocks::read(blocks.0, |i| noise_a.point(i, rel * a.points()[i]));
+    let read_b = Blocks::read(blocks.1, |j| noise_b.point(j, b.points()[j]));
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
     let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
     for &(ka, kb) in pairs {
-        let (block_a, block_b) = (&read_a[ka as usize], &read_b[kb as usize]);
-        block_a.within_reach_of(block_b, &rule, &mut kept_a);
-        block_b.within_reach_of(block_a, &rule, &mut kept_b);
-        for &ka in &kept_a {
-            let (i, pi) = &block_a.points[ka];
-            for &kb in &kept_b {
-                let (j, pj) = &block_b.points[kb];
+        read_a.within_reach_of(ka, &read_b, kb, &rule, &mut kept_a);
+        read_b.within_reach_of(kb, &read_a, ka, &rule, &mut kept_b);
+        let (block_a, block_b) = (read_a.block(ka), read_b.block(kb));
+        for &na in &kept_a {
+            let (i, pi) = &block_a[na];
+            for &nb in &kept_b {
+                let (j, pj) = &block_b[nb];
                 if near_a[*i] && near_b[*j] {
                     continue;
                 }
@@ -302,44 +294,75 @@ fn near_points_in_blocks(
     (near_a, near_b)
 }
 
-/// One block's points with their noise, the box of their positions, and
-/// their largest spacing and sensor standard deviation.
-struct Block<'a> {
+/// Blocks of points read with their noise: one list of every block's points
+/// (one allocation per side, not one per leaf: a query near a miss keeps
+/// few pairs of small leaves), and per block its run in the list
+/// ([`BlockBound`]).
+struct Blocks<'a> {
     points: Vec<(usize, PointNoise<'a>)>,
+    bounds: Vec<BlockBound>,
+}
+
+/// One block's run of [`Blocks::points`], the box of their positions, and
+/// their largest spacing and sensor standard deviation.
+struct BlockBound {
+    run: std::ops::Range<usize>,
     aabb: Aabb,
     spacing_max: Real,
     sigma_max: Real,
 }
 
-impl<'a> Block<'a> {
-    /// Reads the points `idx` (`point(i)`: point `i` with its noise).
-    fn read(idx: &[u32], point: impl Fn(usize) -> PointNoise<'a>) -> Self {
-        let mut block = Self {
-            points: Vec::with_capacity(idx.len()),
-            aabb: Aabb::empty(),
-            spacing_max: 0.0,
-            sigma_max: 0.0,
-        };
-        for &i in idx {
-            let p = point(i as usize);
-            block.aabb.take_point(&p.x);
-            block.spacing_max = block.spacing_max.max(p.spacing);
-            block.sigma_max = block.sigma_max.max(p.sigma_max);
-            block.points.push((i as usize, p));
-        }
-        block
+impl<'a> Blocks<'a> {
+    /// Reads the points of each block of `blocks` (`point(i)`: point `i`
+    /// with its noise).
+    fn read(blocks: &[&[u32]], point: impl Fn(usize) -> PointNoise<'a>) -> Self {
+        let mut points = Vec::with_capacity(blocks.iter().map(|b| b.len()).sum());
+        let bounds = blocks
+            .iter()
+            .map(|idx| {
+                let mut bound = BlockBound {
+                    run: points.len()..points.len() + idx.len(),
+                    aabb: Aabb::empty(),
+                    spacing_max: 0.0,
+                    sigma_max: 0.0,
+                };
+                for &i in *idx {
+                    let p = point(i as usize);
+                    bound.aabb.take_point(&p.x);
+                    bound.spacing_max = bound.spacing_max.max(p.spacing);
+                    bound.sigma_max = bound.sigma_max.max(p.sigma_max);
+                    points.push((i as usize, p));
+                }
+                bound
+            })
+            .collect();
+        Self { points, bounds }
     }
 
-    /// Into `out`, the positions in `self.points` of the points that lie
-    /// within the rule's reach of `other`'s box.
-    fn within_reach_of(&self, other: &Block<'_>, rule: &NearRule, out: &mut Vec<usize>) {
+    /// The points of block `k`.
+    fn block(&self, k: u32) -> &[(usize, PointNoise<'a>)] {
+        &self.points[self.bounds[k as usize].run.clone()]
+    }
+
+    /// Into `out`, the positions within block `k` of its points that lie
+    /// within the rule's reach of the box of `other`'s block `o`.
+    fn within_reach_of(
+        &self,
+        k: u32,
+        other: &Blocks<'_>,
+        o: u32,
+        rule: &NearRule,
+        out: &mut Vec<usize>,
+    ) {
+        let o = &other.bounds[o as usize];
         out.clear();
-        out.extend(self.points.iter().enumerate().filter_map(|(k, (_, p))| {
-            let r = rule.block_reach(p, other.spacing_max, other.sigma_max);
-            (other.aabb.distance_squared_to_point(&p.x) <= r * r).then_some(k)
+        out.extend(self.block(k).iter().enumerate().filter_map(|(n, (_, p))| {
+            let r = rule.block_reach(p, o.spacing_max, o.sigma_max);
+            (o.aabb.distance_squared_to_point(&p.x) <= r * r).then_some(n)
         }));
     }
 }
+
 /// Merges kept leaf pairs into connected components: two leaf pairs are connected
 /// when they share a leaf. Returns one patch per component with the leaves'
 /// points for which `keep_a` / `keep_b` hold (all points when empty), components
