@@ -577,9 +577,11 @@ mod tests {
     #[test]
     fn every_leaf_pair_finds_what_the_rule_written_out_finds() {
         // Two noisy grids with anisotropic sensor covariances (a camera's
-        // noise along its rays, stronger for B), B turned and lifted to a
-        // few sigma over part of A: leaves of 4 points, so most points of a leaf pair
-        // lie beyond the other leaf's reach and are left out of its tests.
+        // noise along its rays, stronger for B), A turned and moved to a few
+        // sigma under part of B; every leaf pair of leaves of 4 points, so
+        // most points of a leaf pair lie beyond the other leaf's reach and
+        // are left out of its tests. The reference is the rule written out,
+        // pair by pair, with each point's sensor deviation along the line.
         use crate::sample::add_noise;
         use nalgebra::{Translation3, UnitQuaternion};
         let ray = |s_across: Real, s_along: Real, axis: Vector3| {
