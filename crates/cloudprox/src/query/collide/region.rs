@@ -159,7 +159,17 @@ impl NearRule {
     /// with `h` the larger spacing.
     fn block_reach(&self, i: &PointNoise<'_>, spacing_max: Real, sigma_max: Real) -> Real {
         let h = i.spacing.max(spacing_max);
-        (self.context * h).max((i.sigma_max + sigma_max) * self.k + SAMPLING_MARGIN * h)
+        (self.context * h).max(self.reach_max(i.sigma_max + sigma_max, h))
+    }
+
+    /// The farthest the rule's noise part reaches between two points whose
+    /// largest sensor deviations sum to `sigma_max_sum`, `h` the larger
+    /// spacing: `sigma_max_sum k + h/2` (the pair test and the block bound
+    /// read this one formula, so the bound cannot fall behind the rule).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn reach_max(&self, sigma_max_sum: Real, h: Real) -> Real {
+        sigma_max_sum * self.k + SAMPLING_MARGIN * h
     }
 
     /// The rule's noise part, `max(0, d - h/2) <= (s_i + s_j) k` (`diff = x_j
@@ -176,7 +186,7 @@ impl NearRule {
     ) -> bool {
         // `max(0, d - h/2) > s k` with `s >= 0` is `d > s k + h/2`: most pairs
         // are decided on the squared distance, without a square root.
-        let reach_max = (i.sigma_max + j.sigma_max) * self.k + SAMPLING_MARGIN * h;
+        let reach_max = self.reach_max(i.sigma_max + j.sigma_max, h);
         if d2 > reach_max * reach_max {
             return false;
         }
