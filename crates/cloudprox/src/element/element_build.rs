@@ -17,79 +17,9 @@ impl SurfaceElements {
         let sensor = cloud.sensor_covariances();
         let spacing = cloud.spacing();
         let n = points.len();
-        let mut indices: Vec<u32> = (0..n as u32).collect();
-        let mut elements = Vec::new();
-        let mut stack = vec![(0usize, n)];
-        while let Some((first, count)) = stack.pop() {
-            let range = first..first + count;
-            if count >= settings.min_points {
-                let fit = fit_element(
-                    points,
-                    sensor,
-                    spacing,
-                    &indices[range.clone()],
-                    first as u32,
-                    settings,
-                );
-                match fit {
-                    Fit::Element(e) => {
-                        elements.push(*e);
-                        continue;
-                    }
-                    Fit::Split(rule) => {
-                        let slice = &mut indices[range];
-                        let mut k = match &rule {
-                            SplitRule::TwoSurfaces { .. } => {
-                                partition(slice, |i| rule.is_below(&points[i as usize]))
-                            }
-                            SplitRule::Median { .. } => 0,
-                        };
-                        if k == 0 || k == count {
-                            let (mean, axis) = match rule {
-                                SplitRule::Median { mean, axis } => (mean, axis),
-                                SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
-                            };
-                            let key = |i: u32| (points[i as usize] - mean).dot(&axis);
-                            k = count / 2;
-                            slice.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
-                        }
-                        stack.push((first + k, count - k));
-                        stack.push((first, k));
-                        continue;
-                    }
-                }
-            }
-            // Too few points for an element: each point stands for itself.
-            let total = cloud.covariances();
-            for j in range {
-                let i = indices[j] as usize;
-                elements.push(SurfaceElement {
-                    first: j as u32,
-                    count: 1,
-                    mean: points[i],
-                    normal: Vector3::z(),
-                    tangents: [Vector3::x(), Vector3::y()],
-                    extent: [[0.0; 2]; 2],
-                    probes: vec![[0.0; 2]],
-                    spacing: 0.0,
-                    cov_mean: total[i],
-                    height: [0.0; 3],
-                    height_cov: nalgebra::SMatrix::zeros(),
-                    common_var: 0.0,
-                    footprint: Vec::new(),
-                });
-            }
-        }
         // Repair what the median splits cut apart, then lay the groups out
         // contiguously.
-        let groups: Vec<(Vec<u32>, SurfaceElement)> = elements
-            .into_iter()
-            .map(|e| {
-                let g = indices[e.first as usize..(e.first + e.count) as usize].to_vec();
-                (g, e)
-            })
-            .collect();
-        let groups = merge_neighbours(points, sensor, spacing, settings, groups);
+        let groups = merge_neighbours(points, sensor, spacing, settings, split(cloud, settings));
         let mut indices = Vec::with_capacity(n);
         let mut elements = Vec::with_capacity(groups.len());
         for (g, mut e) in groups {
@@ -116,6 +46,90 @@ impl SurfaceElements {
             hulls: std::sync::OnceLock::new(),
         })
     }
+}
+
+/// The top-down split: every group that fails the element tests is halved
+/// (at the median along its widest axis, or between the two surfaces it
+/// samples) until it passes or holds too few points, which then stand for
+/// themselves. Returns each group's points with its element, in index order.
+pub(crate) fn split(
+    cloud: &PointCloud,
+    settings: &ElementSettings,
+) -> Vec<(Vec<u32>, SurfaceElement)> {
+    let points = cloud.points();
+    let sensor = cloud.sensor_covariances();
+    let spacing = cloud.spacing();
+    let n = points.len();
+    let mut indices: Vec<u32> = (0..n as u32).collect();
+    let mut elements = Vec::new();
+    let mut stack = vec![(0usize, n)];
+    while let Some((first, count)) = stack.pop() {
+        let range = first..first + count;
+        if count >= settings.min_points {
+            let fit = fit_element(
+                points,
+                sensor,
+                spacing,
+                &indices[range.clone()],
+                first as u32,
+                settings,
+            );
+            match fit {
+                Fit::Element(e) => {
+                    elements.push(*e);
+                    continue;
+                }
+                Fit::Split(rule) => {
+                    let slice = &mut indices[range];
+                    let mut k = match &rule {
+                        SplitRule::TwoSurfaces { .. } => {
+                            partition(slice, |i| rule.is_below(&points[i as usize]))
+                        }
+                        SplitRule::Median { .. } => 0,
+                    };
+                    if k == 0 || k == count {
+                        let (mean, axis) = match rule {
+                            SplitRule::Median { mean, axis } => (mean, axis),
+                            SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
+                        };
+                        let key = |i: u32| (points[i as usize] - mean).dot(&axis);
+                        k = count / 2;
+                        slice.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
+                    }
+                    stack.push((first + k, count - k));
+                    stack.push((first, k));
+                    continue;
+                }
+            }
+        }
+        // Too few points for an element: each point stands for itself.
+        let total = cloud.covariances();
+        for j in range {
+            let i = indices[j] as usize;
+            elements.push(SurfaceElement {
+                first: j as u32,
+                count: 1,
+                mean: points[i],
+                normal: Vector3::z(),
+                tangents: [Vector3::x(), Vector3::y()],
+                extent: [[0.0; 2]; 2],
+                probes: vec![[0.0; 2]],
+                spacing: 0.0,
+                cov_mean: total[i],
+                height: [0.0; 3],
+                height_cov: nalgebra::SMatrix::zeros(),
+                common_var: 0.0,
+                footprint: Vec::new(),
+            });
+        }
+    }
+    elements
+        .into_iter()
+        .map(|e| {
+            let g = indices[e.first as usize..(e.first + e.count) as usize].to_vec();
+            (g, e)
+        })
+        .collect()
 }
 
 /// Moves the entries for which `pred` holds to the front; returns their count.
