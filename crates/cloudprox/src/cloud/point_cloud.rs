@@ -4,7 +4,7 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use crate::bvh::{Bvh, BvhSettings};
+use crate::bvh::{Bvh, BvhSettings, GRID_KNN_MIN_POINTS};
 use crate::element::{ElementSettings, SurfaceElements};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
@@ -54,9 +54,6 @@ struct Spacing {
 
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
 const SPACING_NEIGHBOURS: usize = 6;
-
-/// Above this many points the spacing comes from the filters' hashed grid.
-const GRID_KNN_MIN_POINTS: usize = 4096;
 
 impl Clone for PointCloud {
     fn clone(&self) -> Self {

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use crate::bvh::{Bvh, BvhWorkspace};
+use crate::bvh::{knn_map, Bvh, BvhWorkspace, GRID_KNN_MIN_POINTS};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Vector3};
 use crate::Real;
@@ -60,7 +60,10 @@ impl DiscretizationSettings {
 /// surface patch a sample stands for (tangential) plus any curvature it spans.
 ///
 /// `sensor` holds the sensor covariances (same length as `points`); clouds with
-/// fewer than `k + 1` points use all points.
+/// fewer than `k + 1` points use all points. The neighbours come from `bvh`
+/// up to [`GRID_KNN_MIN_POINTS`] points and from the hashed grid of the
+/// spatial search above (exact as well, and much cheaper on large clouds; the
+/// same neighbours but where distances tie).
 pub fn discretization_covariances(
     points: &[Point3],
     sensor: &[Matrix3],
@@ -79,6 +82,17 @@ pub fn discretization_covariances(
         return Ok(vec![Matrix3::zeros(); points.len()]);
     }
     let k = settings.k.min(points.len() - 1);
+    if points.len() > GRID_KNN_MIN_POINTS {
+        return Ok(knn_map(points, k, |i, others| {
+            // The point itself and its neighbours, nearest first (as the
+            // tree gives them; ties by index).
+            let mut neighbours = Vec::with_capacity(k + 1);
+            neighbours.push((0.0, i as u32));
+            neighbours.extend_from_slice(others);
+            neighbours.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            of_neighbourhood(points, &neighbours, &sensor[i], settings)
+        }));
+    }
     let out = points
         .par_iter()
         .zip(sensor)
@@ -86,31 +100,42 @@ pub fn discretization_covariances(
             || (BvhWorkspace::default(), Vec::with_capacity(k + 1)),
             |(workspace, neighbours), (x, sensor_i)| {
                 bvh.nearest_k(points, x, k + 1, workspace, neighbours);
-                let d_k = neighbours.last().map_or(0.0, |&(d2, _)| d2.sqrt());
-                if d_k <= 0.0 {
-                    return Matrix3::zeros();
-                }
-                let s = settings.weight_scale * d_k;
-                let mut wsum = 0.0;
-                let mut mean = Vector3::zeros();
-                for &(d2, j) in neighbours.iter() {
-                    let w = (-d2 / (s * s)).exp();
-                    wsum += w;
-                    mean += w * points[j as usize].coords;
-                }
-                mean /= wsum;
-                let mut scatter = Matrix3::zeros();
-                for &(d2, j) in neighbours.iter() {
-                    let w = (-d2 / (s * s)).exp();
-                    let o = points[j as usize].coords - mean;
-                    scatter += w * o * o.transpose();
-                }
-                scatter /= wsum;
-                project_psd(&(scatter - sensor_i))
+                of_neighbourhood(points, neighbours, sensor_i, settings)
             },
         )
         .collect();
     Ok(out)
+}
+
+/// One point's discretization covariance from its `neighbours` (itself
+/// included, as `(squared distance, index)` nearest first).
+fn of_neighbourhood(
+    points: &[Point3],
+    neighbours: &[(Real, u32)],
+    sensor_i: &Matrix3,
+    settings: &DiscretizationSettings,
+) -> Matrix3 {
+    let d_k = neighbours.last().map_or(0.0, |&(d2, _)| d2.sqrt());
+    if d_k <= 0.0 {
+        return Matrix3::zeros();
+    }
+    let s = settings.weight_scale * d_k;
+    let mut wsum = 0.0;
+    let mut mean = Vector3::zeros();
+    for &(d2, j) in neighbours {
+        let w = (-d2 / (s * s)).exp();
+        wsum += w;
+        mean += w * points[j as usize].coords;
+    }
+    mean /= wsum;
+    let mut scatter = Matrix3::zeros();
+    for &(d2, j) in neighbours {
+        let w = (-d2 / (s * s)).exp();
+        let o = points[j as usize].coords - mean;
+        scatter += w * o * o.transpose();
+    }
+    scatter /= wsum;
+    project_psd(&(scatter - sensor_i))
 }
 
 /// The nearest positive semi-definite matrix (negative eigenvalues set to zero).
@@ -121,4 +146,45 @@ fn project_psd(m: &Matrix3) -> Matrix3 {
     let v = eig.eigenvectors;
     let c = v * Matrix3::from_diagonal(&vals) * v.transpose();
     0.5 * (c + c.transpose())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::BvhSettings;
+    use crate::sample::{add_noise, box_surface};
+
+    /// Above the grid's threshold the covariances are those the tree's
+    /// neighbours give (the points are noisy: no distances tie).
+    #[test]
+    fn grid_and_tree_neighbourhoods_give_the_same_covariances() {
+        let pts = add_noise(
+            &box_surface(&Point3::origin(), &Vector3::new(0.3, 0.2, 0.1), 0.004),
+            0.001,
+            5,
+        );
+        assert!(pts.len() > GRID_KNN_MIN_POINTS);
+        let sensor: Vec<Matrix3> = (0..pts.len())
+            .map(|i| Matrix3::identity() * (1e-6 * (1.0 + (i % 3) as Real)))
+            .collect();
+        let sigmas = vec![0.0; pts.len()];
+        let bvh = Bvh::build(&pts, &sigmas, &BvhSettings::default()).unwrap();
+        let settings = DiscretizationSettings::default();
+        let grid = discretization_covariances(&pts, &sensor, &bvh, &settings).unwrap();
+        let (mut ws, mut nn) = (BvhWorkspace::default(), Vec::new());
+        let mut nonzero = 0;
+        for (i, p) in pts.iter().enumerate() {
+            bvh.nearest_k(&pts, p, settings.k + 1, &mut ws, &mut nn);
+            let tree = of_neighbourhood(&pts, &nn, &sensor[i], &settings);
+            let scale = tree.norm().max(1e-30);
+            assert!(
+                (grid[i] - tree).norm() <= 1e-12 * scale,
+                "point {i}: {} vs {}",
+                grid[i],
+                tree
+            );
+            nonzero += usize::from(tree.norm() > 0.0);
+        }
+        assert!(nonzero > pts.len() / 2);
+    }
 }
