@@ -12,8 +12,8 @@ use crate::error::{Error, Result};
 use crate::math::Pose;
 use crate::probability::{normal_quantile, Aggregation, CollisionState};
 use crate::query::collide::{
-    collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, CollisionRequest,
-    CollisionResult, QueryModel,
+    collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, prepare,
+    CollisionRequest, CollisionResult, QueryModel,
 };
 use crate::query::exact::intersects;
 use crate::Real;
@@ -431,7 +431,10 @@ pub fn collide_robot_many(
         })?;
     }
     let samples = samples_at(robot, link_spacing(request, cloud)?)?;
-    let _ = (cloud.bvh(), cloud.spacing(), cloud.node_spacing());
+    prepare(cloud, &request.collide);
+    for link_cloud in samples.clouds.iter().flatten() {
+        prepare(link_cloud, &request.collide);
+    }
     Ok(qs
         .par_iter()
         .map_init(RobotWorkspace::default, |ws, q| {

@@ -7,11 +7,12 @@ use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::Pose;
 use crate::query::collide::collide::collide_with_workspace;
-use crate::query::collide::{CollisionRequest, CollisionResult};
+use crate::query::collide::{CollisionRequest, CollisionResult, QueryModel};
 
 /// [`crate::query::collide()`] for cloud `a` at each of `poses_a` against cloud `b`
-/// at `pose_b`, on rayon's thread pool. Both hierarchies are built once, before
-/// the parallel part. Results are in the order of `poses_a`.
+/// at `pose_b`, on rayon's thread pool. What both clouds build on first use
+/// (see [`prepare`]) is built once, before the parallel part. Results are in
+/// the order of `poses_a`.
 pub fn collide_many(
     poses_a: &[Pose],
     a: &PointCloud,
@@ -20,13 +21,34 @@ pub fn collide_many(
     request: &CollisionRequest,
 ) -> Result<Vec<CollisionResult>> {
     request.validate()?;
-    if request.use_hierarchy {
-        let _ = (a.bvh(), b.bvh());
-    }
+    prepare(a, request);
+    prepare(b, request);
     poses_a
         .par_iter()
         .map_init(BvhWorkspace::default, |ws, pose_a| {
             collide_with_workspace(pose_a, a, pose_b, b, request, ws)
         })
         .collect()
+}
+
+/// Builds every part of `cloud` that is built on first use and that a query
+/// under `request` reads: its hierarchy (with `use_hierarchy`), its sampling
+/// spacing and, for the elements model, its surface elements with their
+/// hulls and their samples' hierarchy and spacing.
+///
+/// Parallel loops over queries call it first. These parts are built with
+/// rayon inside a `OnceLock`: a rayon thread building one, while it waits for
+/// its helpers, may take up another query of the same loop that needs the
+/// same part, and would wait for itself. It also keeps the build out of the
+/// first query's time.
+pub(crate) fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
+    if request.use_hierarchy {
+        let _ = cloud.bvh();
+    }
+    let _ = cloud.spacing();
+    if request.model == QueryModel::Elements {
+        let elements = cloud.elements();
+        let samples = elements.samples();
+        let _ = (elements.hulls(), samples.bvh(), samples.spacing());
+    }
 }
