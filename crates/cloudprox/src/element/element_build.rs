@@ -56,58 +56,69 @@ pub(crate) fn split(
     cloud: &PointCloud,
     settings: &ElementSettings,
 ) -> Vec<(Vec<u32>, SurfaceElement)> {
+    let mut indices: Vec<u32> = (0..cloud.len() as u32).collect();
+    split_run(cloud, settings, &mut indices, 0)
+}
+
+/// Runs of at least this many points split their two halves in parallel.
+const PARALLEL_SPLIT_MIN: usize = 2048;
+
+/// [`split`] of one run of the index order, `run`, which starts at `first`:
+/// its groups in index order (the two halves of a split are disjoint runs,
+/// so they are split independently, in parallel when large).
+fn split_run(
+    cloud: &PointCloud,
+    settings: &ElementSettings,
+    run: &mut [u32],
+    first: usize,
+) -> Vec<(Vec<u32>, SurfaceElement)> {
     let points = cloud.points();
-    let sensor = cloud.sensor_covariances();
-    let spacing = cloud.spacing();
-    let n = points.len();
-    let mut indices: Vec<u32> = (0..n as u32).collect();
-    let mut elements = Vec::new();
-    let mut stack = vec![(0usize, n)];
-    while let Some((first, count)) = stack.pop() {
-        let range = first..first + count;
-        if count >= settings.min_points {
-            let fit = fit_element(
-                points,
-                sensor,
-                spacing,
-                &indices[range.clone()],
-                first as u32,
-                settings,
-            );
-            match fit {
-                Fit::Element(e) => {
-                    elements.push(*e);
-                    continue;
-                }
-                Fit::Split(rule) => {
-                    let slice = &mut indices[range];
-                    let mut k = match &rule {
-                        SplitRule::TwoSurfaces { .. } => {
-                            partition(slice, |i| rule.is_below(&points[i as usize]))
-                        }
-                        SplitRule::Median { .. } => 0,
-                    };
-                    if k == 0 || k == count {
-                        let (mean, axis) = match rule {
-                            SplitRule::Median { mean, axis } => (mean, axis),
-                            SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
-                        };
-                        let key = |i: u32| (points[i as usize] - mean).dot(&axis);
-                        k = count / 2;
-                        slice.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
+    let count = run.len();
+    if count >= settings.min_points {
+        let (sensor, spacing) = (cloud.sensor_covariances(), cloud.spacing());
+        match fit_element(points, sensor, spacing, run, first as u32, settings) {
+            Fit::Element(e) => return vec![(run.to_vec(), *e)],
+            Fit::Split(rule) => {
+                let mut k = match &rule {
+                    SplitRule::TwoSurfaces { .. } => {
+                        partition(run, |i| rule.is_below(&points[i as usize]))
                     }
-                    stack.push((first + k, count - k));
-                    stack.push((first, k));
-                    continue;
+                    SplitRule::Median { .. } => 0,
+                };
+                if k == 0 || k == count {
+                    let (mean, axis) = match rule {
+                        SplitRule::Median { mean, axis } => (mean, axis),
+                        SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
+                    };
+                    let key = |i: u32| (points[i as usize] - mean).dot(&axis);
+                    k = count / 2;
+                    run.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
                 }
+                let (lo, hi) = run.split_at_mut(k);
+                let (mut groups, upper) = if count >= PARALLEL_SPLIT_MIN {
+                    rayon::join(
+                        || split_run(cloud, settings, lo, first),
+                        || split_run(cloud, settings, hi, first + k),
+                    )
+                } else {
+                    (
+                        split_run(cloud, settings, lo, first),
+                        split_run(cloud, settings, hi, first + k),
+                    )
+                };
+                groups.extend(upper);
+                return groups;
             }
         }
-        // Too few points for an element: each point stands for itself.
-        let total = cloud.covariances();
-        for j in range {
-            let i = indices[j] as usize;
-            elements.push(SurfaceElement {
-                first: j as u32,
+    }
+    // Too few points for an element: each point stands for itself.
+    let total = cloud.covariances();
+    run.iter()
+        .enumerate()
+        .map(|(j, &i)| {
+            let i = i as usize;
+            let e = SurfaceElement {
+                first: (first + j) as u32,
                 count: 1,
                 mean: points[i],
                 normal: Vector3::z(),
@@ -120,14 +131,8 @@ pub(crate) fn split(
                 height_cov: nalgebra::SMatrix::zeros(),
                 common_var: 0.0,
                 footprint: Vec::new(),
-            });
-        }
-    }
-    elements
-        .into_iter()
-        .map(|e| {
-            let g = indices[e.first as usize..(e.first + e.count) as usize].to_vec();
-            (g, e)
+            };
+            (vec![i as u32], e)
         })
         .collect()
 }

@@ -9,6 +9,8 @@
 
 use std::collections::HashSet;
 
+use rayon::prelude::*;
+
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::element::element_fit::{fit_element, Fit};
 use crate::element::{ElementSettings, SurfaceElement};
@@ -19,6 +21,8 @@ use crate::Real;
 const MERGE_NEIGHBOURS: usize = 6;
 /// Passes at most (each can double an element's size).
 const MERGE_PASSES: usize = 12;
+/// Pairs whose unions are fitted in parallel at a time.
+const MERGE_BATCH: usize = 64;
 
 /// Merges neighbouring `groups` (point indices, with their elements `fits`)
 /// while their unions pass the element tests; returns the groups left.
@@ -64,23 +68,44 @@ pub(crate) fn merge_neighbours(
         pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut touched = vec![false; groups.len()];
         let mut merged_any = false;
-        for (_, i, j) in pairs {
-            let (i, j) = (i as usize, j as usize);
-            if touched[i] || touched[j] || failed.contains(&(ids[i], ids[j])) {
-                continue;
-            }
-            let mut union = groups[i].0.clone();
-            union.extend_from_slice(&groups[j].0);
-            if let Fit::Element(e) = fit_element(points, sensor, spacing, &union, 0, settings) {
-                groups[i] = (union, *e);
-                groups[j].0.clear();
-                ids[i] = next_id;
-                next_id += 1;
-                touched[i] = true;
-                touched[j] = true;
-                merged_any = true;
-            } else {
-                failed.insert((ids[i], ids[j]));
+        // The pairs in order, a batch at a time: the batch's unions are
+        // fitted in parallel, then taken in order as one after the other
+        // would, skipping a pair whose group an earlier one of the batch
+        // merged (its fit is wasted). The same groups as in one sequence.
+        let mut rest = pairs
+            .iter()
+            .map(|&(_, i, j)| (i as usize, j as usize))
+            .peekable();
+        while rest.peek().is_some() {
+            let batch: Vec<(usize, usize)> = rest
+                .by_ref()
+                .filter(|&(i, j)| !(touched[i] || touched[j] || failed.contains(&(ids[i], ids[j]))))
+                .take(MERGE_BATCH)
+                .collect();
+            let fits: Vec<(Vec<u32>, Fit)> = batch
+                .par_iter()
+                .map(|&(i, j)| {
+                    let mut union = groups[i].0.clone();
+                    union.extend_from_slice(&groups[j].0);
+                    let fit = fit_element(points, sensor, spacing, &union, 0, settings);
+                    (union, fit)
+                })
+                .collect();
+            for (&(i, j), (union, fit)) in batch.iter().zip(fits) {
+                if touched[i] || touched[j] {
+                    continue;
+                }
+                if let Fit::Element(e) = fit {
+                    groups[i] = (union, *e);
+                    groups[j].0.clear();
+                    ids[i] = next_id;
+                    next_id += 1;
+                    touched[i] = true;
+                    touched[j] = true;
+                    merged_any = true;
+                } else {
+                    failed.insert((ids[i], ids[j]));
+                }
             }
         }
         let mut kept = groups.iter().map(|(g, _)| !g.is_empty());
