@@ -40,8 +40,6 @@ pub(crate) fn merge_neighbours(
     settings: &ElementSettings,
     mut groups: Vec<(Vec<u32>, SurfaceElement)>,
 ) -> Vec<(Vec<u32>, SurfaceElement)> {
-    let mut ws = BvhWorkspace::default();
-    let mut nn: Vec<(Real, u32)> = Vec::new();
     // Each group's identity (a merged group is a new one), and the pairs of
     // identities whose union failed.
     let mut ids: Vec<u32> = (0..groups.len() as u32).collect();
@@ -56,15 +54,21 @@ pub(crate) fn merge_neighbours(
         let Ok(tree) = Bvh::build(&means, &zeros, &BvhSettings::default()) else {
             break;
         };
-        let mut pairs: Vec<(Real, u32, u32)> = Vec::new();
-        for (i, m) in means.iter().enumerate() {
-            tree.nearest_k(&means, m, MERGE_NEIGHBOURS + 1, &mut ws, &mut nn);
-            pairs.extend(
-                nn.iter()
-                    .filter(|&&(_, j)| j as usize > i)
-                    .map(|&(d2, j)| (d2, i as u32, j)),
-            );
-        }
+        let mut pairs: Vec<(Real, u32, u32)> = means
+            .par_iter()
+            .enumerate()
+            .map_init(
+                || (BvhWorkspace::default(), Vec::new()),
+                |(ws, nn), (i, m)| {
+                    tree.nearest_k(&means, m, MERGE_NEIGHBOURS + 1, ws, nn);
+                    nn.iter()
+                        .filter(|&&(_, j)| j as usize > i)
+                        .map(|&(d2, j)| (d2, i as u32, j))
+                        .collect::<Vec<_>>()
+                },
+            )
+            .flatten_iter()
+            .collect();
         pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut touched = vec![false; groups.len()];
         let mut merged_any = false;
