@@ -28,8 +28,8 @@ impl SurfaceElements {
             // a query that walks the elements in order reads these next to
             // each other (scattered, the spheres' near query of criterion was
             // 25% slower with the same elements).
-            e.probes = e.probes.to_vec();
-            e.footprint = e.footprint.to_vec();
+            e.probes = e.probes.clone();
+            e.footprint = e.footprint.clone();
             e.first = indices.len() as u32;
             // (The same mean as the fit's for a multi-point element.)
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
