@@ -28,8 +28,12 @@ impl SurfaceElements {
             // a query that walks the elements in order reads these next to
             // each other (scattered, the spheres' near query of criterion was
             // 25% slower with the same elements).
-            e.probes = e.probes.clone();
-            e.footprint = e.footprint.clone();
+            let (probes, footprint) = (
+                std::mem::take(&mut e.probes),
+                std::mem::take(&mut e.footprint),
+            );
+            e.probes = probes.iter().copied().collect();
+            e.footprint = footprint.iter().copied().collect();
             e.first = indices.len() as u32;
             // (The same mean as the fit's for a multi-point element.)
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
