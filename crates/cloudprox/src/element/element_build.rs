@@ -32,8 +32,8 @@ impl SurfaceElements {
                 std::mem::take(&mut e.probes),
                 std::mem::take(&mut e.footprint),
             );
-            e.probes = probes.iter().copied().collect();
-            e.footprint = footprint.iter().copied().collect();
+            e.probes = Vec::from(probes.as_slice());
+            e.footprint = Vec::from(footprint.as_slice());
             e.first = indices.len() as u32;
             // (The same mean as the fit's for a multi-point element.)
             e.spacing = g.iter().map(|&i| spacing[i as usize]).sum::<f64>() / g.len() as f64;
