@@ -42,9 +42,9 @@ pub(crate) fn merge_neighbours(
 ) -> Vec<(Vec<u32>, SurfaceElement)> {
     // Each group's identity (a merged group is a new one), and the pairs of
     // identities whose union failed.
-    let mut ids: Vec<u32> = (0..groups.len() as u32).collect();
-    let mut next_id = groups.len() as u32;
-    let mut failed: HashSet<(u32, u32)> = HashSet::new();
+    let mut ids: Vec<u64> = (0..groups.len() as u64).collect();
+    let mut next_id = groups.len() as u64;
+    let mut failed: HashSet<(u64, u64)> = HashSet::new();
     for _ in 0..MERGE_PASSES {
         if groups.len() < 2 {
             break;
@@ -112,8 +112,12 @@ pub(crate) fn merge_neighbours(
                 }
             }
         }
-        let mut kept = groups.iter().map(|(g, _)| !g.is_empty());
-        ids.retain(|_| kept.next() == Some(true));
+        ids = ids
+            .iter()
+            .zip(&groups)
+            .filter(|(_, (g, _))| !g.is_empty())
+            .map(|(&id, _)| id)
+            .collect();
         groups.retain(|(g, _)| !g.is_empty());
         if !merged_any {
             break;

@@ -32,9 +32,10 @@ pub fn collide_many(
 }
 
 /// Builds every part of `cloud` that is built on first use and that a query
-/// under `request` reads: its hierarchy (with `use_hierarchy`), its sampling
-/// spacing and, for the elements model, its surface elements with their
-/// hulls and their samples' hierarchy and spacing.
+/// under `request` reads: its hierarchy and sampling spacing (the spacing is
+/// computed on the hierarchy, so both are built whatever `use_hierarchy`
+/// says) and, for the elements model, its surface elements with their hulls
+/// and their samples' hierarchy and spacing.
 ///
 /// Parallel loops over queries call it first. These parts are built with
 /// rayon inside a `OnceLock`: a rayon thread building one, while it waits for
@@ -42,10 +43,7 @@ pub fn collide_many(
 /// same part, and would wait for itself. It also keeps the build out of the
 /// first query's time.
 pub(crate) fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
-    if request.use_hierarchy {
-        let _ = cloud.bvh();
-    }
-    let _ = cloud.spacing();
+    let _ = (cloud.bvh(), cloud.spacing());
     if request.model == QueryModel::Elements {
         let elements = cloud.elements();
         let samples = elements.samples();
