@@ -46,10 +46,11 @@ def clouds() -> list[tuple[str, Callable[[], cp.PointCloud]]]:
     out: list[tuple[str, Callable[[], cp.PointCloud]]] = []
     for k, name in ((0, "room, 0.5%"), (2, "room, 2%")):
         d = level_inputs(config, k, (p_obj, r_obj), pts, 1)[2][0]
+        room_points, room_cov = d.room_points, d.room_sensor_cov
         out.append(
             (
                 name,
-                lambda d=d: cp.PointCloud(d.room_points, cov=d.room_sensor_cov, discretization=True),
+                lambda p=room_points, c=room_cov: cp.PointCloud(p, cov=c, discretization=True),
             )
         )
     frame = load_kinect_frame()
