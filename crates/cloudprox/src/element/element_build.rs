@@ -1,4 +1,5 @@
-//! Top-down construction of a cloud's surface elements.
+//! Construction of a cloud's surface elements: the top-down split (here),
+//! the bottom-up merge (`element_merge.rs`), the layout in element order.
 
 use crate::cloud::PointCloud;
 use crate::element::element_fit::{fit_element, Fit, SplitRule};
@@ -10,7 +11,9 @@ use crate::math::Vector3;
 
 impl SurfaceElements {
     /// Groups `cloud`'s points into surface elements (see [`crate::element`]),
-    /// in the cloud's own frame. `O(n log n)` tests of `O(m)` each.
+    /// in the cloud's own frame. `O(n log n)` tests of `O(m)` each, on
+    /// rayon's pool (the split's halves, the merge's unions); the groups do
+    /// not depend on the number of threads.
     pub fn build(cloud: &PointCloud, settings: &ElementSettings) -> Result<Self> {
         settings.validate()?;
         let points = cloud.points();
