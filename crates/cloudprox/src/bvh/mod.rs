@@ -38,7 +38,7 @@ pub(crate) use grid_knn::for_each_knn;
 
 /// Above this many points, the k-nearest-neighbour passes over a whole cloud
 /// (its sampling spacing, its discretization covariances) use the hashed grid
-/// ([`knn_map`]) instead of the tree.
+/// (`grid_knn.rs`) instead of the tree.
 pub const GRID_KNN_MIN_POINTS: usize = 4096;
 
 /// For every point of a non-empty, finite cloud (fewer than 2^32 points),

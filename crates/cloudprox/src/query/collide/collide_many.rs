@@ -10,9 +10,11 @@ use crate::query::collide::collide::collide_with_workspace;
 use crate::query::collide::{CollisionRequest, CollisionResult, QueryModel};
 
 /// [`crate::query::collide()`] for cloud `a` at each of `poses_a` against cloud `b`
-/// at `pose_b`, on rayon's thread pool. What both clouds build on first use
-/// (see [`prepare`]) is built once, before the parallel part. Results are in
-/// the order of `poses_a`.
+/// at `pose_b`, on rayon's thread pool. What a query of both clouds builds on
+/// first use (hierarchy, spacing; with the elements model, the elements with
+/// their hulls and samples) is built once, before the parallel part: built
+/// inside a query, rayon inside its `OnceLock` could have a thread wait for
+/// itself. Results are in the order of `poses_a`.
 pub fn collide_many(
     poses_a: &[Pose],
     a: &PointCloud,
