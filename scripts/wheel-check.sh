@@ -14,7 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
 
-step() { printf '\n==> %s\n' "$*"; }
+step() { printf '\n==> [%ss] %s\n' "$SECONDS" "$*"; }
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/cloudprox-wheel.XXXXXX")
 trap 'rm -rf "$work"' EXIT
