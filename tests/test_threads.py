@@ -63,3 +63,24 @@ def test_collide_many_from_threads_matches_collide() -> None:
         batches = list(pool.map(lambda _: cp.collide_many(b, a, poses), range(4)))
     for batch in batches:
         assert all(same(r, s) for r, s in zip(batch, single, strict=True))
+
+
+@pytest.mark.parametrize("model", ["points", "elements"])
+def test_prepared_clouds_answer_as_clouds_built_on_first_use(model: str) -> None:
+    a, b = clouds()
+    lazy = [cp.collide(a, b, pose_b=p, model=model) for p in POSES]
+    a, b = clouds()
+    a.prepare(model=model)
+    b.prepare(cp.CollisionRequest(model=model))
+    b.prepare(model=model)  # again: nothing left to build
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        prepared = list(pool.map(lambda p: cp.collide(a, b, pose_b=p, model=model), POSES))
+    assert all(same(r, s) for r, s in zip(prepared, lazy, strict=True))
+
+
+def test_prepare_refuses_what_a_query_refuses() -> None:
+    a, _ = clouds()
+    with pytest.raises(cp.InvalidInputError, match="model"):
+        a.prepare(model="voxels")
+    with pytest.raises(cp.InvalidInputError, match="mesh_spacing"):
+        a.prepare(mesh_spacing=0.01)

@@ -225,6 +225,15 @@ class PointCloud:
         ``6 / (pi d_6^2)`` points per square metre (a grid of pitch ``h`` gives
         ``h sqrt(2 pi / 6)``).
         """
+    def prepare(self, request: CollisionRequest | None = None, **options: Any) -> None:
+        """Build now, without the GIL, what a query under ``request`` builds on first use.
+
+        The hierarchy and sampling spacing and, for ``model="elements"``, the
+        surface elements (``options`` override the request's fields, as in
+        :func:`collide`). Later queries then do not pay for it, the first
+        query's ``time_seconds`` included; calling it again costs nothing.
+        :func:`collide_many` and the robot queries do it themselves.
+        """
     @property
     def sensor_covariances(self) -> _FloatArray:
         """Per-point sensor covariances (without the discretization part), ``(n, 3, 3)``."""

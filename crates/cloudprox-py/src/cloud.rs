@@ -8,12 +8,14 @@ use cloudprox::uncertainty::DiscretizationSettings;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{
     matrices3_from, matrices3_to_py, points_from, points_to_py, pose_from, shape_str, to_f64_array,
     vec_to_py,
 };
 use crate::error::{invalid_input, run_detached};
+use crate::request::{request_from, PyCollisionRequest};
 use crate::sensor::{sensor_model_from, viewpoint_from};
 
 /// The noise given to the constructor.
@@ -284,6 +286,28 @@ impl PyPointCloud {
     fn cell_side(&self, py: Python<'_>) -> PyResult<f64> {
         let inner = Arc::clone(&self.inner);
         run_detached(py, move || Ok(inner.cell_side()))
+    }
+
+    /// Build now, without the GIL, every part of this cloud that a query under
+    /// `request` (with the keyword `options` on top, as in ``collide``) builds on
+    /// its first use: the hierarchy and sampling spacing and, for
+    /// ``model="elements"``, the surface elements. Later queries then do not
+    /// pay for it (the first query's ``time_seconds`` included); calling it
+    /// again costs nothing. ``collide_many`` and the robot queries do it
+    /// themselves.
+    #[pyo3(signature = (request=None, **options))]
+    fn prepare(
+        &self,
+        py: Python<'_>,
+        request: Option<&Bound<'_, PyCollisionRequest>>,
+        options: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<()> {
+        let request = request_from(py, request, options, &["request"])?;
+        let inner = Arc::clone(&self.inner);
+        run_detached(py, move || {
+            cloudprox::query::prepare(&inner, &request);
+            Ok(())
+        })
     }
 
     /// Correlation of the sensor noise between the points of one surface element

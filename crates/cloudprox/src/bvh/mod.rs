@@ -15,8 +15,9 @@
 //! Spatial search has its home here: besides the tree, a hashed uniform grid
 //! (`grid_knn.rs`) answers exact k-nearest-neighbour queries for every point of
 //! a large cloud at once, much cheaper to build on millions of points than a
-//! tree; the filters and the sampling spacing of large clouds use it
-//! (`knn_map`).
+//! tree; the filters use it, and the k-NN pass over a whole cloud (its
+//! sampling spacing, its discretization covariances) above
+//! [`GRID_KNN_MIN_POINTS`] points (`knn_of_every_point`).
 
 mod aabb;
 mod bvh_build;
@@ -42,13 +43,44 @@ pub(crate) use grid_knn::for_each_knn;
 pub const GRID_KNN_MIN_POINTS: usize = 4096;
 
 /// For every point of a non-empty, finite cloud (fewer than 2^32 points),
-/// `f(i, neighbours)` with its `k` nearest *other* points as `(squared
-/// distance, index)` in no particular order; in parallel, results in point
-/// order: the exact k-NN of the hashed grid.
-pub(crate) fn knn_map<T, F>(points: &[crate::math::Point3], k: usize, f: F) -> Vec<T>
+/// `f(i, neighbours)` with the point itself and its `k` nearest *other* points
+/// (fewer in a cloud of at most `k` points) as `(squared distance, index)`,
+/// nearest first (ties by index from the grid, in the tree's order from the
+/// tree); in parallel, results in point order. The
+/// neighbours come from `bvh` (built over `points`) up to
+/// [`GRID_KNN_MIN_POINTS`] points and from the hashed grid above (exact as
+/// well, and much cheaper to build on large clouds): the same neighbours but
+/// where distances tie. The one k-NN pass over a whole cloud, for its sampling
+/// spacing and its discretization covariances.
+pub(crate) fn knn_of_every_point<T, F>(
+    points: &[crate::math::Point3],
+    bvh: &Bvh,
+    k: usize,
+    f: F,
+) -> Vec<T>
 where
     T: Send,
     F: Fn(usize, &[(f64, u32)]) -> T + Sync,
 {
-    for_each_knn(points, k, f)
+    use rayon::prelude::*;
+    if points.len() > GRID_KNN_MIN_POINTS {
+        return for_each_knn(points, k, |i, others| {
+            let mut neighbours = Vec::with_capacity(others.len() + 1);
+            neighbours.push((0.0, i as u32));
+            neighbours.extend_from_slice(others);
+            neighbours.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            f(i, &neighbours)
+        });
+    }
+    points
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || (BvhWorkspace::default(), Vec::with_capacity(k + 1)),
+            |(workspace, neighbours), (i, x)| {
+                bvh.nearest_k(points, x, k + 1, workspace, neighbours);
+                f(i, neighbours)
+            },
+        )
+        .collect()
 }

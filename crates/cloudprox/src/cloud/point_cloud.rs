@@ -4,7 +4,7 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use crate::bvh::{Bvh, BvhSettings, GRID_KNN_MIN_POINTS};
+use crate::bvh::{knn_of_every_point, Bvh, BvhSettings};
 use crate::element::{ElementSettings, SurfaceElements};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
@@ -357,30 +357,11 @@ impl PointCloud {
         self.spacing.get_or_init(|| {
             let bvh = self.bvh();
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
-            let per_point: Vec<Real> = if self.points.len() > GRID_KNN_MIN_POINTS {
-                // The hashed grid of the spatial search (also the filters'): exact, and much cheaper than the
-                // tree on large clouds (the distance to the k-th neighbour does
-                // not depend on how ties are broken).
-                crate::bvh::knn_map(&self.points, k, |_, nb| {
-                    nb.iter().fold(0.0, |m: Real, &(d2, _)| m.max(d2)).sqrt()
-                })
-            } else {
-                self.points
-                    .par_iter()
-                    .map_init(
-                        || {
-                            (
-                                crate::bvh::BvhWorkspace::default(),
-                                Vec::with_capacity(k + 1),
-                            )
-                        },
-                        |(ws, nn), p| {
-                            bvh.nearest_k(&self.points, p, k + 1, ws, nn);
-                            nn.last().map_or(0.0, |&(d2, _)| d2.sqrt())
-                        },
-                    )
-                    .collect()
-            };
+            // The distance to the k-th neighbour does not depend on how
+            // ties are broken.
+            let per_point: Vec<Real> = knn_of_every_point(&self.points, bvh, k, |_, nb| {
+                nb.last().map_or(0.0, |&(d2, _)| d2.sqrt())
+            });
             let per_node = bvh.node_max(&per_point);
             let mut sorted = per_point.clone();
             let mid = sorted.len() / 2;
@@ -476,6 +457,7 @@ impl PointCloud {
 #[cfg(test)]
 mod spacing_tests {
     use super::*;
+    use crate::bvh::GRID_KNN_MIN_POINTS;
     use crate::sample::{add_noise, box_surface};
 
     /// A pose that moves the points out of range is refused by name and leaves

@@ -1,8 +1,6 @@
 //! Discretization error: how sparsely the surface around each point was sampled.
 
-use rayon::prelude::*;
-
-use crate::bvh::{knn_map, Bvh, BvhWorkspace, GRID_KNN_MIN_POINTS};
+use crate::bvh::{knn_of_every_point, Bvh};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Vector3};
 use crate::Real;
@@ -61,7 +59,7 @@ impl DiscretizationSettings {
 ///
 /// `sensor` holds the sensor covariances (same length as `points`); clouds with
 /// fewer than `k + 1` points use all points. The neighbours come from `bvh`
-/// up to [`GRID_KNN_MIN_POINTS`] points and from the hashed grid of the
+/// up to [`GRID_KNN_MIN_POINTS`](crate::bvh::GRID_KNN_MIN_POINTS) points and from the hashed grid of the
 /// spatial search above (exact as well, and much cheaper on large clouds; the
 /// same neighbours but where distances tie).
 pub fn discretization_covariances(
@@ -82,29 +80,9 @@ pub fn discretization_covariances(
         return Ok(vec![Matrix3::zeros(); points.len()]);
     }
     let k = settings.k.min(points.len() - 1);
-    if points.len() > GRID_KNN_MIN_POINTS {
-        return Ok(knn_map(points, k, |i, others| {
-            // The point itself and its neighbours, nearest first (as the
-            // tree gives them; ties by index).
-            let mut neighbours = Vec::with_capacity(k + 1);
-            neighbours.push((0.0, i as u32));
-            neighbours.extend_from_slice(others);
-            neighbours.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            of_neighbourhood(points, &neighbours, &sensor[i], settings)
-        }));
-    }
-    let out = points
-        .par_iter()
-        .zip(sensor)
-        .map_init(
-            || (BvhWorkspace::default(), Vec::with_capacity(k + 1)),
-            |(workspace, neighbours), (x, sensor_i)| {
-                bvh.nearest_k(points, x, k + 1, workspace, neighbours);
-                of_neighbourhood(points, neighbours, sensor_i, settings)
-            },
-        )
-        .collect();
-    Ok(out)
+    Ok(knn_of_every_point(points, bvh, k, |i, neighbours| {
+        of_neighbourhood(points, neighbours, &sensor[i], settings)
+    }))
 }
 
 /// One point's discretization covariance from its `neighbours` (itself
@@ -151,7 +129,7 @@ fn project_psd(m: &Matrix3) -> Matrix3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::BvhSettings;
+    use crate::bvh::{BvhSettings, BvhWorkspace, GRID_KNN_MIN_POINTS};
     use crate::sample::{add_noise, box_surface};
 
     /// Above the grid's threshold the covariances are those the tree's

@@ -37,14 +37,16 @@ pub fn collide_many(
 /// under `request` reads: its hierarchy and sampling spacing (the spacing is
 /// computed on the hierarchy, so both are built whatever `use_hierarchy`
 /// says) and, for the elements model, its surface elements with their hulls
-/// and their samples' hierarchy and spacing.
+/// and their samples' hierarchy and spacing. Calling it again costs nothing.
 ///
-/// Parallel loops over queries call it first. These parts are built with
-/// rayon inside a `OnceLock`: a rayon thread building one, while it waits for
-/// its helpers, may take up another query of the same loop that needs the
-/// same part, and would wait for itself. It also keeps the build out of the
-/// first query's time.
-pub(crate) fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
+/// Call it on a new cloud before querying it from several threads of a rayon
+/// pool (your own `par_iter` over [`collide`](crate::query::collide())):
+/// these parts are built with rayon inside a `OnceLock`, and a rayon thread
+/// building one, while it waits for its helpers, may take up another query of
+/// the same loop that needs the same part and wait for itself. It also keeps
+/// the build out of the first query's time. [`collide_many`] and the robot's
+/// batch queries call it themselves.
+pub fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
     let _ = (cloud.bvh(), cloud.spacing());
     if request.model == QueryModel::Elements {
         let elements = cloud.elements();

@@ -35,8 +35,7 @@ mod result;
 
 pub use collide::collide;
 pub(crate) use collide::collide_with_workspace;
-pub use collide_many::collide_many;
-pub(crate) use collide_many::prepare;
+pub use collide_many::{collide_many, prepare};
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
 };
