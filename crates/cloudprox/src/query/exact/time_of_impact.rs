@@ -67,7 +67,15 @@ fn cast_pair(
             },
         )
     };
-    if let Some(bound) = vertex_ray_bound(pa, a, direction, pb, b, max_travel) {
+    // Two convex parts are one GJK cast, with no tree for a shorter reach to
+    // prune: the bound would only add its rays.
+    let both_convex = matches!((a, b), (ExactPart::Convex(_), ExactPart::Convex(_)));
+    let bound = if both_convex {
+        None
+    } else {
+        vertex_ray_bound(pa, a, direction, pb, b, max_travel)
+    };
+    if let Some(bound) = bound {
         // Slack for the casts' own rounding: the bound is a travel where the
         // parts touch, the cast's answer at most that.
         let reach = (bound * (1.0 + 1e-9) + 1e-12).min(max_travel);
@@ -81,8 +89,11 @@ fn cast_pair(
 /// An upper bound on the travel of [`cast_pair`] for any `target >= 0`: the
 /// first travel at which a vertex of one part, moving along the relative
 /// direction, lies on the other part (its distance 0 there), as rays of the
-/// part with fewer vertices against the other's tree. `None` when no vertex
-/// meets the other part within `max_travel` (an edge or a face may still).
+/// part with fewer vertices against the other part (its tree for a mesh).
+/// `None` when no vertex meets the other part within `max_travel` (an edge or
+/// a face may still). A vertex that no face uses would bound nothing: the
+/// casts with that reach then find nothing and [`cast_pair`] casts again with
+/// the full reach, so a bound can cost time but never change the answer.
 fn vertex_ray_bound(
     pa: &Pose,
     a: &ExactPart,
@@ -207,7 +218,10 @@ fn cast_mesh_mesh(
     }
     order.sort_by(|x, y| x.0.total_cmp(&y.0));
     let zero = Vector3::zeros();
-    let negligible = IMPACT_TOLERANCE.max(CAST_PRECISION * options.max_time_of_impact);
+    // Relative to the smaller of the reach and the moving mesh's size (the
+    // reach may be infinite).
+    let size = 2.0 * small.local_aabb().half_extents().norm();
+    let negligible = IMPACT_TOLERANCE.max(CAST_PRECISION * options.max_time_of_impact.min(size));
     let mut best: Option<Real> = None;
     for (near, edge, i) in order {
         let reach = best.unwrap_or(options.max_time_of_impact);
@@ -234,7 +248,8 @@ fn cast_mesh_mesh(
         if let Some(t) = hit {
             best = Some(t);
             // Within the casts' own precision of zero (about 1e-7 of the
-            // reach): no later triangle can improve it by more. A start in
+            // reach or of the mesh's size): no later triangle can improve it
+            // by more. A start in
             // contact that the corners alone did not show (large triangles
             // lying on the surface) took seconds of casts that all touch at
             // about zero travel.
@@ -382,7 +397,10 @@ fn search_past_contact(
 ///   `target`, by parry's shape casting (GJK directional distance) over the part
 ///   pairs: exact for contact between polyhedra, within GJK's relative
 ///   tolerance (about 1e-7 of the travel) for a gap, which it casts with one
-///   shape rounded by the gap.
+///   shape rounded by the gap. Between two meshes a travel within 1e-7 of the
+///   smaller of `max_travel` and the moving mesh's size from zero is returned
+///   as found (the start is at the target to the casts' precision), without
+///   casting the remaining triangles.
 /// - `target < 0`: a penetration depth of `-target`: the first contact as
 ///   above, then a search along the line past it on the signed distance of
 ///   [`exact_proximity`](super::exact_proximity) (conservative advancement, secant steps, bisection;
@@ -549,25 +567,31 @@ mod tests {
                 *rotation,
             );
             let tilt = Vector3::new(0.3 * rng.normal(), 0.3 * rng.normal(), -1.0).normalize();
-            let target = [0.0, 0.01, 0.05][k % 3];
-            let (a, b) = (&mover.parts[0], &ground.parts[0]);
+            let target = [0.0, 0.01, 0.05][(k / 3) % 3];
             let o = Pose::identity();
-            let got = cast_pair(&start, a, &tilt, &o, b, target, max_travel).unwrap();
+            // Every other pose the ground moves (the other way) instead: the
+            // part with fewer vertices is then the second.
+            let (pa, a, dir, pb, b) = if k % 2 == 0 {
+                (&start, &mover.parts[0], tilt, &o, &ground.parts[0])
+            } else {
+                (&o, &ground.parts[0], -tilt, &start, &mover.parts[0])
+            };
+            let got = cast_pair(pa, a, &dir, pb, b, target, max_travel).unwrap();
             let options = ShapeCastOptions {
                 max_time_of_impact: max_travel,
                 target_distance: target,
                 stop_at_penetration: true,
                 compute_impact_geometry_on_penetration: false,
             };
-            let full = cast_pair_within(&start, a, &tilt, &o, b, options).unwrap();
-            let bound = vertex_ray_bound(&start, a, &tilt, &o, b, max_travel);
+            let full = cast_pair_within(pa, a, &dir, pb, b, options).unwrap();
+            let bound = vertex_ray_bound(pa, a, &dir, pb, b, max_travel);
             match (got, full) {
                 (Some(t), Some(u)) => {
                     hits += 1;
                     assert!((t - u).abs() <= 1e-7 * max_travel, "pose {k}: {t} vs {u}");
                     if let Some(bound) = bound {
                         bounded += 1;
-                        assert!(t <= bound * (1.0 + 1e-9) + 1e-12, "pose {k}: {t} > {bound}");
+                        assert!(u <= bound * (1.0 + 1e-9) + 1e-12, "pose {k}: {u} > {bound}");
                     }
                 }
                 (None, None) => assert!(bound.is_none(), "pose {k}: a vertex hits, no cast"),
@@ -599,5 +623,52 @@ mod tests {
             .unwrap()
             .unwrap();
         assert!((t - 0.001).abs() <= CAST_PRECISION, "{t}");
+        // An unbounded reach: the first hit's travel is not taken as zero,
+        // the earliest hit is. The plate tilted and moved over the block in
+        // many ways (in some no corner is over it, in some the triangle cast
+        // first is not the one that hits first), against the travel to the
+        // lowest corner of the block's top face under the tilted plane.
+        let mut compared = 0;
+        for (i, j, roll, pitch) in (0..9).flat_map(|i| {
+            (0..9).flat_map(move |j| {
+                [(0.1, 0.05), (-0.1, 0.05), (0.05, -0.1), (-0.07, -0.07)].map(|(r, p)| (i, j, r, p))
+            })
+        }) {
+            let (x, y) = (0.05 * f64::from(i) - 0.2, 0.05 * f64::from(j) - 0.2);
+            let tilted = Pose::from_parts(
+                Translation3::new(x, y, 0.3),
+                nalgebra::UnitQuaternion::from_euler_angles(roll, pitch, 0.0),
+            );
+            let down = -Vector3::z();
+            let u = exact_time_of_impact(&tilted, &plate, &down, &o, &block, 0.0, Real::INFINITY)
+                .unwrap();
+            let normal = tilted.rotation * Vector3::z();
+            let inverse = tilted.inverse();
+            // The block's top corners under the plate, and their travels.
+            let lowest = [(-0.05, -0.05), (-0.05, 0.05), (0.05, -0.05), (0.05, 0.05)]
+                .iter()
+                .filter_map(|&(cx, cy)| {
+                    let p = Point3::new(cx, cy, 0.05);
+                    let t = -(p.coords - tilted.translation.vector).dot(&normal) / normal.z;
+                    let local = inverse * (p + Vector3::z() * t);
+                    (local.x.abs() < 0.2 && local.y.abs() < 0.2).then_some(t)
+                })
+                .fold(Real::INFINITY, Real::min);
+            // Only where the block's top corners decide it (a plate edge may
+            // meet the block first where the plate overhangs no corner).
+            let covered = [(-0.05, -0.05), (0.05, 0.05)].iter().all(|&(cx, cy)| {
+                let local = inverse * Point3::new(cx, cy, 0.05);
+                local.x.abs() < 0.15 && local.y.abs() < 0.15
+            });
+            if covered {
+                let u = u.unwrap();
+                assert!(
+                    (u - lowest).abs() <= 1e-9,
+                    "({x}, {y}, {roll}, {pitch}): {u} vs {lowest}"
+                );
+                compared += 1;
+            }
+        }
+        assert!(compared >= 20, "{compared}");
     }
 }
