@@ -1,4 +1,4 @@
-//! k-nearest-neighbour queries on one hierarchy.
+//! Nearest-neighbour and radius queries on one hierarchy.
 
 use crate::bvh::{Bvh, BvhWorkspace};
 use crate::math::Point3;
@@ -50,6 +50,50 @@ impl Bvh {
                         stack.push((dl, l));
                         stack.push((dr, r));
                     }
+                }
+            }
+        }
+    }
+
+    /// Every point within `radius` of `query`, i.e. with `(p - query).norm() <=
+    /// radius` (this exact test, so that a caller scanning all points with it
+    /// finds the same ones), as indices in the tree's order, appended to `out`
+    /// (cleared first). `points` must be the positions the tree was built or
+    /// refitted over.
+    pub fn within_radius(
+        &self,
+        points: &[Point3],
+        query: &Point3,
+        radius: Real,
+        workspace: &mut BvhWorkspace,
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        if radius.is_nan() || radius < 0.0 {
+            return;
+        }
+        // Boxes are pruned against a slightly larger radius: the box distance
+        // and the norm round differently, and a point on the sphere must not
+        // be lost to rounding.
+        let prune = radius * (1.0 + 1e-9) + Real::MIN_POSITIVE;
+        let prune2 = prune * prune;
+        let stack = &mut workspace.node_stack;
+        stack.clear();
+        stack.push(0);
+        while let Some(id) = stack.pop() {
+            let node = &self.nodes[id as usize];
+            if node.aabb.distance_squared_to_point(query) > prune2 {
+                continue;
+            }
+            match node.children {
+                None => out.extend(
+                    self.node_points(id)
+                        .iter()
+                        .filter(|&&i| (points[i as usize] - query).norm() <= radius),
+                ),
+                Some([l, r]) => {
+                    stack.push(r);
+                    stack.push(l);
                 }
             }
         }

@@ -64,6 +64,43 @@ fn nearest_k_matches_brute_force() {
 }
 
 #[test]
+fn within_radius_matches_brute_force() {
+    // Points on a coarse lattice put many exactly on the query spheres (the
+    // radii are lattice distances): the rounding of the boxes must lose none.
+    let mut pts = lcg_points(400, 3);
+    for i in 0..6 {
+        for j in 0..6 {
+            for k in 0..6 {
+                pts.push(Point3::new(f64::from(i), f64::from(j), f64::from(k)) * 0.2);
+            }
+        }
+    }
+    let sig = vec![0.0; pts.len()];
+    let bvh = Bvh::build(&pts, &sig, &BvhSettings { leaf_max_points: 5 }).unwrap();
+    let mut ws = BvhWorkspace::default();
+    let mut out = Vec::new();
+    let queries = lcg_points(10, 5).into_iter().chain(pts[400..].iter().step_by(37).copied());
+    let mut found = 0;
+    for q in queries {
+        for radius in [0.0, 0.2, 0.2 * 2f64.sqrt(), 0.3, 0.4, 2.0] {
+            bvh.within_radius(&pts, &q, radius, &mut ws, &mut out);
+            let mut got = out.clone();
+            got.sort_unstable();
+            let want: Vec<u32> = (0..pts.len() as u32)
+                .filter(|&i| (pts[i as usize] - q).norm() <= radius)
+                .collect();
+            assert_eq!(got, want, "radius {radius} at {q:?}");
+            found += got.len();
+        }
+    }
+    assert!(found > 1000, "{found}");
+    bvh.within_radius(&pts, &pts[0], -1.0, &mut ws, &mut out);
+    assert!(out.is_empty());
+    bvh.within_radius(&pts, &pts[0], f64::NAN, &mut ws, &mut out);
+    assert!(out.is_empty());
+}
+
+#[test]
 fn prune_bound_formula() {
     assert_eq!(prune_bound(1.0, 0.0, 0.0, 10), 0.0);
     assert_eq!(prune_bound(0.0, 0.0, 0.0, 10), 10.0);

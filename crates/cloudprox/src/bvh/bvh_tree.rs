@@ -90,4 +90,5 @@ impl Bvh {
 pub struct BvhWorkspace {
     pub(crate) pair_stack: Vec<(u32, u32)>,
     pub(crate) node_heap: Vec<(Real, u32)>,
+    pub(crate) node_stack: Vec<u32>,
 }

@@ -10,6 +10,7 @@
 //! surfaces (tangent, or an edge on a face) keep one side; two crossing surfaces
 //! do not.
 
+use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
 use crate::probability::normal_cdf;
 use crate::uncertainty::{directional_std_of, max_std};
@@ -50,39 +51,64 @@ const OWN_NEIGHBOURS: usize = 6;
 /// noisy offsets is selected) and below it with `1 - m Phi(-l)`; the product
 /// (clamped at 0) is returned. Points without a flat enough other neighbourhood
 /// get 0.
+///
+/// The neighbourhoods come from a hierarchy over each cloud (the same points a
+/// scan over all of them finds: the cost grows with the neighbourhoods, not
+/// with the clouds' sizes).
+///
+/// # Panics
+///
+/// If a covariance slice is shorter than its points.
 pub fn crossing_probabilities(
     own: &[Point3],
     own_cov: &[Matrix3],
     other: &[Point3],
     other_cov: &[Matrix3],
 ) -> Vec<Real> {
-    let mut by_distance: Vec<(Real, usize)> = Vec::with_capacity(own.len().max(other.len()));
-    let mut near_other: Vec<usize> = Vec::new();
+    crossing_probabilities_by(own, own_cov, other, other_cov, true)
+}
+
+/// [`crossing_probabilities`], its neighbourhoods found by hierarchies
+/// (`indexed`) or by scanning every point (the reference the tests compare
+/// with).
+fn crossing_probabilities_by(
+    own: &[Point3],
+    own_cov: &[Matrix3],
+    other: &[Point3],
+    other_cov: &[Matrix3],
+    indexed: bool,
+) -> Vec<Real> {
+    if own.is_empty() {
+        return Vec::new();
+    }
+    if other.len() < MIN_PLANE_POINTS {
+        return vec![0.0; own.len()];
+    }
+    let own_std: Vec<Real> = own_cov[..own.len()].iter().map(max_std).collect();
+    let other_std: Vec<Real> = other_cov[..other.len()].iter().map(max_std).collect();
+    let mut own_search = Search::new(own, &own_std, indexed);
+    let mut other_search = Search::new(other, &other_std, indexed);
+    let mut by_distance: Vec<(Real, u32)> = Vec::with_capacity(OWN_NEIGHBOURS + 1);
+    let mut within: Vec<u32> = Vec::new();
+    let mut near_other: Vec<u32> = Vec::new();
+    let mut projected: Vec<Point3> = Vec::new();
     own.iter()
         .map(|x| {
             // The scale: the distance to the 6th nearest own point, or 4 noise
             // standard deviations of the pair, whichever is larger.
-            by_distance.clear();
-            by_distance.extend(
-                own.iter()
-                    .enumerate()
-                    .map(|(j, y)| ((x - y).norm_squared(), j)),
-            );
-            let k = (OWN_NEIGHBOURS + 1).min(by_distance.len());
-            by_distance.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+            let k = (OWN_NEIGHBOURS + 1).min(own.len());
+            own_search.nearest(x, k, &mut by_distance);
             let d_k = by_distance[k - 1].0.sqrt();
-            let own_near: Vec<usize> = by_distance[..k].iter().map(|&(_, j)| j).collect();
-            let noise_at = |pts: &[Point3], covs: &[Matrix3], within: Real| {
-                pts.iter()
-                    .zip(covs)
-                    .filter(|(p, _)| (*p - x).norm() <= within)
-                    .map(|(_, c)| max_std(c))
-                    .fold(0.0, Real::max)
+            let mut noise_at = |search: &mut Search<'_>, std: &[Real]| {
+                search.within(x, d_k, &mut within);
+                within.iter().map(|&j| std[j as usize]).fold(0.0, Real::max)
             };
-            let noise = noise_at(own, own_cov, d_k).max(noise_at(other, other_cov, d_k));
+            let noise =
+                noise_at(&mut own_search, &own_std).max(noise_at(&mut other_search, &other_std));
             let r = d_k.max(RADIUS_SIGMAS * noise);
-            near_other.clear();
-            near_other.extend((0..other.len()).filter(|&j| (other[j] - x).norm() <= r));
+            other_search.within(x, r, &mut near_other);
+            // In index order: the plane's sums add in the same order as a scan.
+            near_other.sort_unstable();
             if near_other.len() < MIN_PLANE_POINTS {
                 return 0.0;
             }
@@ -94,15 +120,17 @@ pub fn crossing_probabilities(
             // is within the other points' spacing (plus noise) of one of them.
             let spacing = r * (std::f64::consts::PI / near_other.len() as Real).sqrt();
             let reach = spacing + noise;
+            projected.clear();
+            projected.extend(near_other.iter().map(|&j| {
+                let q = other[j as usize];
+                q - normal * normal.dot(&(q - centre))
+            }));
             let (mut up, mut down, mut m) = (Real::NEG_INFINITY, Real::NEG_INFINITY, 0usize);
-            for &j in &own_near {
-                let (y, c) = (&own[j], &own_cov[j]);
+            for &(_, j) in &by_distance[..k] {
+                let (y, c) = (&own[j as usize], &own_cov[j as usize]);
                 let along = normal.dot(&(y - centre));
                 let foot = y - normal * along;
-                let covered = near_other.iter().any(|&j| {
-                    let q = other[j] - normal * normal.dot(&(other[j] - centre));
-                    (q - foot).norm() <= reach
-                });
+                let covered = projected.iter().any(|q| (q - foot).norm() <= reach);
                 let s = (directional_std_of(c, &normal).powi(2) + plane_var).sqrt();
                 if !covered || s <= 0.0 {
                     continue;
@@ -122,16 +150,68 @@ pub fn crossing_probabilities(
         .collect()
 }
 
+/// Neighbourhood queries over one cloud: by its hierarchy, or by a scan over
+/// every point (when asked, or if the hierarchy cannot be built).
+struct Search<'a> {
+    points: &'a [Point3],
+    tree: Option<(Bvh, BvhWorkspace)>,
+}
+
+impl<'a> Search<'a> {
+    fn new(points: &'a [Point3], std: &[Real], indexed: bool) -> Self {
+        let tree = indexed
+            .then(|| Bvh::build(points, std, &BvhSettings::default()).ok())
+            .flatten()
+            .map(|t| (t, BvhWorkspace::default()));
+        Self { points, tree }
+    }
+
+    /// The `k` nearest points of `x` (at least one point, `k` at most their
+    /// number) as `(squared distance, index)`, nearest first, into `out`.
+    fn nearest(&mut self, x: &Point3, k: usize, out: &mut Vec<(Real, u32)>) {
+        if let Some((tree, workspace)) = &mut self.tree {
+            tree.nearest_k(self.points, x, k, workspace, out);
+            return;
+        }
+        out.clear();
+        out.extend(
+            self.points
+                .iter()
+                .zip(0u32..)
+                .map(|(y, j)| ((x - y).norm_squared(), j)),
+        );
+        out.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+        out.truncate(k);
+        out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    }
+
+    /// The points with `(p - x).norm() <= r`, into `out` (in no set order).
+    fn within(&mut self, x: &Point3, r: Real, out: &mut Vec<u32>) {
+        if let Some((tree, workspace)) = &mut self.tree {
+            tree.within_radius(self.points, x, r, workspace, out);
+            return;
+        }
+        out.clear();
+        out.extend(
+            self.points
+                .iter()
+                .zip(0u32..)
+                .filter(|(p, _)| (*p - x).norm() <= r)
+                .map(|(_, j)| j),
+        );
+    }
+}
+
 /// Centre, unit normal and the variance of the plane's offset along the normal
 /// of the `idx` points, if they are flat; `None` otherwise.
-fn flat_plane(idx: &[usize], pts: &[Point3], covs: &[Matrix3]) -> Option<(Point3, Vector3, Real)> {
+fn flat_plane(idx: &[u32], pts: &[Point3], covs: &[Matrix3]) -> Option<(Point3, Vector3, Real)> {
     let n = idx.len() as Real;
-    let pa = PrincipalAxes::of(idx.iter().map(|&j| pts[j]));
+    let pa = PrincipalAxes::of(idx.iter().map(|&j| pts[j as usize]));
     let (centre, thickness_var, spread_var) = (pa.mean, pa.variances[0], pa.variances[1]);
     let normal: Vector3 = pa.least();
     let noise_var = idx
         .iter()
-        .map(|&j| directional_std_of(&covs[j], &normal).powi(2))
+        .map(|&j| directional_std_of(&covs[j as usize], &normal).powi(2))
         .sum::<Real>()
         / n;
     // Flat: thin along the normal, as the noise; a plane, not a line: spread
@@ -162,6 +242,49 @@ mod tests {
 
     fn iso(n: usize, s: Real) -> Vec<Matrix3> {
         vec![Matrix3::identity() * s * s; n]
+    }
+
+    /// Two noisy sheets crossing at an angle, sampled unevenly, with
+    /// anisotropic covariances: the hierarchies find exactly the neighbourhoods
+    /// a scan finds, so every probability is the same number.
+    #[test]
+    fn hierarchies_give_the_scan_s_probabilities() {
+        let mut seed = 17u64;
+        let mut uniform = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as Real) / ((1u64 << 53) as Real)
+        };
+        let s = 0.002;
+        let mut sheet = |tilt: Real, n: usize| {
+            let mut pts = Vec::new();
+            let mut covs = Vec::new();
+            for i in 0..n {
+                let (u, v) = (uniform() - 0.5, 0.6 * (uniform() - 0.5));
+                // Denser towards one end: the neighbourhoods' sizes vary.
+                let u = 0.4 * u * u.abs().sqrt();
+                let noise = (uniform() - 0.5) * 2.0 * s;
+                pts.push(Point3::new(u, v, tilt * u + noise));
+                let a = 1.0 + Real::from(u8::try_from(i % 3).unwrap_or(0));
+                covs.push(Matrix3::from_diagonal(&Vector3::new(a, 1.0, 2.0)) * s * s);
+            }
+            (pts, covs)
+        };
+        let (a, ca) = sheet(0.0, 900);
+        let (b, cb) = sheet(1.5, 700);
+        let mut positive = 0;
+        for (own, own_cov, other, other_cov) in [(&a, &ca, &b, &cb), (&b, &cb, &a, &ca)] {
+            let fast = crossing_probabilities(own, own_cov, other, other_cov);
+            let scan = crossing_probabilities_by(own, own_cov, other, other_cov, false);
+            assert_eq!(fast, scan);
+            positive += fast.iter().filter(|&&p| p > 0.5).count();
+            assert!(fast.iter().filter(|&&p| p == 0.0).count() > own.len() / 2);
+        }
+        assert!(positive > 20, "{positive}");
+        // Too few other points for a plane, and an empty cloud.
+        assert_eq!(crossing_probabilities(&a, &ca, &b[..5], &cb[..5]), vec![0.0; a.len()]);
+        assert!(crossing_probabilities(&[], &[], &b, &cb).is_empty());
     }
 
     #[test]
