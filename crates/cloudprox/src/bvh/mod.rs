@@ -17,7 +17,9 @@
 //! a large cloud at once, much cheaper to build on millions of points than a
 //! tree; the filters use it, and the k-NN pass over a whole cloud (its
 //! sampling spacing, its discretization covariances) above
-//! [`GRID_KNN_MIN_POINTS`] points (`knn_of_every_point`).
+//! [`GRID_KNN_MIN_POINTS`] points (`knn_of_every_point`); `PointSearch`
+//! (`point_search.rs`) answers the neighbourhood and radius queries over a
+//! patch's points during a query.
 
 mod aabb;
 mod bvh_build;
@@ -27,6 +29,7 @@ mod bvh_traverse_bvtt;
 mod bvh_tree;
 mod bvh_validation;
 mod grid_knn;
+mod point_search;
 
 #[cfg(test)]
 mod bvh_tests;
@@ -36,6 +39,7 @@ pub use bvh_traverse_bvtt::{prune_bound, PairTraversal};
 pub use bvh_tree::{Bvh, BvhNode, BvhSettings, BvhWorkspace};
 
 pub(crate) use grid_knn::for_each_knn;
+pub(crate) use point_search::{Neighbourhoods, PointSearch};
 
 /// Above this many points, the k-nearest-neighbour passes over a whole cloud
 /// (its sampling spacing, its discretization covariances) use the hashed grid

@@ -94,6 +94,10 @@ mod tests {
     }
 }
 
+/// A point's neighbourhood on its own surface: the point and its 6 nearest
+/// (the surface probability's and the crossing test's).
+pub(crate) const NEIGHBOURHOOD: usize = 7;
+
 /// The probability that the surface around a point lies on the wrong side, from
 /// the margins `c_j f(x_j)` and standard deviations `s_j` along the gradient of
 /// the point and its neighbours: `Phi(-mean(m) / (sqrt(sum s_j^2) / n))`, the

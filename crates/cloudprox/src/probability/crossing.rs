@@ -10,9 +10,9 @@
 //! surfaces (tangent, or an edge on a face) keep one side; two crossing surfaces
 //! do not.
 
-use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
+use crate::bvh::{Neighbourhoods, PointSearch};
 use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
-use crate::probability::normal_cdf;
+use crate::probability::{normal_cdf, NEIGHBOURHOOD};
 use crate::uncertainty::{directional_std_of, max_std};
 use crate::Real;
 
@@ -26,10 +26,9 @@ const MAX_THICKNESS: Real = 1.5;
 /// thickness and the noise (standard deviations): a line of points is no plane.
 const MIN_SPREAD: Real = 2.0;
 /// Radius of the other cloud's neighbourhood, in standard deviations of the
-/// pair's noise (at least the distance to the 6th nearest own point).
+/// pair's noise (at least the distance to the 6th nearest own point: the own
+/// neighbourhood is the point and its 6 nearest, [`NEIGHBOURHOOD`]).
 const RADIUS_SIGMAS: Real = 4.0;
-/// The neighbourhood is at least as wide as this many nearest own points.
-const OWN_NEIGHBOURS: usize = 6;
 
 /// The probability, per point of `own`, that the surface sampled by `own`
 /// crosses the surface sampled by `other` there (both clouds in one frame, with
@@ -65,54 +64,52 @@ pub fn crossing_probabilities(
     other: &[Point3],
     other_cov: &[Matrix3],
 ) -> Vec<Real> {
-    crossing_probabilities_by(own, own_cov, other, other_cov, true)
+    let mut own_search = PointSearch::new(own, true);
+    let near = own_search.neighbourhoods(NEIGHBOURHOOD);
+    let mut other_search = PointSearch::new(other, true);
+    crossing_probabilities_in(&mut own_search, own_cov, &near, &mut other_search, other_cov)
 }
 
-/// [`crossing_probabilities`], its neighbourhoods found by hierarchies
-/// (`indexed`) or by scanning every point (the reference the tests compare
-/// with).
-fn crossing_probabilities_by(
-    own: &[Point3],
+/// [`crossing_probabilities`] with the clouds' searches and the own points'
+/// neighbourhoods (of [`NEIGHBOURHOOD`] points) made by the caller, who may
+/// use them for more (the surface probabilities of the same points).
+pub(crate) fn crossing_probabilities_in(
+    own: &mut PointSearch<'_>,
     own_cov: &[Matrix3],
-    other: &[Point3],
+    near: &Neighbourhoods,
+    other: &mut PointSearch<'_>,
     other_cov: &[Matrix3],
-    indexed: bool,
 ) -> Vec<Real> {
-    if own.is_empty() {
+    let (own_pts, other_pts) = (own.points(), other.points());
+    if own_pts.is_empty() {
         return Vec::new();
     }
-    if other.len() < MIN_PLANE_POINTS {
-        return vec![0.0; own.len()];
+    if other_pts.len() < MIN_PLANE_POINTS {
+        return vec![0.0; own_pts.len()];
     }
-    let own_std: Vec<Real> = own_cov[..own.len()].iter().map(max_std).collect();
-    let other_std: Vec<Real> = other_cov[..other.len()].iter().map(max_std).collect();
-    let mut own_search = Search::new(own, &own_std, indexed);
-    let mut other_search = Search::new(other, &other_std, indexed);
-    let mut by_distance: Vec<(Real, u32)> = Vec::with_capacity(OWN_NEIGHBOURS + 1);
+    let own_std: Vec<Real> = own_cov[..own_pts.len()].iter().map(max_std).collect();
+    let other_std: Vec<Real> = other_cov[..other_pts.len()].iter().map(max_std).collect();
     let mut within: Vec<u32> = Vec::new();
     let mut near_other: Vec<u32> = Vec::new();
     let mut projected: Vec<Point3> = Vec::new();
-    own.iter()
-        .map(|x| {
+    own_pts
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
             // The scale: the distance to the 6th nearest own point, or 4 noise
             // standard deviations of the pair, whichever is larger.
-            let k = (OWN_NEIGHBOURS + 1).min(own.len());
-            own_search.nearest(x, k, &mut by_distance);
-            let d_k = by_distance[k - 1].0.sqrt();
-            let mut noise_at = |search: &mut Search<'_>, std: &[Real]| {
+            let d_k = near.radius(i);
+            let mut noise_at = |search: &mut PointSearch<'_>, std: &[Real]| {
                 search.within(x, d_k, &mut within);
                 within.iter().map(|&j| std[j as usize]).fold(0.0, Real::max)
             };
-            let noise =
-                noise_at(&mut own_search, &own_std).max(noise_at(&mut other_search, &other_std));
+            let noise = noise_at(own, &own_std).max(noise_at(other, &other_std));
             let r = d_k.max(RADIUS_SIGMAS * noise);
-            other_search.within(x, r, &mut near_other);
-            // In index order: the plane's sums add in the same order as a scan.
-            near_other.sort_unstable();
+            other.within(x, r, &mut near_other);
             if near_other.len() < MIN_PLANE_POINTS {
                 return 0.0;
             }
-            let Some((centre, normal, plane_var)) = flat_plane(&near_other, other, other_cov)
+            let Some((centre, normal, plane_var)) = flat_plane(&near_other, other_pts, other_cov)
             else {
                 return 0.0;
             };
@@ -122,12 +119,12 @@ fn crossing_probabilities_by(
             let reach = spacing + noise;
             projected.clear();
             projected.extend(near_other.iter().map(|&j| {
-                let q = other[j as usize];
+                let q = other_pts[j as usize];
                 q - normal * normal.dot(&(q - centre))
             }));
             let (mut up, mut down, mut m) = (Real::NEG_INFINITY, Real::NEG_INFINITY, 0usize);
-            for &(_, j) in &by_distance[..k] {
-                let (y, c) = (&own[j as usize], &own_cov[j as usize]);
+            for &(_, j) in near.of(i) {
+                let (y, c) = (&own_pts[j as usize], &own_cov[j as usize]);
                 let along = normal.dot(&(y - centre));
                 let foot = y - normal * along;
                 let covered = projected.iter().any(|q| (q - foot).norm() <= reach);
@@ -148,58 +145,6 @@ fn crossing_probabilities_by(
             side(up) * side(down)
         })
         .collect()
-}
-
-/// Neighbourhood queries over one cloud: by its hierarchy, or by a scan over
-/// every point (when asked, or if the hierarchy cannot be built).
-struct Search<'a> {
-    points: &'a [Point3],
-    tree: Option<(Bvh, BvhWorkspace)>,
-}
-
-impl<'a> Search<'a> {
-    fn new(points: &'a [Point3], std: &[Real], indexed: bool) -> Self {
-        let tree = indexed
-            .then(|| Bvh::build(points, std, &BvhSettings::default()).ok())
-            .flatten()
-            .map(|t| (t, BvhWorkspace::default()));
-        Self { points, tree }
-    }
-
-    /// The `k` nearest points of `x` (at least one point, `k` at most their
-    /// number) as `(squared distance, index)`, nearest first, into `out`.
-    fn nearest(&mut self, x: &Point3, k: usize, out: &mut Vec<(Real, u32)>) {
-        if let Some((tree, workspace)) = &mut self.tree {
-            tree.nearest_k(self.points, x, k, workspace, out);
-            return;
-        }
-        out.clear();
-        out.extend(
-            self.points
-                .iter()
-                .zip(0u32..)
-                .map(|(y, j)| ((x - y).norm_squared(), j)),
-        );
-        out.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-        out.truncate(k);
-        out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-    }
-
-    /// The points with `(p - x).norm() <= r`, into `out` (in no set order).
-    fn within(&mut self, x: &Point3, r: Real, out: &mut Vec<u32>) {
-        if let Some((tree, workspace)) = &mut self.tree {
-            tree.within_radius(self.points, x, r, workspace, out);
-            return;
-        }
-        out.clear();
-        out.extend(
-            self.points
-                .iter()
-                .zip(0u32..)
-                .filter(|(p, _)| (*p - x).norm() <= r)
-                .map(|(_, j)| j),
-        );
-    }
 }
 
 /// Centre, unit normal and the variance of the plane's offset along the normal
@@ -276,7 +221,11 @@ mod tests {
         let mut positive = 0;
         for (own, own_cov, other, other_cov) in [(&a, &ca, &b, &cb), (&b, &cb, &a, &ca)] {
             let fast = crossing_probabilities(own, own_cov, other, other_cov);
-            let scan = crossing_probabilities_by(own, own_cov, other, other_cov, false);
+            let mut own_scan = PointSearch::new(own, false);
+            let near = own_scan.neighbourhoods(NEIGHBOURHOOD);
+            let mut other_scan = PointSearch::new(other, false);
+            let scan =
+                crossing_probabilities_in(&mut own_scan, own_cov, &near, &mut other_scan, other_cov);
             assert_eq!(fast, scan);
             positive += fast.iter().filter(|&&p| p > 0.5).count();
             assert!(fast.iter().filter(|&&p| p == 0.0).count() > own.len() / 2);

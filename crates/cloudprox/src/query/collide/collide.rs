@@ -2,12 +2,12 @@
 
 use std::time::Instant;
 
-use crate::bvh::BvhWorkspace;
+use crate::bvh::{BvhWorkspace, PointSearch};
 use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{crossing_probabilities, normal_cdf, normal_quantile, Aggregation};
+use crate::probability::{normal_cdf, normal_quantile, Aggregation};
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
     element_crossings, element_pairs_within_reach, element_points, element_sides_within_reach,
@@ -15,7 +15,7 @@ use crate::query::collide::elements::{
 };
 use crate::query::collide::near::{near_set, NearSet};
 use crate::query::collide::probabilities::{
-    core_values, indexed, point_probabilities, surface_probabilities,
+    core_values, indexed, point_probabilities, surface_side,
 };
 use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::{
@@ -276,18 +276,11 @@ pub(crate) fn collide_with_workspace(
             let (qa, qb) = match (crossings, request.aggregation) {
                 (Some((qa, qb, _)), _) => (qa, qb),
                 (None, Aggregation::Surface) if elements.is_none() => {
-                    let either = |q: Vec<Real>, c: Vec<Real>| -> Vec<Real> {
-                        q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
-                    };
+                    let (mut search_a, mut search_b) =
+                        (PointSearch::new(own_a, true), PointSearch::new(own_b, true));
                     (
-                        either(
-                            surface_probabilities(sep, own_a, cov_a, 1.0),
-                            crossing_probabilities(own_a, cov_a, own_b, cov_b),
-                        ),
-                        either(
-                            surface_probabilities(sep, own_b, cov_b, -1.0),
-                            crossing_probabilities(own_b, cov_b, own_a, cov_a),
-                        ),
+                        surface_side(sep, &mut search_a, cov_a, &mut search_b, cov_b, 1.0),
+                        surface_side(sep, &mut search_b, cov_b, &mut search_a, cov_a, -1.0),
                     )
                 }
                 (None, _) => (

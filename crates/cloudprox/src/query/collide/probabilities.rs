@@ -2,15 +2,15 @@
 //! its trained surface, the paper model's surface probability, and which
 //! values count towards the pair's `P` (core points only).
 
+use crate::bvh::{Neighbourhoods, PointSearch};
 use crate::classify::Separator;
 use crate::element::SurfaceElements;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{point_probability, surface_probability};
+use crate::probability::{
+    crossing_probabilities_in, point_probability, surface_probability, NEIGHBOURHOOD,
+};
 use crate::uncertainty::directional_std_of;
 use crate::Real;
-
-/// Neighbours behind a surface probability: the point and its 6 nearest.
-const SURFACE_NEIGHBOURS: usize = 7;
 
 /// Eq. 3 of each point of the elements `owners` of `elements` (moved by `pose`
 /// into the separator's frame) against `sep`, with label `label`; the larger
@@ -54,14 +54,15 @@ pub(crate) fn indexed<'a>(
 
 /// The surface probability `q_i` ([`surface_probability`]) of each of one side's
 /// points of a patch (`pts`, `covs` in the separator's frame, label `label`),
-/// from the point and its nearest neighbours among that side's patch points
+/// from the point's neighbourhood `near` among that side's patch points
 /// (neighbours beyond the patch belong to surfaces the separator was not
 /// fitted to, e.g. the far face of a thin plate).
-pub(crate) fn surface_probabilities(
+fn surface_probabilities(
     sep: &Separator,
     pts: &[Point3],
     covs: &[Matrix3],
     label: Real,
+    near: &Neighbourhoods,
 ) -> Vec<Real> {
     let form = sep.quadratic_form(&Pose::identity());
     let (margins, stds): (Vec<Real>, Vec<Real>) = pts
@@ -72,25 +73,35 @@ pub(crate) fn surface_probabilities(
             (label * f, directional_std_of(c, &g))
         })
         .unzip();
-    let k = SURFACE_NEIGHBOURS.min(pts.len());
-    let mut by_distance: Vec<(Real, usize)> = Vec::with_capacity(pts.len());
-    let (mut m, mut s) = (Vec::with_capacity(k), Vec::with_capacity(k));
-    pts.iter()
-        .map(|x| {
-            by_distance.clear();
-            by_distance.extend(
-                pts.iter()
-                    .enumerate()
-                    .map(|(j, y)| ((x - y).norm_squared(), j)),
-            );
-            by_distance.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+    let (mut m, mut s) = (Vec::new(), Vec::new());
+    (0..pts.len())
+        .map(|i| {
             m.clear();
             s.clear();
-            for &(_, j) in &by_distance[..k] {
-                m.push(margins[j]);
-                s.push(stds[j]);
+            for &(_, j) in near.of(i) {
+                m.push(margins[j as usize]);
+                s.push(stds[j as usize]);
             }
             surface_probability(&m, &s)
         })
         .collect()
+}
+
+/// The points model's `surface` inputs of one side of a patch (`own`, label
+/// `label`, against `other`; both in the separator's frame): for each point,
+/// the larger of its surface probability against `sep` and the probability
+/// that its surface crosses the other's there ([`crossing_probabilities_in`]).
+/// Each point's neighbourhood is found once for both.
+pub(crate) fn surface_side(
+    sep: &Separator,
+    own: &mut PointSearch<'_>,
+    own_cov: &[Matrix3],
+    other: &mut PointSearch<'_>,
+    other_cov: &[Matrix3],
+    label: Real,
+) -> Vec<Real> {
+    let near = own.neighbourhoods(NEIGHBOURHOOD);
+    let q = surface_probabilities(sep, own.points(), own_cov, label, &near);
+    let c = crossing_probabilities_in(own, own_cov, &near, other, other_cov);
+    q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
 }
