@@ -79,7 +79,9 @@ fn within_radius_matches_brute_force() {
     let bvh = Bvh::build(&pts, &sig, &BvhSettings { leaf_max_points: 5 }).unwrap();
     let mut ws = BvhWorkspace::default();
     let mut out = Vec::new();
-    let queries = lcg_points(10, 5).into_iter().chain(pts[400..].iter().step_by(37).copied());
+    let queries = lcg_points(10, 5)
+        .into_iter()
+        .chain(pts[400..].iter().step_by(37).copied());
     let mut found = 0;
     for q in queries {
         for radius in [0.0, 0.2, 0.2 * 2f64.sqrt(), 0.3, 0.4, 2.0] {

@@ -141,7 +141,10 @@ mod tests {
         // A set smaller than k: every point is in every neighbourhood.
         let few = &pts[..3];
         let n = PointSearch::new(few, true).neighbourhoods(7);
-        assert_eq!(n.of(2).iter().map(|e| e.1).collect::<Vec<_>>(), vec![0, 1, 2]);
+        assert_eq!(
+            n.of(2).iter().map(|e| e.1).collect::<Vec<_>>(),
+            vec![0, 1, 2]
+        );
         // No points: no hierarchy, nothing found.
         let mut none = PointSearch::new(&[], true);
         assert!(none.tree.is_none());

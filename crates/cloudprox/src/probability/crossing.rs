@@ -67,7 +67,13 @@ pub fn crossing_probabilities(
     let mut own_search = PointSearch::new(own, true);
     let near = own_search.neighbourhoods(NEIGHBOURHOOD);
     let mut other_search = PointSearch::new(other, true);
-    crossing_probabilities_in(&mut own_search, own_cov, &near, &mut other_search, other_cov)
+    crossing_probabilities_in(
+        &mut own_search,
+        own_cov,
+        &near,
+        &mut other_search,
+        other_cov,
+    )
 }
 
 /// [`crossing_probabilities`] with the clouds' searches and the own points'
@@ -224,15 +230,23 @@ mod tests {
             let mut own_scan = PointSearch::new(own, false);
             let near = own_scan.neighbourhoods(NEIGHBOURHOOD);
             let mut other_scan = PointSearch::new(other, false);
-            let scan =
-                crossing_probabilities_in(&mut own_scan, own_cov, &near, &mut other_scan, other_cov);
+            let scan = crossing_probabilities_in(
+                &mut own_scan,
+                own_cov,
+                &near,
+                &mut other_scan,
+                other_cov,
+            );
             assert_eq!(fast, scan);
             positive += fast.iter().filter(|&&p| p > 0.5).count();
             assert!(fast.iter().filter(|&&p| p == 0.0).count() > own.len() / 2);
         }
         assert!(positive > 20, "{positive}");
         // Too few other points for a plane, and an empty cloud.
-        assert_eq!(crossing_probabilities(&a, &ca, &b[..5], &cb[..5]), vec![0.0; a.len()]);
+        assert_eq!(
+            crossing_probabilities(&a, &ca, &b[..5], &cb[..5]),
+            vec![0.0; a.len()]
+        );
         assert!(crossing_probabilities(&[], &[], &b, &cb).is_empty());
     }
 

@@ -265,7 +265,7 @@ pub fn near_points_brute_force(
 /// rule's widest reach towards any point of that block
 /// ([`NearRule::block_reach`]) is left out of the pair tests: it is near none
 /// of them, and none of them near it, so the result is that of testing every
-/// pair.
+/// pair. A pair of blocks whose points have all been found near is skipped.
 fn near_points_in_blocks(
     blocks: (&[&[u32]], &[&[u32]]),
     pairs: &[(u32, u32)],
@@ -283,8 +283,16 @@ fn near_points_in_blocks(
     let read_b = Blocks::read(blocks.1, |j| noise_b.point(j, b.points()[j]));
     let mut near_a = vec![false; a.len()];
     let mut near_b = vec![false; b.len()];
+    // Per block, its points not yet found near: a pair of two blocks whose
+    // points are all near can change nothing (deep in an overlap, most pairs).
+    let mut left_a: Vec<usize> = read_a.bounds.iter().map(|b| b.run.len()).collect();
+    let mut left_b: Vec<usize> = read_b.bounds.iter().map(|b| b.run.len()).collect();
     let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
     for &(ka, kb) in pairs {
+        let (la, lb) = (&mut left_a[ka as usize], &mut left_b[kb as usize]);
+        if *la == 0 && *lb == 0 {
+            continue;
+        }
         read_a.within_reach_of(ka, &read_b, kb, &rule, &mut kept_a);
         read_b.within_reach_of(kb, &read_a, ka, &rule, &mut kept_b);
         let (block_a, block_b) = (read_a.block(ka), read_b.block(kb));
@@ -296,8 +304,14 @@ fn near_points_in_blocks(
                     continue;
                 }
                 let (ni, nj) = rule.near_sides(pi, pj);
-                near_a[*i] |= ni;
-                near_b[*j] |= nj;
+                if ni && !near_a[*i] {
+                    near_a[*i] = true;
+                    *la -= 1;
+                }
+                if nj && !near_b[*j] {
+                    near_b[*j] = true;
+                    *lb -= 1;
+                }
             }
         }
     }
