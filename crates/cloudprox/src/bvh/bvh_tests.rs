@@ -1,6 +1,7 @@
+use crate::bvh::bvh_traverse_bvtt::kept_without_bound;
 use crate::bvh::{prune_bound, Bvh, BvhSettings, BvhWorkspace};
 use crate::math::{Point3, Pose, Vector3};
-use crate::probability::normal_cdf;
+use crate::probability::{normal_cdf, normal_quantile};
 
 fn lcg_points(n: usize, seed: u64) -> Vec<Point3> {
     let mut s = seed;
@@ -100,6 +101,62 @@ fn within_radius_matches_brute_force() {
     assert!(out.is_empty());
     bvh.within_radius(&pts, &pts[0], f64::NAN, &mut ws, &mut out);
     assert!(out.is_empty());
+}
+
+#[test]
+fn pairs_kept_without_the_bound_have_a_bound_above_epsilon() {
+    for eps in [1e-12, 1e-9, 1e-6, 1e-3, 0.1, 0.5, 1.0] {
+        let z = kept_without_bound(eps);
+        let exact = -normal_quantile(0.5 * eps);
+        assert!(
+            z <= exact && z >= exact * (1.0 - 1e-5),
+            "{eps}: {z} vs {exact}"
+        );
+        // At the shortcut's edge, the smallest pair (2 points) is kept by the
+        // bound too, whatever the split of the deviations.
+        for (sa, sb) in [(1.0, 0.0), (0.3, 0.7), (1e-3, 2e-3)] {
+            let gap = z * (sa + sb);
+            assert!(prune_bound(gap, sa, sb, 2) >= eps, "{eps} {sa} {sb}");
+        }
+    }
+    assert_eq!(kept_without_bound(0.0), f64::INFINITY);
+    assert_eq!(kept_without_bound(2.0), f64::NEG_INFINITY);
+    assert_eq!(kept_without_bound(f64::NAN), f64::NEG_INFINITY);
+}
+
+#[test]
+fn every_kept_leaf_pair_has_a_bound_of_at_least_epsilon() {
+    // Two noisy clouds a few deviations apart: many leaf pairs lie near the
+    // pruning threshold, on both sides of the shortcut's edge.
+    let a = lcg_points(3000, 11);
+    let b: Vec<Point3> = lcg_points(3000, 12)
+        .into_iter()
+        .map(|p| p + Vector3::new(1.02, 0.0, 0.0))
+        .collect();
+    let (sa, sb) = (vec![0.004; a.len()], vec![0.006; b.len()]);
+    let settings = BvhSettings { leaf_max_points: 8 };
+    let (ta, tb) = (
+        Bvh::build(&a, &sa, &settings).unwrap(),
+        Bvh::build(&b, &sb, &settings).unwrap(),
+    );
+    let mut ws = BvhWorkspace::default();
+    let eps = 1e-6;
+    let t = ta.traverse_pairs(&tb, &Pose::identity(), eps, &[], &[], &mut ws);
+    let z = kept_without_bound(eps);
+    let mut beyond = 0;
+    for &(la, lb) in &t.leaf_pairs {
+        let (na, nb) = (&ta.nodes()[la as usize], &tb.nodes()[lb as usize]);
+        let gap = na.aabb.distance(&nb.aabb);
+        let n = (na.count + nb.count) as usize;
+        assert!(prune_bound(gap, na.sigma_max, nb.sigma_max, n) >= eps);
+        beyond += usize::from(gap > z * (na.sigma_max + nb.sigma_max));
+    }
+    // Some kept pairs were decided by the bound itself, not the shortcut.
+    assert!(
+        beyond > 0 && t.leaf_pairs.len() > beyond,
+        "{beyond} of {}",
+        t.leaf_pairs.len()
+    );
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use crate::bvh::{BoxMotion, Bvh, BvhWorkspace};
 use crate::math::Pose;
-use crate::probability::normal_cdf;
+use crate::probability::{normal_cdf, normal_quantile};
 use crate::Real;
 
 /// What a pair traversal found.
@@ -36,6 +36,28 @@ pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
         return if gap > 0.0 { 0.0 } else { n };
     }
     n * normal_cdf(-gap / s)
+}
+
+/// A gap of at most this many times `sigma_a + sigma_b` gives a
+/// [`prune_bound`] of at least `epsilon` for any pair of nodes (at least two
+/// points): `-Phi^-1(epsilon / 2)`, lowered until the computed bound at it
+/// reaches `epsilon` (so that rounding cannot keep a pair the bound would
+/// prune); infinite for `epsilon = 0` (nothing is pruned), `-inf` where no
+/// gap is (`epsilon > 1`, NaN).
+pub(crate) fn kept_without_bound(epsilon: Real) -> Real {
+    let z = -normal_quantile(0.5 * epsilon);
+    if z.is_nan() || z < 0.0 {
+        return Real::NEG_INFINITY;
+    }
+    if z.is_infinite() {
+        return z;
+    }
+    // A margin far above rounding, then checked.
+    let mut z = z * (1.0 - 1e-7);
+    while z > 0.0 && 2.0 * normal_cdf(-z) < epsilon {
+        z *= 1.0 - 1e-7;
+    }
+    z
 }
 
 impl Bvh {
@@ -81,6 +103,7 @@ impl Bvh {
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
         let motion = BoxMotion::new(pose);
+        let keep_within = kept_without_bound(epsilon);
         out.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.pair_stack,
@@ -89,6 +112,11 @@ impl Bvh {
                 let gap = (na.aabb.moved(&motion).distance(&nb.aabb)
                     - margin(margin_self, ia).max(margin(margin_other, ib)))
                 .max(0.0);
+                // Close pairs are kept without the Gaussian tail (most pairs of
+                // an overlap); the bound decides the others.
+                if gap <= keep_within * (na.sigma_max + nb.sigma_max) {
+                    return true;
+                }
                 let bound = prune_bound(
                     gap,
                     na.sigma_max,
