@@ -83,6 +83,25 @@ def test_reconstruction_of_a_noisy_sphere_lies_on_it() -> None:
         assert np.array_equal(np.asarray(again.vertices), np.asarray(mesh.vertices))
 
 
+def test_reconstruction_asks_open3d_for_one_thread(monkeypatch: pytest.MonkeyPatch) -> None:
+    # On a one-core machine the repeats above cannot differ: the solver's
+    # thread count is what makes the surface reproducible.
+    o3d = pytest.importorskip("open3d")
+    solver = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson
+    calls: list[dict[str, object]] = []
+
+    def spy(pcd: object, **kwargs: object) -> object:
+        calls.append(kwargs)
+        return solver(pcd, **kwargs)
+
+    monkeypatch.setattr(o3d.geometry.TriangleMesh, "create_from_point_cloud_poisson", spy)
+    rng = np.random.default_rng(2)
+    v = rng.standard_normal((2000, 3))
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    reconstruct(0.5 * v, 0.04, 0.001)
+    assert len(calls) == 1 and calls[0].get("n_threads") == 1
+
+
 def test_tiles_partition_the_triangles() -> None:
     mesh = cp.Mesh.cylinder(0.3, 0.5, 64)
     parts = tiles(mesh, 0.1)

@@ -6,7 +6,9 @@ use crate::Real;
 
 impl Bvh {
     /// The `k` points nearest to `query`, as `(squared distance, point index)`
-    /// sorted by distance, written into `out` (cleared first). `points` must be the
+    /// sorted by distance and, where distances tie, by index (so ties at the
+    /// `k`-th distance go to the smaller index), written into `out` (cleared
+    /// first). `points` must be the
     /// positions the tree was built or refitted over.
     pub fn nearest_k(
         &self,
@@ -32,8 +34,11 @@ impl Bvh {
                 None => {
                     for &i in self.node_points(id) {
                         let d2 = (points[i as usize] - query).norm_squared();
-                        if out.len() < k || d2 < out[k - 1].0 {
-                            let pos = out.partition_point(|&(d, _)| d <= d2);
+                        // Ties at the k-th distance go to the smaller index
+                        // (as in the hashed grid's k-NN).
+                        let before = |&(d, j): &(Real, u32)| d < d2 || (d == d2 && j < i);
+                        if out.len() < k || !before(&out[k - 1]) {
+                            let pos = out.partition_point(before);
                             out.insert(pos, (d2, i));
                             out.truncate(k);
                         }
@@ -57,8 +62,8 @@ impl Bvh {
 
     /// Every point within `radius` of `query`, i.e. with `(p - query).norm() <=
     /// radius` (this exact test, so that a caller scanning all points with it
-    /// finds the same ones), as indices in the tree's order, appended to `out`
-    /// (cleared first). `points` must be the positions the tree was built or
+    /// finds the same ones), as indices in the tree's order, written into
+    /// `out` (cleared first). `points` must be the positions the tree was built or
     /// refitted over.
     pub fn within_radius(
         &self,

@@ -43,14 +43,20 @@ pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
 /// points): `-Phi^-1(epsilon / 2)`, lowered until the computed bound at it
 /// reaches `epsilon` (so that rounding cannot keep a pair the bound would
 /// prune); infinite for `epsilon = 0` (nothing is pruned), `-inf` where no
-/// gap is (`epsilon > 1`, NaN).
+/// gap is (`epsilon > 1`, NaN, negative) or where `epsilon / 2` is not
+/// representable (the smallest subnormal).
 pub(crate) fn kept_without_bound(epsilon: Real) -> Real {
     let z = -normal_quantile(0.5 * epsilon);
     if z.is_nan() || z < 0.0 {
         return Real::NEG_INFINITY;
     }
     if z.is_infinite() {
-        return z;
+        // `epsilon / 2` rounded to 0: only a zero epsilon prunes nothing.
+        return if epsilon <= 0.0 {
+            Real::INFINITY
+        } else {
+            Real::NEG_INFINITY
+        };
     }
     // A margin far above rounding, then checked.
     let mut z = z * (1.0 - 1e-7);
@@ -98,12 +104,34 @@ impl Bvh {
         margin_other: &[Real],
         workspace: &mut BvhWorkspace,
     ) -> PairTraversal {
+        let keep_within = kept_without_bound(epsilon);
+        self.traverse_pairs_keeping(
+            other,
+            pose,
+            epsilon,
+            (margin_self, margin_other),
+            keep_within,
+            workspace,
+        )
+    }
+
+    /// [`Bvh::traverse_pairs`] with node pairs closer than `keep_within`
+    /// times their deviations kept without the bound ([`kept_without_bound`];
+    /// `-inf`: every pair by the bound, the tests' reference).
+    pub(crate) fn traverse_pairs_keeping(
+        &self,
+        other: &Bvh,
+        pose: &Pose,
+        epsilon: Real,
+        (margin_self, margin_other): (&[Real], &[Real]),
+        keep_within: Real,
+        workspace: &mut BvhWorkspace,
+    ) -> PairTraversal {
         let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
         let mut out = PairTraversal::default();
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
         let motion = BoxMotion::new(pose);
-        let keep_within = kept_without_bound(epsilon);
         out.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.pair_stack,

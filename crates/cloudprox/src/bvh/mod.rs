@@ -49,13 +49,15 @@ pub const GRID_KNN_MIN_POINTS: usize = 4096;
 /// For every point of a non-empty, finite cloud (fewer than 2^32 points),
 /// `f(i, neighbours)` with the point itself and its `k` nearest *other* points
 /// (fewer in a cloud of at most `k` points) as `(squared distance, index)`,
-/// nearest first (ties by index from the grid, in the tree's order from the
-/// tree); in parallel, results in point order. The
+/// nearest first (ties by index, from the grid and the tree alike); in
+/// parallel, results in point order. The
 /// neighbours come from `bvh` (built over `points`) up to
 /// [`GRID_KNN_MIN_POINTS`] points and from the hashed grid above (exact as
-/// well, and much cheaper to build on large clouds): the same neighbours but
-/// where distances tie. The one k-NN pass over a whole cloud, for its sampling
-/// spacing and its discretization covariances.
+/// well, and much cheaper to build on large clouds): the same neighbours (but
+/// where more than `k + 1` points share a position). The
+/// k-NN pass over a whole cloud, for its sampling spacing and its
+/// discretization covariances (a query's searches over a patch are
+/// `PointSearch`'s).
 pub(crate) fn knn_of_every_point<T, F>(
     points: &[crate::math::Point3],
     bvh: &Bvh,

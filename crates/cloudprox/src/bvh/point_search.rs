@@ -1,56 +1,91 @@
-//! Neighbourhood queries over the points of one patch side: a hierarchy built
-//! for the query (or, as the tests' reference, a scan over every point).
+//! Neighbourhood queries over a set of points during a query (a patch side's
+//! points, a region's element means): a hierarchy built for the query above
+//! [`SEARCH_TREE_MIN`] points, a scan over every point below (and, in the
+//! tests, as the reference).
+//!
+//! Ties at the `k`-th distance go to the smaller index in both, as in the
+//! hashed grid's k-NN: a grid-sampled surface (a depth image, a lattice)
+//! gives many, and which of them is taken changes a neighbourhood.
+//!
+//! [`super::knn_of_every_point`] is the other k-NN of the crate: a whole
+//! cloud's, in parallel, when the cloud is prepared; this one runs inside one
+//! query, on one thread.
+
+use std::borrow::Cow;
+use std::cell::RefCell;
 
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::math::Point3;
 use crate::Real;
 
-/// Nearest-neighbour and radius queries over a slice of points.
+/// Above this many points a search builds a hierarchy.
+pub(crate) const SEARCH_TREE_MIN: usize = 32;
+
+/// Nearest-neighbour and radius queries over a set of points.
 pub(crate) struct PointSearch<'a> {
-    points: &'a [Point3],
-    tree: Option<(Bvh, BvhWorkspace)>,
+    points: Cow<'a, [Point3]>,
+    /// The hierarchy and its traversal's scratch space (queries take `&self`,
+    /// so that the points can be read while searching).
+    tree: Option<(Bvh, RefCell<BvhWorkspace>)>,
 }
 
 impl<'a> PointSearch<'a> {
-    /// A search over `points` by a hierarchy (`indexed`), else by scanning
-    /// every point (also where the hierarchy cannot be built: no points).
-    pub(crate) fn new(points: &'a [Point3], indexed: bool) -> Self {
-        let tree = indexed
-            .then(|| Bvh::build(points, &vec![0.0; points.len()], &BvhSettings::default()).ok())
-            .flatten()
-            .map(|t| (t, BvhWorkspace::default()));
+    /// A search over `points`: by a hierarchy above [`SEARCH_TREE_MIN`]
+    /// points, else by scanning them.
+    pub(crate) fn new(points: impl Into<Cow<'a, [Point3]>>) -> Self {
+        let points = points.into();
+        let tree = if points.len() > SEARCH_TREE_MIN {
+            Bvh::build(&points, &vec![0.0; points.len()], &BvhSettings::default())
+                .ok()
+                .map(|t| (t, RefCell::new(BvhWorkspace::default())))
+        } else {
+            None
+        };
         Self { points, tree }
     }
 
-    /// The points searched.
-    pub(crate) fn points(&self) -> &'a [Point3] {
-        self.points
+    /// A search that scans every point (the tests' reference).
+    #[cfg(test)]
+    pub(crate) fn scan(points: impl Into<Cow<'a, [Point3]>>) -> Self {
+        Self {
+            points: points.into(),
+            tree: None,
+        }
     }
 
-    /// The `k` nearest points of `x` (`1 <= k <=` their number) as `(squared
-    /// distance, index)`, nearest first, into `out`. Which of several points
-    /// at exactly the `k`-th distance is taken depends on the search.
-    pub(crate) fn nearest(&mut self, x: &Point3, k: usize, out: &mut Vec<(Real, u32)>) {
-        if let Some((tree, workspace)) = &mut self.tree {
-            tree.nearest_k(self.points, x, k, workspace, out);
+    /// The points searched.
+    pub(crate) fn points(&self) -> &[Point3] {
+        &self.points
+    }
+
+    /// The `k` nearest points of `x` (all of them if there are fewer) as
+    /// `(squared distance, index)`, nearest first, ties by index, into `out`.
+    pub(crate) fn nearest(&self, x: &Point3, k: usize, out: &mut Vec<(Real, u32)>) {
+        let k = k.min(self.points.len());
+        if let Some((tree, workspace)) = &self.tree {
+            tree.nearest_k(&self.points, x, k, &mut workspace.borrow_mut(), out);
             return;
         }
         out.clear();
+        if k == 0 {
+            return;
+        }
         out.extend(
             self.points
                 .iter()
                 .zip(0u32..)
                 .map(|(y, j)| ((y - x).norm_squared(), j)),
         );
-        out.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+        let order = |a: &(Real, u32), b: &(Real, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        out.select_nth_unstable_by(k - 1, order);
         out.truncate(k);
-        out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        out.sort_unstable_by(order);
     }
 
     /// The points with `(p - x).norm() <= r`, into `out`, in index order.
-    pub(crate) fn within(&mut self, x: &Point3, r: Real, out: &mut Vec<u32>) {
-        if let Some((tree, workspace)) = &mut self.tree {
-            tree.within_radius(self.points, x, r, workspace, out);
+    pub(crate) fn within(&self, x: &Point3, r: Real, out: &mut Vec<u32>) {
+        if let Some((tree, workspace)) = &self.tree {
+            tree.within_radius(&self.points, x, r, &mut workspace.borrow_mut(), out);
             out.sort_unstable();
             return;
         }
@@ -64,13 +99,15 @@ impl<'a> PointSearch<'a> {
         );
     }
 
-    /// Every point's neighbourhood among the searched points: the point and its
-    /// `k - 1` nearest others (fewer in a smaller set).
-    pub(crate) fn neighbourhoods(&mut self, k: usize) -> Neighbourhoods {
+    /// Every point's neighbourhood among the searched points: its `k` nearest
+    /// (fewer in a smaller set; the point itself among them unless more than
+    /// `k` points share its position), each in index order.
+    pub(crate) fn neighbourhoods(&self, k: usize) -> Neighbourhoods {
         let k = k.min(self.points.len());
-        let mut entries = Vec::with_capacity(k * self.points.len());
+        let n = self.points.len();
+        let mut entries = Vec::with_capacity(k * n);
         let mut one = Vec::with_capacity(k);
-        for x in self.points {
+        for x in self.points.iter() {
             self.nearest(x, k, &mut one);
             one.sort_unstable_by_key(|&(_, j)| j);
             entries.extend_from_slice(&one);
@@ -79,9 +116,9 @@ impl<'a> PointSearch<'a> {
     }
 }
 
-/// The `k` nearest points of every point of a set (the point itself among
-/// them), each point's in index order: sums over a neighbourhood add in the
-/// same order whichever search found it.
+/// The `k` nearest points of every point of a set, each point's in index
+/// order: sums over a neighbourhood add in the same order whichever search
+/// found it.
 pub(crate) struct Neighbourhoods {
     k: usize,
     entries: Vec<(Real, u32)>,
@@ -103,6 +140,29 @@ impl Neighbourhoods {
 mod tests {
     use super::*;
 
+    fn check(pts: &[Point3], radii: &[Real]) {
+        let (tree, scan) = (PointSearch::new(pts), PointSearch::scan(pts));
+        assert!(tree.tree.is_some() && scan.tree.is_none());
+        for k in [1, 7, 40] {
+            let (a, b) = (tree.neighbourhoods(k), scan.neighbourhoods(k));
+            for i in 0..pts.len() {
+                assert_eq!(a.of(i), b.of(i), "k {k}, point {i}");
+                assert!(a.of(i).iter().any(|&(d, j)| j as usize == i && d == 0.0));
+                assert!(a.of(i).windows(2).all(|w| w[0].1 < w[1].1));
+                assert_eq!(a.radius(i), b.radius(i));
+            }
+        }
+        let (mut x, mut y) = (Vec::new(), Vec::new());
+        for (i, p) in pts.iter().enumerate().step_by(13) {
+            for &r in radii {
+                tree.within(p, r, &mut x);
+                scan.within(p, r, &mut y);
+                assert_eq!(x, y);
+                assert!(x.contains(&(i as u32)));
+            }
+        }
+    }
+
     #[test]
     fn the_hierarchy_finds_what_a_scan_finds() {
         let mut seed = 5u64;
@@ -113,42 +173,47 @@ mod tests {
             ((seed >> 11) as Real) / ((1u64 << 53) as Real)
         };
         // A thin noisy sheet, denser at one end.
-        let pts: Vec<Point3> = (0..600)
+        let sheet: Vec<Point3> = (0..600)
             .map(|_| {
                 let u = uniform();
                 Point3::new(u * u, uniform(), 0.01 * uniform())
             })
             .collect();
-        let (mut tree, mut scan) = (PointSearch::new(&pts, true), PointSearch::new(&pts, false));
-        assert!(tree.tree.is_some() && scan.tree.is_none());
-        for k in [1, 7, 40] {
-            let (a, b) = (tree.neighbourhoods(k), scan.neighbourhoods(k));
-            for i in 0..pts.len() {
-                assert_eq!(a.of(i), b.of(i));
-                assert!(a.of(i).iter().any(|&(d, j)| j as usize == i && d == 0.0));
-                assert!(a.of(i).windows(2).all(|w| w[0].1 < w[1].1));
-                assert_eq!(a.radius(i), b.radius(i));
-            }
-        }
-        let (mut x, mut y) = (Vec::new(), Vec::new());
-        for (i, p) in pts.iter().enumerate().step_by(13) {
-            let r = 0.02 * (1 + i % 5) as Real;
-            tree.within(p, r, &mut x);
-            scan.within(p, r, &mut y);
-            assert_eq!(x, y);
-            assert!(x.contains(&(i as u32)));
-        }
-        // A set smaller than k: every point is in every neighbourhood.
-        let few = &pts[..3];
-        let n = PointSearch::new(few, true).neighbourhoods(7);
+        check(&sheet, &[0.02, 0.05, 0.1]);
+        // A lattice: every point has four neighbours at one spacing and four
+        // at the diagonal, so the 7 nearest are decided by the ties' indices;
+        // the radii fall on lattice distances.
+        let lattice: Vec<Point3> = (0..900)
+            .map(|i| Point3::new((i % 30) as Real * 0.01, (i / 30) as Real * 0.01, 0.0))
+            .collect();
+        check(&lattice, &[0.01, 0.02 * std::f64::consts::SQRT_2, 0.03]);
+    }
+
+    #[test]
+    fn small_and_empty_sets() {
+        let pts: Vec<Point3> = (0..5).map(|i| Point3::new(i as Real, 0.0, 0.0)).collect();
+        // Few points: a scan; fewer than k: every point in every neighbourhood.
+        let few = PointSearch::new(&pts[..3]);
+        assert!(few.tree.is_none());
+        let n = few.neighbourhoods(7);
         assert_eq!(
             n.of(2).iter().map(|e| e.1).collect::<Vec<_>>(),
             vec![0, 1, 2]
         );
-        // No points: no hierarchy, nothing found.
-        let mut none = PointSearch::new(&[], true);
-        assert!(none.tree.is_none());
-        none.within(&pts[0], 1.0, &mut x);
-        assert!(x.is_empty());
+        let mut out = vec![(1.0, 1)];
+        few.nearest(&pts[0], 0, &mut out);
+        assert!(out.is_empty());
+        // An owned set, as the element means are.
+        let owned = PointSearch::new(pts.clone());
+        owned.nearest(&Point3::new(2.6, 0.0, 0.0), 2, &mut out);
+        assert_eq!(out.iter().map(|e| e.1).collect::<Vec<_>>(), vec![3, 2]);
+        // No points: nothing found.
+        let none = PointSearch::new(&[][..]);
+        none.within(&pts[0], 1.0, &mut Vec::new());
+        let mut w = vec![3];
+        none.within(&pts[0], 1.0, &mut w);
+        assert!(w.is_empty());
+        none.nearest(&pts[0], 3, &mut out);
+        assert!(out.is_empty());
     }
 }

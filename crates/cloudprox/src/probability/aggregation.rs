@@ -2,6 +2,10 @@
 
 use crate::Real;
 
+/// A point's neighbourhood on its own surface: the point and its 6 nearest
+/// (the surface probability's and the crossing test's).
+pub(crate) const NEIGHBOURHOOD: usize = 7;
+
 /// How the per-point probabilities `p_i` become the pair's `P`.
 ///
 /// `Max`, `Union` and `Independent` (the paper's) are driven by the noisiest
@@ -93,10 +97,6 @@ mod tests {
         }
     }
 }
-
-/// A point's neighbourhood on its own surface: the point and its 6 nearest
-/// (the surface probability's and the crossing test's).
-pub(crate) const NEIGHBOURHOOD: usize = 7;
 
 /// The probability that the surface around a point lies on the wrong side, from
 /// the margins `c_j f(x_j)` and standard deviations `s_j` along the gradient of

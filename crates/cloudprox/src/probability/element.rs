@@ -1,6 +1,6 @@
 //! The probability that the fitted surfaces of two clouds' elements cross.
 
-use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
+use crate::bvh::PointSearch;
 use crate::classify::Separator;
 use crate::element::{across_normal, hull_gap, Hull, SurfaceElement, HALF_SPACING};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
@@ -216,49 +216,6 @@ struct Across {
     lateral: Real,
 }
 
-/// The other side's elements nearest to a probe by mean: a hierarchy over the
-/// means when there are many (a patch holds hundreds of elements, each with 25
-/// probes), every mean otherwise.
-struct Candidates {
-    means: Vec<Point3>,
-    tree: Option<Bvh>,
-}
-
-/// Above this many elements the candidates come from a hierarchy over the means.
-const CANDIDATE_TREE_MIN: usize = 32;
-
-impl Candidates {
-    fn new(means: Vec<Point3>) -> Self {
-        let tree = if means.len() > CANDIDATE_TREE_MIN {
-            Bvh::build(&means, &vec![0.0; means.len()], &BvhSettings::default()).ok()
-        } else {
-            None
-        };
-        Self { means, tree }
-    }
-
-    /// The [`FACING_CANDIDATES`] means nearest to `x`, as `(squared distance,
-    /// index)`, into `out`.
-    fn nearest(&self, x: &Point3, ws: &mut BvhWorkspace, out: &mut Vec<(Real, u32)>) {
-        let c = FACING_CANDIDATES.min(self.means.len());
-        if let Some(tree) = &self.tree {
-            tree.nearest_k(&self.means, x, c, ws, out);
-            return;
-        }
-        out.clear();
-        out.extend(
-            self.means
-                .iter()
-                .enumerate()
-                .map(|(j, m)| ((m - x).norm_squared(), j as u32)),
-        );
-        if c > 0 {
-            out.select_nth_unstable_by(c - 1, |a, b| a.0.total_cmp(&b.0));
-        }
-        out.truncate(c);
-    }
-}
-
 /// Calls `visit` on the facing pair of each of `own`'s probes that has one (see
 /// [`element_crossing_probabilities`]), for the elements marked `active`, until
 /// `visit` returns `false`; returns whether every pair was visited.
@@ -268,16 +225,17 @@ fn for_each_facing(
     active: &[bool],
     mut visit: impl FnMut(&Facing) -> bool,
 ) -> bool {
-    let candidates = Candidates::new(other.iter().map(|o| o.mean).collect());
-    let mut nearest: Vec<(Real, u32)> = Vec::with_capacity(other.len());
-    let mut ws = BvhWorkspace::default();
+    // The other side's elements nearest to a probe by mean (a patch holds
+    // hundreds of elements, each with 25 probes).
+    let candidates = PointSearch::new(other.iter().map(|o| o.mean).collect::<Vec<_>>());
+    let mut nearest: Vec<(Real, u32)> = Vec::with_capacity(FACING_CANDIDATES);
     for (k, p) in own.iter().enumerate() {
         if !active[k] {
             continue;
         }
         for &[u, v] in &p.e.probes {
             let (x, var_x) = p.probe(u, v);
-            candidates.nearest(&x, &mut ws, &mut nearest);
+            candidates.nearest(&x, FACING_CANDIDATES, &mut nearest);
             let mut best: Option<Facing> = None;
             for &(_, j) in &nearest {
                 let j = j as usize;
@@ -681,19 +639,13 @@ mod tests {
             )
         };
         let means: Vec<Point3> = (0..500).map(mean).collect();
-        let tree = Candidates::new(means.clone());
-        assert!(tree.tree.is_some());
-        let brute = Candidates {
-            means: means.clone(),
-            tree: None,
-        };
-        let mut ws = BvhWorkspace::default();
+        let tree = PointSearch::new(means.clone());
+        let brute = PointSearch::scan(means);
         let (mut a, mut b) = (Vec::new(), Vec::new());
         for q in 0..50 {
             let x = Point3::new(q as Real * 0.031 - 0.2, 0.5, q as Real * 0.007);
-            tree.nearest(&x, &mut ws, &mut a);
-            brute.nearest(&x, &mut ws, &mut b);
-            b.sort_by(|p, q| p.0.total_cmp(&q.0));
+            tree.nearest(&x, FACING_CANDIDATES, &mut a);
+            brute.nearest(&x, FACING_CANDIDATES, &mut b);
             assert_eq!(a.len(), FACING_CANDIDATES);
             assert_eq!(a, b, "query {q}");
         }

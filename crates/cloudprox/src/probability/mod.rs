@@ -19,7 +19,7 @@ mod state;
 pub(crate) use aggregation::NEIGHBOURHOOD;
 pub use aggregation::{surface_probability, Aggregation};
 pub use crossing::crossing_probabilities;
-pub(crate) use crossing::crossing_probabilities_in;
+pub(crate) use crossing::{crossing_probabilities_in, CrossingSide};
 pub(crate) use element::{
     element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
     elements_within_reach, ElementSide,

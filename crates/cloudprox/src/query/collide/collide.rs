@@ -22,6 +22,7 @@ use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactPatch, PointAggregates, PointProbabilities,
     QueryModel, QueryStats,
 };
+use crate::uncertainty::max_std;
 use crate::Real;
 
 /// The probabilistic collision query between cloud `a` at world pose `pose_a` and
@@ -276,11 +277,14 @@ pub(crate) fn collide_with_workspace(
             let (qa, qb) = match (crossings, request.aggregation) {
                 (Some((qa, qb, _)), _) => (qa, qb),
                 (None, Aggregation::Surface) if elements.is_none() => {
-                    let (mut search_a, mut search_b) =
-                        (PointSearch::new(own_a, true), PointSearch::new(own_b, true));
+                    let (search_a, search_b) = (PointSearch::new(own_a), PointSearch::new(own_b));
+                    let std = |c: &[Matrix3]| c.iter().map(max_std).collect::<Vec<Real>>();
+                    let (std_a, std_b) = (std(cov_a), std(cov_b));
+                    let side_a = (&search_a, cov_a, &std_a[..]);
+                    let side_b = (&search_b, cov_b, &std_b[..]);
                     (
-                        surface_side(sep, &mut search_a, cov_a, &mut search_b, cov_b, 1.0),
-                        surface_side(sep, &mut search_b, cov_b, &mut search_a, cov_a, -1.0),
+                        surface_side(sep, side_a, side_b, 1.0),
+                        surface_side(sep, side_b, side_a, -1.0),
                     )
                 }
                 (None, _) => (

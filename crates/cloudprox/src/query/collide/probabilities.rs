@@ -2,12 +2,12 @@
 //! its trained surface, the paper model's surface probability, and which
 //! values count towards the pair's `P` (core points only).
 
-use crate::bvh::{Neighbourhoods, PointSearch};
+use crate::bvh::Neighbourhoods;
 use crate::classify::Separator;
 use crate::element::SurfaceElements;
 use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{
-    crossing_probabilities_in, point_probability, surface_probability, NEIGHBOURHOOD,
+    crossing_probabilities_in, point_probability, surface_probability, CrossingSide, NEIGHBOURHOOD,
 };
 use crate::uncertainty::directional_std_of;
 use crate::Real;
@@ -88,20 +88,19 @@ fn surface_probabilities(
 }
 
 /// The points model's `surface` inputs of one side of a patch (`own`, label
-/// `label`, against `other`; both in the separator's frame): for each point,
+/// `label`, against `other`; each its search, covariances and largest
+/// deviations, in the separator's frame): for each point,
 /// the larger of its surface probability against `sep` and the probability
 /// that its surface crosses the other's there ([`crossing_probabilities_in`]).
 /// Each point's neighbourhood is found once for both.
 pub(crate) fn surface_side(
     sep: &Separator,
-    own: &mut PointSearch<'_>,
-    own_cov: &[Matrix3],
-    other: &mut PointSearch<'_>,
-    other_cov: &[Matrix3],
+    own: CrossingSide<'_, '_>,
+    other: CrossingSide<'_, '_>,
     label: Real,
 ) -> Vec<Real> {
-    let near = own.neighbourhoods(NEIGHBOURHOOD);
-    let q = surface_probabilities(sep, own.points(), own_cov, label, &near);
-    let c = crossing_probabilities_in(own, own_cov, &near, other, other_cov);
+    let near = own.0.neighbourhoods(NEIGHBOURHOOD);
+    let q = surface_probabilities(sep, own.0.points(), own.1, label, &near);
+    let c = crossing_probabilities_in(own, &near, other);
     q.into_iter().zip(c).map(|(q, c)| q.max(c)).collect()
 }

@@ -285,8 +285,8 @@ fn near_points_in_blocks(
     let mut near_b = vec![false; b.len()];
     // Per block, its points not yet found near: a pair of two blocks whose
     // points are all near can change nothing (deep in an overlap, most pairs).
-    let mut left_a: Vec<usize> = read_a.bounds.iter().map(|b| b.run.len()).collect();
-    let mut left_b: Vec<usize> = read_b.bounds.iter().map(|b| b.run.len()).collect();
+    let mut left_a: Vec<usize> = read_a.bounds.iter().map(|bound| bound.run.len()).collect();
+    let mut left_b: Vec<usize> = read_b.bounds.iter().map(|bound| bound.run.len()).collect();
     let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
     for &(ka, kb) in pairs {
         let (la, lb) = (&mut left_a[ka as usize], &mut left_b[kb as usize]);
