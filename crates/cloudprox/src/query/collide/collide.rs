@@ -22,7 +22,6 @@ use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactPatch, PointAggregates, PointProbabilities,
     QueryModel, QueryStats,
 };
-use crate::uncertainty::max_std;
 use crate::Real;
 
 /// The probabilistic collision query between cloud `a` at world pose `pose_a` and
@@ -278,8 +277,12 @@ pub(crate) fn collide_with_workspace(
                 (Some((qa, qb, _)), _) => (qa, qb),
                 (None, Aggregation::Surface) if elements.is_none() => {
                     let (search_a, search_b) = (PointSearch::new(own_a), PointSearch::new(own_b));
-                    let std = |c: &[Matrix3]| c.iter().map(max_std).collect::<Vec<Real>>();
-                    let (std_a, std_b) = (std(cov_a), std(cov_b));
+                    // Each point's largest deviation, kept by its cloud (a
+                    // rotation does not change it).
+                    let std = |idx: &[u32], cloud: &PointCloud| -> Vec<Real> {
+                        idx.iter().map(|&i| cloud.sigma_max()[i as usize]).collect()
+                    };
+                    let (std_a, std_b) = (std(&ia, sa), std(&ib, sb));
                     let side_a = (&search_a, cov_a, &std_a[..]);
                     let side_b = (&search_b, cov_b, &std_b[..]);
                     (
