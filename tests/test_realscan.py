@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+
 import numpy as np
 import pytest
 
@@ -13,7 +16,7 @@ from cloudprox.reproduce.realscan import (
     kinect_covariances,
     sample_scan_poses,
 )
-from cloudprox.reproduce.reconstruct import reconstruct, surface_shape, tiles
+from cloudprox.reproduce.reconstruct import reconstruct, reconstruct_many, surface_shape, tiles
 
 
 def test_kinect_noise_follows_nguyen_et_al() -> None:
@@ -100,6 +103,30 @@ def test_reconstruction_asks_open3d_for_one_thread(monkeypatch: pytest.MonkeyPat
     v /= np.linalg.norm(v, axis=1, keepdims=True)
     reconstruct(0.5 * v, 0.04, 0.001)
     assert len(calls) == 1 and calls[0].get("n_threads") == 1
+
+
+def test_reconstructions_in_a_process_pool_are_those_of_one_by_one() -> None:
+    # The reproduction reconstructs a level's clouds at once, one per process:
+    # the surfaces (its baseline's answers) must not depend on it.
+    pytest.importorskip("open3d")
+    rng = np.random.default_rng(3)
+    clouds = []
+    for k, radius in enumerate((0.5, 0.3, 0.4)):
+        v = rng.standard_normal((1500, 3))
+        v /= np.linalg.norm(v, axis=1, keepdims=True)
+        origin = None if k < 2 else (0.0, 0.0, 3.0)
+        clouds.append((radius * v + 0.001 * rng.standard_normal((1500, 3)), 0.05, 0.001, origin))
+    alone = reconstruct_many(clouds)
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(2, mp_context=ctx) as pool:
+        pooled = reconstruct_many(clouds, pool)
+        with pytest.raises(ValueError, match="at least 10 points"):
+            reconstruct_many([clouds[0], (clouds[1][0][:5], 0.05, 0.001, None)], pool)
+    assert len(pooled) == 3
+    for a, b in zip(alone, pooled, strict=True):
+        assert len(a.faces) > 100
+        assert np.array_equal(np.asarray(a.faces), np.asarray(b.faces))
+        assert np.array_equal(np.asarray(a.vertices), np.asarray(b.vertices))
 
 
 def test_tiles_partition_the_triangles() -> None:

@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 
 from cloudprox.cli import main
-from cloudprox.reproduce.methods import Draw, nn_gap_answer, sampling_spacing, states_from
+from cloudprox.reproduce.methods import (
+    Draw,
+    PointClusters,
+    collision_map_answer,
+    nn_gap_answer,
+    sampling_spacing,
+    sphere_union_answer,
+    states_from,
+)
 from cloudprox.reproduce.metrics import auc, compute_metrics, roc_curve
 from cloudprox.reproduce.noise import NoiseModel
 from cloudprox.reproduce.poses import sample_poses
@@ -121,6 +129,71 @@ def test_nn_gap_equals_the_score_over_every_nearest_neighbour() -> None:
     b2 = np.array([[0.0, 0.0, 0.5], [10.0, 0.0, 0.7]])
     two = nn_gap_answer(Draw(a2, cov(std), b2, cov(std)), np.eye(4)[None]).score[0]
     assert two == pytest.approx(float(ndtr(2.0 - 0.7 / np.sqrt(0.02))), rel=1e-12)
+
+
+def test_the_baselines_clusters_keep_every_near_point_and_the_same_answers() -> None:
+    """Querying only the clusters' near points changes no baseline's answer."""
+    from scipy.spatial import cKDTree
+    from scipy.spatial.transform import Rotation
+
+    from cloudprox.reproduce.methods import _world
+
+    rng = np.random.default_rng(5)
+    # A box-like "piano" (1 m) over a floor and a wall, points on its faces.
+    u = rng.random((3000, 3))
+    face = rng.integers(0, 3, 3000)
+    u[np.arange(3000), face] = rng.integers(0, 2, 3000)
+    a = u * [1.0, 0.6, 1.2] - [0.5, 0.3, 0.0]
+    floor = np.column_stack([rng.uniform(-2, 2, 4000), rng.uniform(-2, 2, 4000), np.zeros(4000)])
+    wall = np.column_stack([np.full(1500, 0.8), rng.uniform(-2, 2, 1500), rng.uniform(0, 2, 1500)])
+    b = np.vstack([floor, wall]) + 0.002 * rng.standard_normal((5500, 3))
+    std_a, std_b = np.full(3000, 0.003), np.full(5500, 0.003)
+    cov = lambda s: s[:, None, None] ** 2 * np.eye(3)  # noqa: E731
+    draw = Draw(a, cov(std_a), b, cov(std_b))
+    cl = draw.piano_clusters()
+    # Every point in its cluster's ball; clusters over the whole cloud.
+    assert np.all(np.linalg.norm(a - cl.centres[cl.label], axis=1) <= cl.radius[cl.label] + 1e-15)
+    assert 20 < len(cl.centres) <= 8**3 and np.array_equal(
+        np.unique(cl.label), np.arange(len(cl.centres))
+    )
+    poses = np.repeat(np.eye(4)[None], 40, axis=0)
+    poses[:, :3, :3] = Rotation.random(40, random_state=1).as_matrix()
+    poses[:20, :3, :3] = np.eye(3)  # upright, on or near the floor
+    poses[:, :3, 3] = np.column_stack(
+        [rng.uniform(-0.3, 0.3, 40), rng.uniform(-0.3, 0.3, 40), rng.uniform(-0.05, 0.6, 40)]
+    )
+    tree = cKDTree(b)
+    spacing = 0.02
+    kept = []
+    for pose in poses:
+        x = _world(a, pose)
+        for reach, norm in ((0.012, 2.0), (spacing, np.inf), (0.1, 2.0)):
+            d, _ = tree.query(x, p=norm, distance_upper_bound=reach)
+            near = draw.near_piano_points(pose, reach, norm)
+            assert set(np.flatnonzero(d < reach)) <= set(near.tolist())
+            assert np.all(np.diff(near) > 0)
+            kept.append(len(near) / len(a))
+    # The filter does filter (upright poses: the bottom face and the wall side).
+    assert np.median(kept) < 0.5
+    # The same answers as querying every point.
+    for answer, reach, norm in (
+        (collision_map_answer(draw, poses, spacing), spacing, np.inf),
+        (sphere_union_answer(draw, poses, spacing / np.sqrt(2.0)), spacing * np.sqrt(2.0), 2.0),
+    ):
+        for pose, score in zip(poses, answer.score, strict=True):
+            d, _ = tree.query(_world(a, pose), p=norm, distance_upper_bound=reach)
+            assert score == float(np.any(d < reach))
+    assert 0 < collision_map_answer(draw, poses, spacing).score.sum() < 40
+    got = nn_gap_answer(draw, poses).score
+    from scipy.special import ndtr
+
+    for pose, score in zip(poses, got, strict=True):
+        d, j = tree.query(_world(a, pose))
+        s = np.sqrt(std_a**2 + std_b[j] ** 2)
+        assert score == pytest.approx(float(ndtr(np.max(-(d - 2.0 * s) / s))), rel=1e-12, abs=0)
+    # One point, and every point on one spot: one cluster of radius 0.
+    one = PointClusters.of(np.zeros((5, 3)))
+    assert len(one.centres) == 1 and one.radius[0] == 0.0
 
 
 def test_one_points_query_answers_the_papers_three_aggregations() -> None:

@@ -50,7 +50,7 @@ from cloudprox._native import (
     exact_proximity,
     exact_proximity_many,
 )
-from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
+from cloudprox.reproduce.reconstruct import reconstruct_many, surface_shape
 
 __all__ = [
     "AGGREGATIONS",
@@ -58,6 +58,7 @@ __all__ = [
     "POINT_BASELINES",
     "Draw",
     "MethodAnswer",
+    "PointClusters",
     "cloudprox_answer",
     "cloudprox_answers",
     "collision_map_answer",
@@ -84,6 +85,8 @@ TIMED_QUERIES = 30
 #: Share of the poses whose queries :func:`timed_subset` times (one in this
 #: many), and the fewest it times (all of fewer poses).
 TIMED_SHARE, TIMED_LEAST = 8, 200
+#: Cells of :class:`PointClusters` along a cloud's longest side.
+CLUSTER_CELLS = 8
 #: The baselines on the points themselves (:func:`point_baseline_answers`).
 POINT_BASELINES = ("nn-gap", "collision-map", "spheres")
 #: The points model's aggregations: the surface one and the paper's three.
@@ -118,6 +121,46 @@ def states_from(p: FloatArray) -> npt.NDArray[np.str_]:
     return np.where(
         p >= THRESHOLD_COLLISION, "collision", np.where(p <= THRESHOLD_FREE, "free", "contact")
     )
+
+
+@dataclass(frozen=True)
+class PointClusters:
+    """Points grouped into the cubes of a grid, each with its centre and radius.
+
+    A point ``p`` of a cluster (centre ``c``, radius ``rho``: the largest
+    Euclidean distance of its points to ``c``) within ``reach`` of a point ``q``
+    has ``|c - q| <= rho + reach`` (the triangle inequality; in the max norm too,
+    which is at most the Euclidean). So the clusters whose centres have no room
+    point within that hold no point within ``reach``, and the point baselines
+    query only the points of the others: the same answers, in a fraction of the
+    time where a small part of the piano is near the room. The grid has
+    :data:`CLUSTER_CELLS` cells along the cloud's longest side (rigid motions
+    change no distance, so the clusters are made once per cloud).
+    """
+
+    centres: FloatArray
+    radius: FloatArray
+    #: Cluster of each point.
+    label: npt.NDArray[np.intp]
+
+    @classmethod
+    def of(cls, points: FloatArray) -> PointClusters:
+        """Cluster ``points`` (shape ``(n, 3)``, at least one)."""
+        lo = points.min(axis=0)
+        extent = float(np.max(points.max(axis=0) - lo))
+        cell = extent / CLUSTER_CELLS if extent > 0.0 else 1.0
+        keys = np.floor((points - lo) / cell).astype(np.int64)
+        _, label = np.unique(keys, axis=0, return_inverse=True)
+        label = label.ravel()
+        k = int(label.max()) + 1
+        counts = np.bincount(label, minlength=k).astype(float)
+        centres = np.stack(
+            [np.bincount(label, weights=points[:, i], minlength=k) for i in range(3)], axis=1
+        )
+        centres /= counts[:, None]
+        radius = np.zeros(k)
+        np.maximum.at(radius, label, np.linalg.norm(points - centres[label], axis=1))
+        return cls(centres, radius, label)
 
 
 @dataclass
@@ -162,6 +205,30 @@ class Draw:
             self._cache["tree"] = cKDTree(self.room_points)
         return self._cache["tree"]  # type: ignore[return-value]
 
+    def piano_clusters(self) -> PointClusters:
+        """Return the piano's points grouped into cubes (own frame; :class:`PointClusters`)."""
+        if "clusters" not in self._cache:
+            self._cache["clusters"] = PointClusters.of(self.piano_points)
+        return self._cache["clusters"]  # type: ignore[return-value]
+
+    def near_piano_points(
+        self, pose: FloatArray, reach: float, norm: float = 2.0
+    ) -> npt.NDArray[np.intp]:
+        """Return the piano points (indices, ascending) that may have a room point in ``reach``.
+
+        Every piano point with a room point closer than ``reach`` (``norm``-distance,
+        2 or infinity) at ``pose`` is among them: exact, not an approximation
+        (see :class:`PointClusters`).
+        """
+        if not np.isfinite(reach):
+            return np.arange(len(self.piano_points))
+        cl = self.piano_clusters()
+        bound = (reach + cl.radius) * (1.0 + 1e-9) + 1e-12
+        d, _ = self.room_tree().query(
+            _world(cl.centres, pose), p=norm, distance_upper_bound=float(bound.max())
+        )
+        return np.flatnonzero((d <= bound)[cl.label])
+
     def sensor_std(self) -> tuple[FloatArray, FloatArray]:
         """Largest sensor standard deviation per point, piano and room (core: ``sigma_max``)."""
         if "std" not in self._cache:
@@ -173,6 +240,22 @@ class Draw:
                 )
             )
         return self._cache["std"]  # type: ignore[return-value]
+
+
+def reconstruct_draws(
+    draws: list[Draw], spacing: float, sigma: float, pool: Executor | None = None
+) -> None:
+    """Reconstruct both clouds of every draw not yet reconstructed (kept in its cache).
+
+    With ``pool`` (a process pool), all of them at once: each reconstruction runs on
+    one thread, so the surfaces are those of one by one
+    (:func:`cloudprox.reproduce.reconstruct.reconstruct_many`).
+    """
+    todo = [d for d in draws if "meshes" not in d._cache]
+    clouds = [(p, spacing, sigma, None) for d in todo for p in (d.piano_points, d.room_points)]
+    meshes = reconstruct_many(clouds, pool)
+    for k, d in enumerate(todo):
+        d._cache["meshes"] = (surface_shape(meshes[2 * k]), surface_shape(meshes[2 * k + 1]))
 
 
 def reconstruct_answer(
@@ -191,11 +274,7 @@ def reconstruct_answer(
     that median).
     """
     if shapes is None:
-        if "meshes" not in draw._cache:
-            draw._cache["meshes"] = tuple(
-                surface_shape(reconstruct(p, spacing, sigma))
-                for p in (draw.piano_points, draw.room_points)
-            )
+        reconstruct_draws([draw], spacing, sigma)
         shapes = draw._cache["meshes"]  # type: ignore[assignment]
     piano, room = shapes
     r = exact_proximity_many(piano, room, poses)
@@ -381,7 +460,8 @@ def nn_gap_answer(draw: Draw, poses: FloatArray) -> MethodAnswer:
     largest ``s_i`` can be). A point without one there has ``(2 s_i - d_i) /
     s_i < 2 - R / s_max``, so once a found point reaches that, the maximum is
     among the found ones; else ``R`` doubles. (A full search per pose took
-    120-175 ms at 10 000 points; this one 5-27 ms, the same scores.)
+    120-175 ms at 10 000 points; this one 5-27 ms, the same scores.) Each search
+    reads only the points :meth:`Draw.near_piano_points` keeps for its reach.
     """
     tree = draw.room_tree()
     std_a, std_b = draw.sensor_std()
@@ -389,14 +469,15 @@ def nn_gap_answer(draw: Draw, poses: FloatArray) -> MethodAnswer:
     scores, seconds = np.empty(len(poses)), np.empty(len(poses))
     for i, pose in enumerate(poses):
         t0 = time.perf_counter()
-        x = _world(draw.piano_points, pose)
         # (Without noise, every neighbour at once.)
         reach = 4.0 * s_max if s_max > 0.0 else np.inf
         while True:
-            d, j = tree.query(x, distance_upper_bound=reach)
+            # Only the points that may have a neighbour within the reach.
+            near = draw.near_piano_points(pose, reach)
+            d, j = tree.query(_world(draw.piano_points[near], pose), distance_upper_bound=reach)
             found = np.isfinite(d)
             if found.any():
-                s = np.sqrt(std_a[found] ** 2 + std_b[j[found]] ** 2)
+                s = np.sqrt(std_a[near[found]] ** 2 + std_b[j[found]] ** 2)
                 best = float(np.max(2.0 - d[found] / s))
                 if reach == np.inf or best >= 2.0 - reach / s_max:
                     break
@@ -412,7 +493,9 @@ def _overlap_answer(draw: Draw, poses: FloatArray, reach: float, norm: float) ->
     hit, seconds = np.empty(len(poses), dtype=bool), np.empty(len(poses))
     for i, pose in enumerate(poses):
         t0 = time.perf_counter()
-        d, _ = tree.query(_world(draw.piano_points, pose), p=norm, distance_upper_bound=reach)
+        near = draw.near_piano_points(pose, reach, norm)
+        x = _world(draw.piano_points[near], pose)
+        d, _ = tree.query(x, p=norm, distance_upper_bound=reach)
         hit[i] = bool(np.any(d < reach))
         seconds[i] = time.perf_counter() - t0
     return MethodAnswer(hit.astype(float), np.where(hit, "collision", "free"), seconds)

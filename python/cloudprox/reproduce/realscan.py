@@ -70,7 +70,7 @@ from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.metrics import Metrics, compute_metrics
 from cloudprox.reproduce.poses import draw_target_units
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
-from cloudprox.reproduce.reconstruct import reconstruct, surface_shape
+from cloudprox.reproduce.reconstruct import reconstruct, reconstruct_many, surface_shape
 
 __all__ = [
     "GRIPPER_SIGMA",
@@ -351,13 +351,16 @@ def run_scan(
     answers = m.variant_answers(draws, q.poses, variants, many, tick, "kinect")
     answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
     if reconstruction_available():
-        answers["reconstruct"] = []
-        for d in draws:
-            scan_sigma = float(np.median(kinect_axial_sigma(d.room_points[:, 2])))
-            scan = surface_shape(reconstruct(d.room_points, spacing, scan_sigma, frame.origin))
-            answers["reconstruct"].append(
-                m.reconstruct_answer(d, q.poses, spacing, scan_sigma, shapes=(gripper, scan))
-            )
+        # Each draw's scan on its own (the gripper is its own mesh), both at once.
+        sig = [float(np.median(kinect_axial_sigma(d.room_points[:, 2]))) for d in draws]
+        scans = reconstruct_many(
+            [(d.room_points, spacing, s, frame.origin) for d, s in zip(draws, sig, strict=True)],
+            pool,
+        )
+        answers["reconstruct"] = [
+            m.reconstruct_answer(d, q.poses, spacing, s, shapes=(gripper, surface_shape(mesh)))
+            for d, s, mesh in zip(draws, sig, scans, strict=True)
+        ]
     tick("kinect: baselines", 1)
     unit_distance = q.signed_distance / q.sigma
     out = ScanResult({}, q, {}, {}, {}, {}, draws[0].room_points, g_pts)

@@ -382,6 +382,7 @@ def _run(
         answers = m.variant_answers(draws, q.poses, VARIANTS, many, tick, name)
         answers.update(m.point_baseline_answers(draws, q.poses, spacing, pool, workers))
         if with_reconstruction:
+            m.reconstruct_draws(draws, spacing, sigma, pool)
             answers[RECON] = [m.reconstruct_answer(d, q.poses, spacing, sigma) for d in draws]
         tick(f"{name}: baselines", 1)
         scores: dict[str, np.ndarray] = {}
