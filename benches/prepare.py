@@ -31,8 +31,7 @@ import numpy as np
 import cloudprox as cp
 from cloudprox.datasets import load_kinect_frame
 from cloudprox.reproduce.realscan import STRIDE, kinect_camera
-from cloudprox.reproduce.run import Config, level_inputs
-from cloudprox.scenes import piano, room
+from cloudprox.reproduce.run import Config, level_inputs, sample_scene
 
 FAR = cp.pose.from_translation((1e3, 0.0, 0.0))
 
@@ -40,12 +39,10 @@ FAR = cp.pose.from_translation((1e3, 0.0, 0.0))
 def clouds() -> list[tuple[str, Callable[[], cp.PointCloud]]]:
     """Each test cloud by name, as a function making it anew."""
     config = Config(poses=1, scan_poses=0)
-    p_obj, r_obj = piano(), room()
-    density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
-    pts = (p_obj.sample(density, config.seed)[0], r_obj.sample(density, config.seed + 1)[0])
+    scene = sample_scene(config)
     out: list[tuple[str, Callable[[], cp.PointCloud]]] = []
     for k, name in ((0, "room, 0.5%"), (2, "room, 2%")):
-        d = level_inputs(config, k, (p_obj, r_obj), pts, 1)[2][0]
+        d = level_inputs(config, k, scene, 1)[2][0]
         room_points, room_cov = d.room_points, d.room_sensor_cov
         out.append(
             (

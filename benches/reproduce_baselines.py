@@ -21,8 +21,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from cloudprox.reproduce import methods as m
-from cloudprox.reproduce.run import Config, config_levels, level_inputs, level_name
-from cloudprox.scenes import piano, room
+from cloudprox.reproduce.run import Config, config_levels, level_inputs, level_name, sample_scene
 
 
 def main() -> None:
@@ -32,13 +31,10 @@ def main() -> None:
     k, out = int(sys.argv[1]), sys.argv[2]
     config = Config()
     n = int(sys.argv[3]) if len(sys.argv) > 3 else config.poses
-    p_obj, r_obj = piano(), room()
-    density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
-    piano_pts, _ = p_obj.sample(density, config.seed)
-    room_pts, _ = r_obj.sample(density, config.seed + 1)
-    spacing = m.sampling_spacing(np.concatenate([piano_pts, room_pts]))
+    scene = sample_scene(config)
+    spacing = scene.spacing
     share, aniso = config_levels(config)[k]
-    sigma, q, draws = level_inputs(config, k, (p_obj, r_obj), (piano_pts, room_pts), n)
+    sigma, q, draws = level_inputs(config, k, scene, n)
     with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
         list(pool.map(int, [0, 0]))  # workers started before the clock
         t = time.perf_counter()

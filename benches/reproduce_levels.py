@@ -24,8 +24,7 @@ import numpy as np
 
 from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.metrics import compute_metrics
-from cloudprox.reproduce.run import Config, config_levels, level_inputs, level_name
-from cloudprox.scenes import piano, room
+from cloudprox.reproduce.run import Config, config_levels, level_inputs, level_name, sample_scene
 
 
 def main() -> None:
@@ -70,14 +69,11 @@ def main() -> None:
     variant = (parts[0], parts[1], parts[2])
     if args.poses < 1:
         ap.error(f"--poses must be >= 1, got {args.poses}")
-    p_obj, r_obj = piano(), room()
-    density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
-    piano_pts, _ = p_obj.sample(density, config.seed)
-    room_pts, _ = r_obj.sample(density, config.seed + 1)
+    scene = sample_scene(config)
     for k, name in enumerate(names):
         if name not in asked:
             continue
-        sigma, q, draws = level_inputs(config, k, (p_obj, r_obj), (piano_pts, room_pts), args.poses)
+        sigma, q, draws = level_inputs(config, k, scene, args.poses)
         t0 = time.perf_counter()
         answers = m.variant_answers(draws, q.poses, (variant,), None, lambda *_: None, name)
         ans = answers[m.variant_name(*variant)]

@@ -37,11 +37,12 @@ from cloudprox.reproduce.noise import NoiseModel
 from cloudprox.reproduce.poses import QueryPoses, sample_poses
 from cloudprox.reproduce.realscan import SCAN_STEPS, run_scan
 from cloudprox.reproduce.reconstruct import available as reconstruction_available
-from cloudprox.scenes import piano, room
+from cloudprox.scenes import SceneObject, piano, room
 
 __all__ = [
     "Claim",
     "Config",
+    "Scene",
     "Summary",
     "available_cpus",
     "check_claims",
@@ -49,6 +50,7 @@ __all__ = [
     "level_inputs",
     "level_name",
     "run",
+    "sample_scene",
 ]
 
 #: The method whose claims are checked, and the baselines.
@@ -154,23 +156,50 @@ def config_levels(config: Config) -> list[tuple[float, bool]]:
     return [(s, False) for s in config.levels] + [(s, True) for s in config.anisotropic_levels]
 
 
+@dataclass(frozen=True)
+class Scene:
+    """The piano and the room with their noise-free sampled points, as the run samples them.
+
+    Attributes
+    ----------
+    piano, room : SceneObject
+        The two objects (the piano moves, the room stays).
+    piano_points, room_points : ndarray, shape (n, 3)
+        Their surfaces sampled at one density (``config.piano_points`` on the piano).
+    spacing : float
+        The sampling spacing of both clouds together (metres).
+    """
+
+    piano: SceneObject
+    room: SceneObject
+    piano_points: np.ndarray
+    room_points: np.ndarray
+    spacing: float
+
+
+def sample_scene(config: Config) -> Scene:
+    """Sample the piano and the room as :func:`run` does (same density, same seeds)."""
+    p_obj, r_obj = piano(), room()
+    density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
+    piano_pts, _ = p_obj.sample(density, config.seed)
+    room_pts, _ = r_obj.sample(density, config.seed + 1)
+    spacing = m.sampling_spacing(np.concatenate([piano_pts, room_pts]))
+    return Scene(p_obj, r_obj, piano_pts, room_pts, spacing)
+
+
 def level_inputs(
-    config: Config,
-    k: int,
-    objects: tuple[Any, Any],
-    points: tuple[np.ndarray, np.ndarray],
-    poses: int,
+    config: Config, k: int, scene: Scene, poses: int
 ) -> tuple[float, QueryPoses, list[m.Draw]]:
     """Return level ``k``'s sigma, query poses and noise draws, as the run makes them.
 
-    ``objects`` are the piano and the room, ``points`` their sampled points;
-    ``poses`` query poses (``config.poses`` in the run). The level's generator
-    is seeded from ``config.seed`` and ``k``, so any one level can be made
-    alone with the run's poses and draws (``benches/reproduce_levels.py``).
+    ``scene`` is :func:`sample_scene`'s; ``poses`` query poses (``config.poses``
+    in the run). The level's generator is seeded from ``config.seed`` and ``k``,
+    so any one level can be made alone with the run's poses and draws
+    (``benches/reproduce_levels.py``).
     """
     share, aniso = config_levels(config)[k]
-    p_obj, r_obj = objects
-    piano_pts, room_pts = points
+    p_obj, r_obj = scene.piano, scene.room
+    piano_pts, room_pts = scene.piano_points, scene.room_points
     sigma = share * p_obj.diagonal
     rng = np.random.default_rng(config.seed * 1000 + k)
     q = sample_poses(p_obj, r_obj, poses, sigma, rng)
@@ -355,11 +384,8 @@ def _run(
     t0 = time.perf_counter()
     tick = progress or (lambda _d, _n: None)
     out.mkdir(parents=True, exist_ok=True)
-    p_obj, r_obj = piano(), room()
-    density = config.piano_points / sum(part.mesh.area for part in p_obj.parts)
-    piano_pts, _ = p_obj.sample(density, config.seed)
-    room_pts, _ = r_obj.sample(density, config.seed + 1)
-    spacing = m.sampling_spacing(np.concatenate([piano_pts, room_pts]))
+    scene = sample_scene(config)
+    spacing = scene.spacing
     tick("sampled the scene", 1)
     summary = Summary(config)
     with_reconstruction = reconstruction_available()
@@ -373,9 +399,7 @@ def _run(
     fig_roc: list[tuple[str, np.ndarray, dict[str, np.ndarray]]] = []
     for k, (share, aniso) in enumerate(config_levels(config)):
         name = level_name(share, aniso)
-        sigma, q, draws = level_inputs(
-            config, k, (p_obj, r_obj), (piano_pts, room_pts), config.poses
-        )
+        sigma, q, draws = level_inputs(config, k, scene, config.poses)
         summary.sigmas[name] = sigma
         tick(f"{name}: poses", 1)
         tick(f"{name}: noise draws", 1)

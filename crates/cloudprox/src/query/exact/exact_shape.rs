@@ -1,7 +1,10 @@
 //! Objects prepared for exact queries: one parry shape per mesh part.
 
-use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
+use parry3d_f64::shape::{ConvexPolyhedron, Shape, TriMesh, TriMeshFlags};
+use parry3d_f64::transformation::try_convex_hull;
 
+use super::climbing_hull::ClimbingHull;
+use super::exact::as_shape;
 use super::mesh_distance::TriangleTree;
 use crate::bvh::Aabb;
 use crate::cloud::MAX_COORDINATE;
@@ -47,6 +50,9 @@ pub struct ExactShape {
     /// The hierarchy over each mesh part's triangles (`None` for a convex
     /// part).
     pub(crate) trees: Vec<Option<TriangleTree>>,
+    /// Each large convex part again, with a support function that walks its
+    /// edges (the shape casts' GJK calls it at every iteration).
+    climbing: Vec<Option<ClimbingHull>>,
 }
 
 impl ExactShape {
@@ -77,6 +83,7 @@ impl ExactShape {
             return Err(Error::invalid("an exact shape needs at least one part"));
         }
         let mut out = Vec::with_capacity(parts.len());
+        let mut climbing = Vec::with_capacity(parts.len());
         for (i, m) in parts.iter().enumerate() {
             // parry asserts (panics) on the degenerate projections that
             // overflowing coordinates produce.
@@ -91,15 +98,25 @@ impl ExactShape {
             }
             let diag = m.aabb().half_extents().norm() * 2.0;
             let part = if solid && m.is_convex(CONVEX_TOLERANCE * diag.max(Real::MIN_POSITIVE)) {
-                let c = ConvexPolyhedron::from_convex_mesh(m.vertices().to_vec(), m.faces())
-                    .or_else(|| ConvexPolyhedron::from_convex_hull(m.vertices()))
-                    .ok_or_else(|| {
-                        Error::invalid(format!(
-                            "part {i}: parry could not build its convex polyhedron"
-                        ))
-                    })?;
+                // The triangles parry builds the polyhedron from (the part's
+                // own, else its hull's) give the climbing hull its edges.
+                let (c, triangles) =
+                    match ConvexPolyhedron::from_convex_mesh(m.vertices().to_vec(), m.faces()) {
+                        Some(c) => (Some(c), m.faces().to_vec()),
+                        None => match try_convex_hull(m.vertices()) {
+                            Ok((v, t)) => (ConvexPolyhedron::from_convex_mesh(v, &t), t),
+                            Err(_) => (None, Vec::new()),
+                        },
+                    };
+                let c = c.ok_or_else(|| {
+                    Error::invalid(format!(
+                        "part {i}: parry could not build its convex polyhedron"
+                    ))
+                })?;
+                climbing.push(ClimbingHull::new(&c, &triangles));
                 ExactPart::Convex(c)
             } else {
+                climbing.push(None);
                 let closed = solid && m.is_closed();
                 let flags = if closed {
                     TriMeshFlags::ORIENTED
@@ -125,12 +142,22 @@ impl ExactShape {
             parts: out,
             aabbs: parts.iter().map(Mesh::aabb).collect(),
             trees,
+            climbing,
         })
     }
 
     /// The prepared parts.
     pub fn parts(&self) -> &[ExactPart] {
         &self.parts
+    }
+
+    /// The shape that casts of part `i` use: a large convex part's climbing
+    /// hull (the same support points, found along its edges), else the part.
+    pub(crate) fn cast_shape(&self, i: usize) -> &dyn Shape {
+        match &self.climbing[i] {
+            Some(c) => c,
+            None => as_shape(&self.parts[i]),
+        }
     }
 
     /// Part `i` with its triangle hierarchy (a mesh part's).

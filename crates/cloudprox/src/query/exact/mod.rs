@@ -7,8 +7,11 @@
 //! intersection; point containment through pseudo-normals when it is closed).
 //! [`exact_time_of_impact`] moves one object along a straight line until its
 //! signed distance to the other reaches a target (shape casting, then a search
-//! on the penetration depth for a negative target).
+//! on the penetration depth for a negative target); a convex part of many vertices
+//! is cast with a support function that walks its edges instead of scanning its
+//! vertices (the same support points).
 
+mod climbing_hull;
 #[allow(clippy::module_inception)]
 mod exact;
 mod exact_shape;

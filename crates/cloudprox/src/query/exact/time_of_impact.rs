@@ -3,7 +3,7 @@
 
 use nalgebra::Translation3;
 use parry3d_f64::query::{self, PointQuery, Ray, ShapeCastOptions};
-use parry3d_f64::shape::TriMesh;
+use parry3d_f64::shape::{Shape, TriMesh};
 use rayon::prelude::*;
 
 use super::exact::{as_shape, intersects, proximity};
@@ -24,6 +24,23 @@ const CAST_PRECISION: Real = 1e-7;
 /// Most signed-distance evaluations of the search past contact.
 const MAX_STEPS: usize = 200;
 
+/// A part as the casts see it: its representation, and the shape handed to
+/// parry's casts ([`ExactShape::cast_shape`]: a large hull's climbing support).
+#[derive(Clone, Copy)]
+struct CastPart<'a> {
+    part: &'a ExactPart,
+    shape: &'a dyn Shape,
+}
+
+impl<'a> CastPart<'a> {
+    fn of(shape: &'a ExactShape, i: usize) -> Self {
+        Self {
+            part: &shape.parts[i],
+            shape: shape.cast_shape(i),
+        }
+    }
+}
+
 /// `pose` translated by `t` along the unit `direction`.
 fn moved(pose: &Pose, direction: &Vector3, t: Real) -> Pose {
     Pose::from_parts(
@@ -41,10 +58,10 @@ fn moved(pose: &Pose, direction: &Vector3, t: Real) -> Pose {
 /// far as `max_travel` only if that finds nothing.
 fn cast_pair(
     pa: &Pose,
-    a: &ExactPart,
+    a: CastPart<'_>,
     direction: &Vector3,
     pb: &Pose,
-    b: &ExactPart,
+    b: CastPart<'_>,
     target: Real,
     max_travel: Real,
 ) -> Result<Option<Real>> {
@@ -69,11 +86,14 @@ fn cast_pair(
     };
     // Two convex parts are one GJK cast, with no tree for a shorter reach to
     // prune: the bound would only add its rays.
-    let both_convex = matches!((a, b), (ExactPart::Convex(_), ExactPart::Convex(_)));
+    let both_convex = matches!(
+        (a.part, b.part),
+        (ExactPart::Convex(_), ExactPart::Convex(_))
+    );
     let bound = if both_convex {
         None
     } else {
-        vertex_ray_bound(pa, a, direction, pb, b, max_travel)
+        vertex_ray_bound(pa, a.part, direction, pb, b.part, max_travel)
     };
     if let Some(bound) = bound {
         // Slack for the casts' own rounding: the bound is a travel where the
@@ -131,10 +151,10 @@ fn vertex_ray_bound(
 /// [`cast_pair`] with the reach of `options` (its target included).
 fn cast_pair_within(
     pa: &Pose,
-    a: &ExactPart,
+    a: CastPart<'_>,
     direction: &Vector3,
     pb: &Pose,
-    b: &ExactPart,
+    b: CastPart<'_>,
     options: ShapeCastOptions,
 ) -> Result<Option<Real>> {
     let triangles = |p: &ExactPart| match p {
@@ -143,22 +163,14 @@ fn cast_pair_within(
     };
     let max_travel = options.max_time_of_impact;
     let zero = Vector3::zeros();
-    if let (ExactPart::Mesh { mesh: ma, .. }, ExactPart::Mesh { mesh: mb, .. }) = (a, b) {
+    if let (ExactPart::Mesh { mesh: ma, .. }, ExactPart::Mesh { mesh: mb, .. }) = (a.part, b.part) {
         return Ok(cast_mesh_mesh(pa, ma, direction, pb, mb, options));
     }
-    let hit = if triangles(b) > triangles(a) {
+    let hit = if triangles(b.part) > triangles(a.part) {
         // b moves by -direction relative to a: the same travel.
-        query::cast_shapes(
-            pb,
-            &-direction,
-            as_shape(b),
-            pa,
-            &zero,
-            as_shape(a),
-            options,
-        )
+        query::cast_shapes(pb, &-direction, b.shape, pa, &zero, a.shape, options)
     } else {
-        query::cast_shapes(pa, direction, as_shape(a), pb, &zero, as_shape(b), options)
+        query::cast_shapes(pa, direction, a.shape, pb, &zero, b.shape, options)
     }
     .map_err(|_| Error::invalid("parry cannot cast this pair of parts"))?;
     Ok(hit
@@ -290,10 +302,10 @@ fn cast_shapes_to(
         }
         let hit = cast_pair(
             pose_a,
-            &a.parts[i],
+            CastPart::of(a, i),
             direction,
             pose_b,
-            &b.parts[j],
+            CastPart::of(b, j),
             target,
             reach,
         )?;
@@ -539,6 +551,53 @@ mod tests {
         Mesh::new(vertices, vec![[0, 1, 2], [0, 2, 3]]).unwrap()
     }
 
+    /// A large hull's casts walk its edges for support points (its climbing
+    /// hull): every travel is bit for bit the scanning polyhedron's, whichever
+    /// of the two moves, at random poses over a wavy surface.
+    #[test]
+    fn a_climbing_hull_casts_as_the_polyhedron() {
+        use parry3d_f64::shape::ShapeType;
+        let ground = terrain();
+        let points: Vec<Point3> = crate::sample::sphere(&Point3::origin(), 1.0, 400)
+            .iter()
+            .map(|p| Point3::new(0.06 * p.x, 0.03 * p.y, 0.02 * p.z))
+            .collect();
+        let (v, t) = parry3d_f64::transformation::convex_hull(&points);
+        let pebble = ExactShape::new(&[Mesh::new(v, t).unwrap()]).unwrap();
+        assert_eq!(pebble.cast_shape(0).shape_type(), ShapeType::Custom);
+        let scanning = CastPart {
+            part: &pebble.parts[0],
+            shape: as_shape(&pebble.parts[0]),
+        };
+        let rotations = random_rotations(60, 3);
+        let mut rng = NormalRng::new(5);
+        let mut hits = 0;
+        for (k, rotation) in rotations.iter().enumerate() {
+            let start = Pose::from_parts(
+                Translation3::new(0.3 * rng.normal(), 0.3 * rng.normal(), 0.2),
+                *rotation,
+            );
+            let dir = Vector3::new(0.3 * rng.normal(), 0.3 * rng.normal(), -1.0).normalize();
+            let options = ShapeCastOptions {
+                max_time_of_impact: 1.0,
+                target_distance: [0.0, 0.01][k % 2],
+                stop_at_penetration: true,
+                compute_impact_geometry_on_penetration: false,
+            };
+            let o = Pose::identity();
+            let soil = CastPart::of(&ground, 0);
+            let climbing = CastPart::of(&pebble, 0);
+            let walk = cast_pair_within(&start, climbing, &dir, &o, soil, options).unwrap();
+            let scan = cast_pair_within(&start, scanning, &dir, &o, soil, options).unwrap();
+            assert_eq!(walk, scan, "pose {k}");
+            let walk = cast_pair_within(&o, soil, &-dir, &start, climbing, options).unwrap();
+            let back = cast_pair_within(&o, soil, &-dir, &start, scanning, options).unwrap();
+            assert_eq!(walk, back, "pose {k}, the ground moving");
+            hits += usize::from(scan.is_some());
+        }
+        assert!(hits >= 40, "{hits} hits");
+    }
+
     /// The vertex bound only shortens the casts' reach: the travel is the
     /// full-reach cast's to the casts' precision, and never beyond the bound,
     /// for convex, non-convex and open movers in random poses and directions
@@ -572,9 +631,21 @@ mod tests {
             // Every other pose the ground moves (the other way) instead: the
             // part with fewer vertices is then the second.
             let (pa, a, dir, pb, b) = if k % 2 == 0 {
-                (&start, &mover.parts[0], tilt, &o, &ground.parts[0])
+                (
+                    &start,
+                    CastPart::of(mover, 0),
+                    tilt,
+                    &o,
+                    CastPart::of(&ground, 0),
+                )
             } else {
-                (&o, &ground.parts[0], -tilt, &start, &mover.parts[0])
+                (
+                    &o,
+                    CastPart::of(&ground, 0),
+                    -tilt,
+                    &start,
+                    CastPart::of(mover, 0),
+                )
             };
             let got = cast_pair(pa, a, &dir, pb, b, target, max_travel).unwrap();
             let options = ShapeCastOptions {
@@ -584,7 +655,7 @@ mod tests {
                 compute_impact_geometry_on_penetration: false,
             };
             let full = cast_pair_within(pa, a, &dir, pb, b, options).unwrap();
-            let bound = vertex_ray_bound(pa, a, &dir, pb, b, max_travel);
+            let bound = vertex_ray_bound(pa, a.part, &dir, pb, b.part, max_travel);
             match (got, full) {
                 (Some(t), Some(u)) => {
                     hits += 1;
