@@ -30,7 +30,7 @@ from cloudprox.reproduce import methods as m
 from cloudprox.reproduce.noise import NoiseModel
 from cloudprox.reproduce.poses import sample_poses
 from cloudprox.reproduce.reconstruct import available, reconstruct, surface_shape
-from cloudprox.scenes import piano, room
+from cloudprox.reproduce.run import Config, sample_scene
 
 
 def _row(name: str, seconds: np.ndarray) -> None:
@@ -46,11 +46,9 @@ def main() -> None:
     ap.add_argument("--level", type=float, default=0.005, help="noise, share of the diagonal")
     ap.add_argument("--points", type=int, default=10_000)
     args = ap.parse_args()
-    p_obj, r_obj = piano(), room()
-    density = args.points / sum(part.mesh.area for part in p_obj.parts)
-    pp, _ = p_obj.sample(density, 0)
-    rp, _ = r_obj.sample(density, 1)
-    spacing = m.sampling_spacing(np.concatenate([pp, rp]))
+    scene = sample_scene(Config(piano_points=args.points, seed=0))
+    p_obj, r_obj, pp, rp = scene.piano, scene.room, scene.piano_points, scene.room_points
+    spacing = scene.spacing
     sigma = args.level * p_obj.diagonal
     rng = np.random.default_rng(0)
     q = sample_poses(p_obj, r_obj, args.poses, sigma, rng)

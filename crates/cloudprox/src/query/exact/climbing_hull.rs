@@ -11,23 +11,28 @@
 //! of a few precomputed extreme vertices, the walk visits a handful of
 //! vertices and their neighbours instead of all of them.
 //!
-//! The point returned is the scan's: the same dot products (same arithmetic)
-//! decide, and where several vertices are exactly as far (a face square to the
-//! direction) the lowest index among them is returned, as the scan's first
-//! maximum is.
+//! On an exactly convex hull the point returned is the scan's: the same dot
+//! products (same arithmetic) decide, and where the walk ends beside a vertex
+//! exactly as far (a face or an edge square to the direction) it hands the
+//! choice to parry's scan, whose first maximum is the lowest index. A mesh
+//! accepted as convex within a tolerance (or near-coplanar faces, where the
+//! rounded dot products are not exactly linear) can end the walk at a vertex
+//! within that tolerance of the farthest.
 
 use parry3d_f64::bounding_volume::{Aabb, BoundingSphere};
 use parry3d_f64::mass_properties::MassProperties;
+use parry3d_f64::math::Isometry;
 use parry3d_f64::math::{Point, Real, Vector};
 use parry3d_f64::query::{PointProjection, PointQuery, Ray, RayCast, RayIntersection};
 use parry3d_f64::shape::{ConvexPolyhedron, FeatureId, Shape, ShapeType, SupportMap, TypedShape};
+use parry3d_f64::utils::point_cloud_support_point_id;
 
 /// Hulls with fewer vertices are scanned: a walk would not be cheaper.
 pub(crate) const MIN_CLIMBING_VERTICES: usize = 48;
 
 /// A convex polyhedron with its vertices' neighbours (along edges of the
 /// triangles it was built from) and a few extreme vertices to start walks from.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub(crate) struct ClimbingHull {
     poly: ConvexPolyhedron,
     /// Vertex `v`'s neighbours are `neighbours[offsets[v]..offsets[v + 1]]`.
@@ -41,8 +46,9 @@ pub(crate) struct ClimbingHull {
 impl ClimbingHull {
     /// The hull `poly`, built by parry from exactly `triangles` over its own
     /// points (their edges include every edge of the polytope). `None` when a
-    /// triangle names a vertex the polyhedron does not have, or the
-    /// polyhedron has too few vertices for a walk to pay.
+    /// triangle names a vertex the polyhedron does not have, a vertex is in no
+    /// triangle (a walk could neither leave nor reach it, and the scan may
+    /// pick it), or the polyhedron has too few vertices for a walk to pay.
     pub(crate) fn new(poly: &ConvexPolyhedron, triangles: &[[u32; 3]]) -> Option<Self> {
         let n = poly.points().len();
         if n < MIN_CLIMBING_VERTICES || triangles.iter().flatten().any(|&v| v as usize >= n) {
@@ -58,6 +64,9 @@ impl ClimbingHull {
         let mut offsets = vec![0u32; n + 1];
         for &(u, _) in &pairs {
             offsets[u as usize + 1] += 1;
+        }
+        if offsets[1..].contains(&0) {
+            return None;
         }
         for v in 0..n {
             offsets[v + 1] += offsets[v];
@@ -103,43 +112,25 @@ impl ClimbingHull {
             }
             if next != best {
                 (best, best_dot) = (next, next_dot);
-            } else if !tie {
-                return best;
+            } else if tie {
+                // A farthest face or edge square to the direction (special
+                // directions only): the scan picks among its vertices.
+                return point_cloud_support_point_id(dir, pts);
             } else {
-                match self.plateau(best, best_dot, dir) {
-                    Ok(lowest) => return lowest,
-                    Err((u, d)) => (best, best_dot) = (u, d),
-                }
+                return best;
             }
         }
     }
+}
 
-    /// The vertices as far along `dir` as `start` (`value`) and joined to it
-    /// through such vertices: `Ok` with the lowest index among them if none has
-    /// a neighbour farther, else `Err` with that neighbour and its value.
-    fn plateau(
-        &self,
-        start: usize,
-        value: Real,
-        dir: &Vector<Real>,
-    ) -> Result<usize, (usize, Real)> {
-        let pts = self.poly.points();
-        let mut seen = vec![start];
-        let mut stack = vec![start];
-        while let Some(v) = stack.pop() {
-            for &u in self.around(v) {
-                let u = u as usize;
-                let d = pts[u].coords.dot(dir);
-                if d > value {
-                    return Err((u, d));
-                }
-                if d == value && !seen.contains(&u) {
-                    seen.push(u);
-                    stack.push(u);
-                }
-            }
-        }
-        Ok(seen.into_iter().min().unwrap_or(start))
+impl std::fmt::Debug for ClimbingHull {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "ClimbingHull({} vertices, {} seeds)",
+            self.poly.points().len(),
+            self.seeds.len()
+        )
     }
 }
 
@@ -203,6 +194,10 @@ impl PointQuery for ClimbingHull {
 impl Shape for ClimbingHull {
     fn compute_local_aabb(&self) -> Aabb {
         self.poly.local_aabb()
+    }
+
+    fn compute_aabb(&self, position: &Isometry<Real>) -> Aabb {
+        self.poly.aabb(position)
     }
 
     fn compute_local_bounding_sphere(&self) -> BoundingSphere {
@@ -319,5 +314,14 @@ mod tests {
         assert!(ClimbingHull::new(&poly, &t).is_none());
         let (poly, _) = hull(&ball_points(600, 2));
         assert!(ClimbingHull::new(&poly, &[[0, 1, poly.points().len() as u32]]).is_none());
+        // A vertex in no triangle (here a duplicate of a corner, first in
+        // order): no walk could leave or reach it.
+        let (v, t) = convex_hull(&ball_points(600, 2));
+        let mut with_unused = vec![v[0]];
+        with_unused.extend(&v);
+        let shifted: Vec<[u32; 3]> = t.iter().map(|f| f.map(|k| k + 1)).collect();
+        let poly = ConvexPolyhedron::from_convex_mesh(with_unused, &shifted).expect("a hull");
+        assert!(ClimbingHull::new(&poly, &shifted).is_none());
+        assert!(ClimbingHull::new(&hull(&ball_points(600, 2)).0, &t).is_some());
     }
 }

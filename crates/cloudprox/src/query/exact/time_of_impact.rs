@@ -551,27 +551,40 @@ mod tests {
         Mesh::new(vertices, vec![[0, 1, 2], [0, 2, 3]]).unwrap()
     }
 
+    /// A convex hull of `n` points on an ellipsoid of half-axes `axes`.
+    fn ellipsoid_hull(n: usize, axes: [Real; 3]) -> ExactShape {
+        let points: Vec<Point3> = crate::sample::sphere(&Point3::origin(), 1.0, n)
+            .iter()
+            .map(|p| Point3::new(axes[0] * p.x, axes[1] * p.y, axes[2] * p.z))
+            .collect();
+        let (v, t) = parry3d_f64::transformation::convex_hull(&points);
+        ExactShape::new(&[Mesh::new(v, t).unwrap()]).unwrap()
+    }
+
+    /// Part 0 of `shape` as the casts saw it before climbing hulls.
+    fn scanning(shape: &ExactShape) -> CastPart<'_> {
+        CastPart {
+            part: &shape.parts[0],
+            shape: as_shape(&shape.parts[0]),
+        }
+    }
+
     /// A large hull's casts walk its edges for support points (its climbing
-    /// hull): every travel is bit for bit the scanning polyhedron's, whichever
-    /// of the two moves, at random poses over a wavy surface.
+    /// hull): every travel is bit for bit the scanning polyhedron's, at random
+    /// poses over a wavy surface and against another large hull.
     #[test]
     fn a_climbing_hull_casts_as_the_polyhedron() {
         use parry3d_f64::shape::ShapeType;
         let ground = terrain();
-        let points: Vec<Point3> = crate::sample::sphere(&Point3::origin(), 1.0, 400)
-            .iter()
-            .map(|p| Point3::new(0.06 * p.x, 0.03 * p.y, 0.02 * p.z))
-            .collect();
-        let (v, t) = parry3d_f64::transformation::convex_hull(&points);
-        let pebble = ExactShape::new(&[Mesh::new(v, t).unwrap()]).unwrap();
-        assert_eq!(pebble.cast_shape(0).shape_type(), ShapeType::Custom);
-        let scanning = CastPart {
-            part: &pebble.parts[0],
-            shape: as_shape(&pebble.parts[0]),
-        };
+        let pebble = ellipsoid_hull(400, [0.06, 0.03, 0.02]);
+        let stone = ellipsoid_hull(300, [0.05, 0.05, 0.03]);
+        for s in [&pebble, &stone] {
+            assert_eq!(s.cast_shape(0).shape_type(), ShapeType::Custom);
+        }
+        let stone_at = Pose::translation(0.0, 0.0, -0.05);
         let rotations = random_rotations(60, 3);
         let mut rng = NormalRng::new(5);
-        let mut hits = 0;
+        let (mut hits, mut convex_hits) = (0, 0);
         for (k, rotation) in rotations.iter().enumerate() {
             let start = Pose::from_parts(
                 Translation3::new(0.3 * rng.normal(), 0.3 * rng.normal(), 0.2),
@@ -588,14 +601,20 @@ mod tests {
             let soil = CastPart::of(&ground, 0);
             let climbing = CastPart::of(&pebble, 0);
             let walk = cast_pair_within(&start, climbing, &dir, &o, soil, options).unwrap();
-            let scan = cast_pair_within(&start, scanning, &dir, &o, soil, options).unwrap();
-            assert_eq!(walk, scan, "pose {k}");
-            let walk = cast_pair_within(&o, soil, &-dir, &start, climbing, options).unwrap();
-            let back = cast_pair_within(&o, soil, &-dir, &start, scanning, options).unwrap();
-            assert_eq!(walk, back, "pose {k}, the ground moving");
-            hits += usize::from(scan.is_some());
+            let scan = cast_pair_within(&start, scanning(&pebble), &dir, &o, soil, options);
+            assert_eq!(walk, scan.unwrap(), "pose {k}");
+            hits += usize::from(walk.is_some());
+            // Hull against hull: one GJK cast of two support maps.
+            let (st, still) = (CastPart::of(&stone, 0), scanning(&stone));
+            let walk = cast_pair_within(&start, climbing, &dir, &stone_at, st, options).unwrap();
+            let scan = cast_pair_within(&start, scanning(&pebble), &dir, &stone_at, still, options);
+            assert_eq!(walk, scan.unwrap(), "pose {k}, two hulls");
+            convex_hits += usize::from(walk.is_some());
         }
-        assert!(hits >= 40, "{hits} hits");
+        assert!(
+            hits >= 40 && convex_hits >= 5,
+            "{hits} and {convex_hits} hits"
+        );
     }
 
     /// The vertex bound only shortens the casts' reach: the travel is the
