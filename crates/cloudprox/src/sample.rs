@@ -51,6 +51,19 @@ pub fn box_surface(center: &Point3, half: &Vector3, spacing: Real) -> Vec<Point3
     out
 }
 
+/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator
+/// seeded by `seed` (Knuth's MMIX constants): the tests' fixed streams.
+#[cfg(test)]
+pub(crate) fn lcg_uniform(seed: u64) -> impl FnMut() -> Real {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as Real) / ((1u64 << 53) as Real)
+    }
+}
+
 /// A small seeded generator of standard normal numbers (SplitMix64 + Box-Muller).
 #[derive(Debug, Clone)]
 pub struct NormalRng {

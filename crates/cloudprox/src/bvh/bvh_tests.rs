@@ -4,13 +4,7 @@ use crate::math::{Point3, Pose, Vector3};
 use crate::probability::{normal_cdf, normal_quantile};
 
 fn lcg_points(n: usize, seed: u64) -> Vec<Point3> {
-    let mut s = seed;
-    let mut next = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64) / ((1u64 << 53) as f64)
-    };
+    let mut next = crate::sample::lcg_uniform(seed);
     (0..n)
         .map(|_| Point3::new(next(), next(), next()))
         .collect()

@@ -165,13 +165,7 @@ mod tests {
 
     #[test]
     fn the_hierarchy_finds_what_a_scan_finds() {
-        let mut seed = 5u64;
-        let mut uniform = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as Real) / ((1u64 << 53) as Real)
-        };
+        let mut uniform = crate::sample::lcg_uniform(5);
         // A thin noisy sheet, denser at one end.
         let sheet: Vec<Point3> = (0..600)
             .map(|_| {

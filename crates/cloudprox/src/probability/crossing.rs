@@ -283,13 +283,7 @@ mod tests {
     /// scan break the ties alike.
     #[test]
     fn searches_give_the_scans_probabilities() {
-        let mut seed = 17u64;
-        let mut uniform = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as Real) / ((1u64 << 53) as Real)
-        };
+        let mut uniform = crate::sample::lcg_uniform(17);
         let s = 0.002;
         let mut sheet = |tilt: Real, n: usize| {
             let mut pts = Vec::new();
