@@ -71,7 +71,9 @@ pub(crate) fn near_set(
             .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
         let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE);
         let links = add_links_to_core(&links(&core), &mut core);
-        let any_near = core.0.iter().any(|&k| k);
+        // Only the leaf pairs and the links set core flags: without either,
+        // none is set, and a query the bounds decide does not scan its clouds.
+        let any_near = (!t.leaf_pairs.is_empty() || !links.is_empty()) && core.0.iter().any(|&k| k);
         let mut keep = core.clone();
         if any_near && ctx > SAMPLING_MARGIN {
             let (ma, mb) = (margins(a, ctx), margins(b, ctx));
