@@ -73,7 +73,7 @@ impl ClimbingHull {
         }
         let neighbours = pairs.iter().map(|&(_, v)| v).collect();
         let mut seeds: Vec<u32> = cube_directions()
-            .map(|d| scan(poly.points(), &d) as u32)
+            .map(|d| point_cloud_support_point_id(&d, poly.points()) as u32)
             .collect();
         seeds.sort_unstable();
         seeds.dedup();
@@ -132,19 +132,6 @@ impl std::fmt::Debug for ClimbingHull {
             self.seeds.len()
         )
     }
-}
-
-/// The first farthest point of `points` along `dir` (parry's scan).
-fn scan(points: &[Point<Real>], dir: &Vector<Real>) -> usize {
-    let mut best = 0;
-    let mut best_dot = Real::NEG_INFINITY;
-    for (i, p) in points.iter().enumerate() {
-        let d = p.coords.dot(dir);
-        if d > best_dot {
-            (best, best_dot) = (i, d);
-        }
-    }
-    best
 }
 
 /// The 26 directions from a cube's centre to its faces, edges and corners.
@@ -273,11 +260,17 @@ mod tests {
         let mut rng = NormalRng::new(11);
         for _ in 0..5000 {
             let d = Vector::new(rng.normal(), rng.normal(), rng.normal()) * rng.normal().exp();
-            assert_eq!(climbing.support_id(&d), scan(poly.points(), &d));
+            assert_eq!(
+                climbing.support_id(&d),
+                point_cloud_support_point_id(&d, poly.points())
+            );
         }
         // Towards each seed direction and the zero vector (every vertex ties).
         for d in cube_directions().chain([Vector::zeros()]) {
-            assert_eq!(climbing.support_id(&d), scan(poly.points(), &d));
+            assert_eq!(
+                climbing.support_id(&d),
+                point_cloud_support_point_id(&d, poly.points())
+            );
         }
     }
 
@@ -300,7 +293,7 @@ mod tests {
         let upright = [Vector::z(), -Vector::z(), Vector::new(1e-300, 0.0, 1.0)];
         for d in cube_directions().chain(horizontal).chain(upright) {
             for s in [1.0, 1e-3, 1e6] {
-                let want = scan(poly.points(), &(d * s));
+                let want = point_cloud_support_point_id(&(d * s), poly.points());
                 assert_eq!(climbing.support_id(&(d * s)), want, "direction {d:?}");
             }
         }
