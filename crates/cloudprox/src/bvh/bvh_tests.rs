@@ -1,4 +1,4 @@
-use crate::bvh::bvh_traverse_bvtt::kept_without_bound;
+use crate::bvh::bvh_traverse_bvtt::{kept_without_bound, pruned_within};
 use crate::bvh::{prune_bound, Bvh, BvhSettings, BvhWorkspace};
 use crate::math::{Point3, Pose, Vector3};
 use crate::probability::{normal_cdf, normal_quantile};
@@ -162,6 +162,139 @@ fn the_shortcut_changes_no_traversal() {
         }
     }
     assert!(fired > 100, "{fired}");
+}
+
+#[test]
+fn the_screened_bound_prunes_exactly_the_pairs_the_bound_prunes() {
+    // Gaps around every decision edge: for each n and epsilon, the gap
+    // where n Phi(-x) = epsilon, and a spread around it, where Mills'
+    // bracket decides and where it leaves the pair to the bound.
+    let mut checked = [0usize; 2];
+    for eps in [1e-9, 1e-6, 1e-3, 0.1] {
+        for n in [2usize, 17, 400, 20_000] {
+            let edge = -normal_quantile(eps / n as f64);
+            for k in -400..=400 {
+                let x = edge * (1.0 + k as f64 * 1e-3);
+                for (sa, sb) in [(1.0, 0.0), (0.3, 0.7), (2e-3, 5e-4)] {
+                    let gap = x * (sa + sb);
+                    let exact = prune_bound(gap, sa, sb, n);
+                    if let Some(b) = pruned_within(gap, sa, sb, n, eps) {
+                        assert!(exact < eps, "{eps} {n} {x}: {exact}");
+                        assert!(b >= exact && b < eps, "{eps} {n} {x}: {b} vs {exact}");
+                        checked[0] += 1;
+                    } else {
+                        assert!(exact >= eps, "{eps} {n} {x}: {exact}");
+                        checked[1] += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked[0] > 10_000 && checked[1] > 10_000, "{checked:?}");
+    // No deviation: pruned at any positive gap, with a zero bound.
+    assert_eq!(pruned_within(1e-9, 0.0, 0.0, 5, 1e-3), Some(0.0));
+    assert_eq!(pruned_within(0.0, 0.0, 0.0, 5, 1e-3), None);
+}
+
+#[test]
+fn the_nested_traversal_is_the_two_traversals() {
+    // Inner margins (half a spacing) and outer ones (two spacings) per node,
+    // noisy clouds overlapping, near and apart, moved and turned: the nested
+    // descent gives each traversal's leaf pairs in its order, visits and
+    // pruned sum.
+    let a = lcg_points(3000, 21);
+    let (sa, sb) = (vec![0.004; a.len()], vec![0.006; 2500]);
+    let settings = BvhSettings { leaf_max_points: 8 };
+    let ta = Bvh::build(&a, &sa, &settings).unwrap();
+    let mut ws = BvhWorkspace::default();
+    let spacing = |t: &Bvh, k: f64| -> Vec<f64> {
+        (0..t.nodes().len())
+            .map(|i| k * 0.01 * (1.0 + (i % 7) as f64 / 7.0))
+            .collect()
+    };
+    let mut differ = 0;
+    for (shift, eps, angle) in [
+        (1.02, 1e-6, 0.0),
+        (1.05, 1e-3, 0.3),
+        (0.5, 1e-3, 0.0),
+        (1.1, 1e-9, -0.7),
+        (3.0, 1e-3, 0.0),
+        // Sums past the cap of 1, where the far pairs' bounds are skipped.
+        (0.95, 0.3, 0.2),
+        (0.7, 0.05, 0.0),
+    ] {
+        let b: Vec<Point3> = lcg_points(2500, 22)
+            .into_iter()
+            .map(|p| p + Vector3::new(shift, 0.0, 0.0))
+            .collect();
+        let tb = Bvh::build(&b, &sb, &settings).unwrap();
+        let pose = Pose::from_parts(
+            nalgebra::Translation3::new(0.01, -0.02, 0.0),
+            nalgebra::UnitQuaternion::from_euler_angles(angle, 0.5 * angle, 0.0),
+        );
+        let (ia, ib) = (spacing(&ta, 0.5), spacing(&tb, 0.5));
+        let (oa, ob) = (spacing(&ta, 2.0), spacing(&tb, 2.0));
+        let inner = ta.traverse_pairs(&tb, &pose, eps, &ia, &ib, &mut ws);
+        let outer = ta.traverse_pairs(&tb, &pose, eps, &oa, &ob, &mut ws);
+        for (t, m) in [(&inner, (&ia[..], &ib[..])), (&outer, (&oa[..], &ob[..]))] {
+            let (pairs, visited, pruned) = by_definition(&ta, &tb, &pose, eps, m);
+            assert_eq!(t.leaf_pairs, pairs, "shift {shift}, epsilon {eps}");
+            assert_eq!(t.node_pairs_visited, visited);
+            // Mills' ratio sums a little more, by at most 1/x^2 of a pair
+            // (x above 3 here); both are capped at 1.
+            let pruned = pruned.min(1.0);
+            assert!(
+                t.pruned_bound >= pruned && t.pruned_bound <= (1.12 * pruned).min(1.0),
+                "{} vs {pruned}",
+                t.pruned_bound
+            );
+        }
+        let (n_in, n_out) =
+            ta.traverse_pairs_nested(&tb, &pose, eps, (&ia, &ib), (&oa, &ob), &mut ws);
+        assert_eq!(n_in, inner, "shift {shift}, epsilon {eps}");
+        assert_eq!(n_out, outer, "shift {shift}, epsilon {eps}");
+        differ += usize::from(outer.leaf_pairs.len() > inner.leaf_pairs.len());
+    }
+    assert!(differ >= 3, "{differ}");
+}
+
+/// The pair traversal by its definition: every node pair whose boxes'
+/// gap (less the larger margin) has `prune_bound >= epsilon` is descended,
+/// the larger node split first: leaf pairs in order, visits, pruned sum.
+fn by_definition(
+    ta: &Bvh,
+    tb: &Bvh,
+    pose: &Pose,
+    eps: f64,
+    (ma, mb): (&[f64], &[f64]),
+) -> (Vec<(u32, u32)>, usize, f64) {
+    let (mut pairs, mut visited, mut pruned) = (Vec::new(), 0, 0.0);
+    let mut stack = vec![(0u32, 0u32)];
+    while let Some((ia, ib)) = stack.pop() {
+        visited += 1;
+        let (na, nb) = (&ta.nodes()[ia as usize], &tb.nodes()[ib as usize]);
+        let gap = (na.aabb.transformed(pose).distance(&nb.aabb)
+            - ma[ia as usize].max(mb[ib as usize]))
+        .max(0.0);
+        let bound = prune_bound(
+            gap,
+            na.sigma_max,
+            nb.sigma_max,
+            (na.count + nb.count) as usize,
+        );
+        if bound < eps {
+            pruned += bound;
+            continue;
+        }
+        let split_a = na.count >= nb.count;
+        match (na.children, nb.children) {
+            (None, None) => pairs.push((ia, ib)),
+            (Some([l, r]), None) => stack.extend([(l, ib), (r, ib)]),
+            (Some([l, r]), Some(_)) if split_a => stack.extend([(l, ib), (r, ib)]),
+            (_, Some([l, r])) => stack.extend([(ia, l), (ia, r)]),
+        }
+    }
+    (pairs, visited, pruned)
 }
 
 #[test]

@@ -13,9 +13,11 @@ pub struct PairTraversal {
     pub leaf_pairs: Vec<(u32, u32)>,
     /// Number of node pairs tested.
     pub node_pairs_visited: usize,
-    /// Sum of [`prune_bound`] over every pruned node pair: an upper bound on the
-    /// probability that any pruned point lies on the wrong side of a plane that
-    /// separates its node's box from the other node's box (capped at 1).
+    /// Sum over every pruned node pair of [`prune_bound`] (or, where Mills'
+    /// ratio `phi(x) / x` already puts it below `epsilon`, of that slightly
+    /// larger bound): an upper bound on the probability that any pruned point
+    /// lies on the wrong side of a plane that separates its node's box from
+    /// the other node's box (capped at 1).
     pub pruned_bound: Real,
 }
 
@@ -37,6 +39,44 @@ pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
     }
     n * normal_cdf(-gap / s)
 }
+
+/// Whether [`prune_bound`] prunes a pair (is below `epsilon`), and if so an
+/// upper bound on it that is also below `epsilon`: exactly the pairs
+/// [`prune_bound`] would prune, mostly without its `erfc`.
+///
+/// Mills' ratio brackets the tail with one exponential: `phi(x) x / (1 + x^2)
+/// < Phi(-x) < phi(x) / x` for `x > 0`. The bracket is a relative `1 / x^2`
+/// or so wide (9% at the closest pairs the default `epsilon`, 1e-3, prunes,
+/// `x` about 3.3; less beyond), far wider than rounding: where `n` times its
+/// upper end is below `epsilon` the pair is pruned and that end returned
+/// (slightly above [`prune_bound`]); where `n` times its lower end reaches
+/// `epsilon` the pair is kept; only between them is [`prune_bound`]
+/// computed.
+pub(crate) fn pruned_within(
+    gap: Real,
+    sigma_a: Real,
+    sigma_b: Real,
+    n: usize,
+    epsilon: Real,
+) -> Option<Real> {
+    let s = sigma_a + sigma_b;
+    let x = gap / s;
+    if s > 0.0 && x > 1.0 {
+        let tail = n as Real * (-0.5 * x * x).exp() / SQRT_2PI;
+        let upper = tail / x;
+        if upper < epsilon {
+            return Some(upper);
+        }
+        if tail * x / (1.0 + x * x) >= epsilon {
+            return None;
+        }
+    }
+    let bound = prune_bound(gap, sigma_a, sigma_b, n);
+    (bound < epsilon).then_some(bound)
+}
+
+/// `sqrt(2 pi)`.
+const SQRT_2PI: Real = 2.506_628_274_631_000_5;
 
 /// A gap of at most this many times `sigma_a + sigma_b` gives a
 /// [`prune_bound`] of at least `epsilon` for any pair of nodes (at least two
@@ -123,42 +163,30 @@ impl Bvh {
         other: &Bvh,
         pose: &Pose,
         epsilon: Real,
-        (margin_self, margin_other): (&[Real], &[Real]),
+        margins: (&[Real], &[Real]),
         keep_within: Real,
         workspace: &mut BvhWorkspace,
     ) -> PairTraversal {
-        let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
+        let test = PairTest::new(self, other, pose, epsilon, keep_within);
         let mut out = PairTraversal::default();
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
-        let motion = BoxMotion::new(pose);
         out.node_pairs_visited = self.descend_pairs(
             other,
-            &mut workspace.pair_stack,
-            |ia, ib| {
-                let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
-                let gap = (na.aabb.moved(&motion).distance(&nb.aabb)
-                    - margin(margin_self, ia).max(margin(margin_other, ib)))
-                .max(0.0);
-                // Close pairs are kept without the Gaussian tail (most pairs of
-                // an overlap); the bound decides the others.
-                if gap <= keep_within * (na.sigma_max + nb.sigma_max) {
-                    return true;
+            &mut workspace.tagged_pairs,
+            true,
+            |ia, ib, _| {
+                let gap = test.distance(ia, ib);
+                match test.pruned(ia, ib, gap, margins, pruned_bound >= 1.0) {
+                    Some(bound) => {
+                        pruned_bound += bound;
+                        None
+                    }
+                    None => Some(true),
                 }
-                let bound = prune_bound(
-                    gap,
-                    na.sigma_max,
-                    nb.sigma_max,
-                    (na.count + nb.count) as usize,
-                );
-                if bound < epsilon {
-                    pruned_bound += bound;
-                    return false;
-                }
-                true
             },
             |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
-            |ia, ib| {
+            |ia, ib, _| {
                 leaf_pairs.push((ia, ib));
                 true
             },
@@ -168,55 +196,188 @@ impl Bvh {
         out
     }
 
-    /// The bounding volume test tree of `self` and `other`: from the root pair,
-    /// every node pair for which `keep` holds is descended (where both nodes
-    /// have children, `self`'s node is split when `split_self` says so; both
-    /// nodes leaves: `leaf` is called), until `leaf` returns `false`. Returns
-    /// the number of node pairs tested. The traversals differ in `keep` (what
-    /// bounds a node pair), in which node they split first and in what a leaf
-    /// pair does.
-    pub(crate) fn descend_pairs(
+    /// Two [`Bvh::traverse_pairs`] in one descent: with the `inner` margins
+    /// and with the `outer` ones, each at least as large (per node) as the
+    /// inner one. A larger margin only shrinks a pair's gap, so every pair
+    /// the inner traversal keeps the outer one keeps too: the descent runs
+    /// the outer traversal and tags the pairs whose every ancestor the inner
+    /// one kept; the inner traversal is those, in the same order, with the
+    /// same counters. Returns `(inner, outer)`.
+    pub(crate) fn traverse_pairs_nested(
         &self,
         other: &Bvh,
-        stack: &mut Vec<(u32, u32)>,
-        mut keep: impl FnMut(u32, u32) -> bool,
+        pose: &Pose,
+        epsilon: Real,
+        inner: (&[Real], &[Real]),
+        outer: (&[Real], &[Real]),
+        workspace: &mut BvhWorkspace,
+    ) -> (PairTraversal, PairTraversal) {
+        let test = PairTest::new(self, other, pose, epsilon, kept_without_bound(epsilon));
+        let (mut t_in, mut t_out) = (PairTraversal::default(), PairTraversal::default());
+        let (mut pruned_in, mut pruned_out) = (0.0, 0.0);
+        let mut visited_in = 0;
+        let mut leaves: Vec<(u32, u32, bool)> = Vec::new();
+        t_out.node_pairs_visited = self.descend_pairs(
+            other,
+            &mut workspace.tagged_pairs,
+            true,
+            |ia, ib, inner_kept_above| {
+                let gap = test.distance(ia, ib);
+                if inner_kept_above {
+                    visited_in += 1;
+                    match test.pruned(ia, ib, gap, inner, pruned_in >= 1.0) {
+                        None => return Some(true),
+                        Some(bound) => pruned_in += bound,
+                    }
+                }
+                match test.pruned(ia, ib, gap, outer, pruned_out >= 1.0) {
+                    Some(bound) => {
+                        pruned_out += bound;
+                        None
+                    }
+                    None => Some(false),
+                }
+            },
+            |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
+            |ia, ib, inner_kept| {
+                leaves.push((ia, ib, inner_kept));
+                true
+            },
+        );
+        t_in.node_pairs_visited = visited_in;
+        t_in.leaf_pairs = leaves.iter().filter(|l| l.2).map(|l| (l.0, l.1)).collect();
+        t_out.leaf_pairs = leaves.into_iter().map(|l| (l.0, l.1)).collect();
+        t_in.pruned_bound = pruned_in.min(1.0);
+        t_out.pruned_bound = pruned_out.min(1.0);
+        (t_in, t_out)
+    }
+
+    /// The bounding volume test tree of `self` and `other`: from the root pair
+    /// (tagged `root`), every node pair for which `keep` gives a tag is
+    /// descended, its children carrying that tag (where both nodes have
+    /// children, `self`'s node is split when `split_self` says so; both nodes
+    /// leaves: `leaf` is called with it), until `leaf` returns `false`.
+    /// Returns the number of node pairs tested. The traversals differ in
+    /// `keep` (what bounds a node pair, and what its descendants should know
+    /// of it), in which node they split first and in what a leaf pair does.
+    pub(crate) fn descend_pairs<T: Copy>(
+        &self,
+        other: &Bvh,
+        stack: &mut Vec<(u32, u32, T)>,
+        root: T,
+        mut keep: impl FnMut(u32, u32, T) -> Option<T>,
         split_self: impl Fn(u32, u32) -> bool,
-        mut leaf: impl FnMut(u32, u32) -> bool,
+        mut leaf: impl FnMut(u32, u32, T) -> bool,
     ) -> usize {
         let mut visited = 0;
         stack.clear();
-        stack.push((0, 0));
-        while let Some((ia, ib)) = stack.pop() {
+        stack.push((0, 0, root));
+        while let Some((ia, ib, above)) = stack.pop() {
             visited += 1;
-            if !keep(ia, ib) {
+            let Some(tag) = keep(ia, ib, above) else {
                 continue;
-            }
+            };
             let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
             match (na.children, nb.children) {
                 (None, None) => {
-                    if !leaf(ia, ib) {
+                    if !leaf(ia, ib, tag) {
                         break;
                     }
                 }
                 (Some([l, r]), None) => {
-                    stack.push((l, ib));
-                    stack.push((r, ib));
+                    stack.push((l, ib, tag));
+                    stack.push((r, ib, tag));
                 }
                 (None, Some([l, r])) => {
-                    stack.push((ia, l));
-                    stack.push((ia, r));
+                    stack.push((ia, l, tag));
+                    stack.push((ia, r, tag));
                 }
                 (Some([al, ar]), Some([bl, br])) => {
                     if split_self(ia, ib) {
-                        stack.push((al, ib));
-                        stack.push((ar, ib));
+                        stack.push((al, ib, tag));
+                        stack.push((ar, ib, tag));
                     } else {
-                        stack.push((ia, bl));
-                        stack.push((ia, br));
+                        stack.push((ia, bl, tag));
+                        stack.push((ia, br, tag));
                     }
                 }
             }
         }
         visited
+    }
+}
+
+/// The bound test of one node pair of two hierarchies (see
+/// [`Bvh::traverse_pairs`]): the distance between the nodes' boxes (the first
+/// moved by the pose), less a margin, against the Gaussian bound.
+struct PairTest<'t> {
+    a: &'t Bvh,
+    b: &'t Bvh,
+    motion: BoxMotion,
+    epsilon: Real,
+    keep_within: Real,
+    /// Beyond this many deviations every pair is pruned, whatever its
+    /// points: `Phi^-1(epsilon / n)` with `n` all the points of both
+    /// hierarchies (widened far beyond rounding).
+    prune_beyond: Real,
+}
+
+impl<'t> PairTest<'t> {
+    fn new(a: &'t Bvh, b: &'t Bvh, pose: &Pose, epsilon: Real, keep_within: Real) -> Self {
+        let all = a.nodes.first().map_or(0, |n| n.count) + b.nodes.first().map_or(0, |n| n.count);
+        let prune_beyond = -normal_quantile(epsilon / all.max(1) as Real) * (1.0 + 1e-6);
+        Self {
+            a,
+            b,
+            motion: BoxMotion::new(pose),
+            epsilon,
+            keep_within,
+            prune_beyond: if prune_beyond.is_nan() {
+                Real::INFINITY
+            } else {
+                prune_beyond
+            },
+        }
+    }
+
+    /// The distance between the boxes of node `ia` (moved) and node `ib`.
+    fn distance(&self, ia: u32, ib: u32) -> Real {
+        let (na, nb) = (&self.a.nodes[ia as usize], &self.b.nodes[ib as usize]);
+        na.aabb.moved(&self.motion).distance(&nb.aabb)
+    }
+
+    /// The pair's bound if it prunes the pair, given the boxes' `distance`
+    /// and per-node `margins` (the larger of the two nodes' is subtracted;
+    /// an empty slice: none). With `saturated` (the caller's sum of bounds
+    /// has reached its cap of 1, so only the decision matters), a pair
+    /// beyond [`PairTest::prune_beyond`] deviations is pruned with a bound
+    /// of 0, without computing it.
+    fn pruned(
+        &self,
+        ia: u32,
+        ib: u32,
+        distance: Real,
+        (margin_a, margin_b): (&[Real], &[Real]),
+        saturated: bool,
+    ) -> Option<Real> {
+        let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
+        let (na, nb) = (&self.a.nodes[ia as usize], &self.b.nodes[ib as usize]);
+        let gap = (distance - margin(margin_a, ia).max(margin(margin_b, ib))).max(0.0);
+        // Close pairs are kept without the Gaussian tail (most pairs of an
+        // overlap); the bound decides the others.
+        let sigma = na.sigma_max + nb.sigma_max;
+        if gap <= self.keep_within * sigma {
+            return None;
+        }
+        if saturated && gap > self.prune_beyond * sigma {
+            return Some(0.0);
+        }
+        pruned_within(
+            gap,
+            na.sigma_max,
+            nb.sigma_max,
+            (na.count + nb.count) as usize,
+            self.epsilon,
+        )
     }
 }

@@ -226,6 +226,9 @@ pub(crate) fn solve_primal_dual(
     let mut hcol = vec![0.0; n * m];
     let mut s_mat = DMatrix::<Real>::zeros(m, m);
     let (mut aff, mut cor) = (Direction::new(n, m), Direction::new(n, m));
+    // Each point's `B^T B` (packed lower triangle), fixed over the iterations:
+    // the Schur complement then adds three terms per entry, not five.
+    let btb: Vec<[Real; PACKED]> = data.iter().map(|pd| packed_btb(pd, m)).collect();
 
     for iter in 0..MAX_ITER {
         // Residuals: r_s = s - (G x - h), r_d = P x + q - G^T y.
@@ -262,9 +265,9 @@ pub(crate) fn solve_primal_dual(
         let mu = gap / nu;
 
         // Scalings, the Schur complement S and its per-point pieces.
-        let mut sacc = [0.0; MAX_UNKNOWNS * MAX_UNKNOWNS];
+        let mut sacc = [0.0; PACKED];
         for k in 0..d {
-            sacc[k * m + k] = 1.0;
+            sacc[k * (k + 1) / 2 + k] = 1.0;
         }
         for i in 0..n {
             let sc_i = Scaling::new(&sc[i], &yc[i])?;
@@ -283,22 +286,23 @@ pub(crate) fn solve_primal_dual(
             let beta = 2.0 * c1 - 4.0 * c1 * c1 * v[0] * v[0] * inv_d;
             let gamma = 2.0 * c1 * c1 * v[0] * inv_d;
             let hi = &mut hcol[i * m..(i + 1) * m];
+            let bb = &btb[i];
             for k in 0..m {
                 hi[k] = c1 * (2.0 * v[0] * p[k] - a[k]);
                 let ca = alpha * a[k] + gamma * p[k];
                 let cp = beta * p[k] + gamma * a[k];
-                let (b0, b1, b2) = (c1 * pd.b[0][k], c1 * pd.b[1][k], c1 * pd.b[2][k]);
-                let row = &mut sacc[k * m..=k * m + k];
-                for (l, x) in row.iter_mut().enumerate() {
-                    *x +=
-                        ca * a[l] + cp * p[l] + b0 * pd.b[0][l] + b1 * pd.b[1][l] + b2 * pd.b[2][l];
+                let at = k * (k + 1) / 2;
+                let row = sacc[at..=at + k].iter_mut().zip(&bb[at..=at + k]);
+                for (l, (x, b)) in row.enumerate() {
+                    *x += ca * a[l] + cp * p[l] + c1 * b;
                 }
             }
         }
         for k in 0..m {
             for l in 0..=k {
-                s_mat[(k, l)] = sacc[k * m + l];
-                s_mat[(l, k)] = sacc[k * m + l];
+                let x = sacc[k * (k + 1) / 2 + l];
+                s_mat[(k, l)] = x;
+                s_mat[(l, k)] = x;
             }
         }
         let chol = s_mat.clone().cholesky()?;
@@ -403,6 +407,23 @@ pub(crate) fn solve_primal_dual(
         }
     }
     None
+}
+
+/// Entries of a packed lower triangle of `MAX_UNKNOWNS` rows.
+const PACKED: usize = MAX_UNKNOWNS * (MAX_UNKNOWNS + 1) / 2;
+
+/// `B^T B` of one point's cone over the first `m` unknowns, as a packed lower
+/// triangle (row `k`, column `l <= k` at `k (k + 1) / 2 + l`).
+fn packed_btb(pd: &ConeData, m: usize) -> [Real; PACKED] {
+    let mut out = [0.0; PACKED];
+    for k in 0..m {
+        let at = k * (k + 1) / 2;
+        for l in 0..=k {
+            out[at + l] =
+                pd.b[0][k] * pd.b[0][l] + pd.b[1][k] * pd.b[1][l] + pd.b[2][k] * pd.b[2][l];
+        }
+    }
+    out
 }
 
 fn finite_solution(z: &[Real], xi: &[Real], d: usize, iterations: u32) -> Option<Solution> {

@@ -66,21 +66,31 @@ pub(crate) fn near_set(
     let eps = request.prune_epsilon;
     if request.use_hierarchy {
         let (ma, mb) = (margins(a, SAMPLING_MARGIN), margins(b, SAMPLING_MARGIN));
-        let mut t = a
-            .bvh()
-            .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-        let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE);
+        // The core's leaf pairs and, where the context reaches farther, the
+        // context's, in one descent (the second holds the first).
+        let (mut t, wider) = if ctx > SAMPLING_MARGIN {
+            let (ca, cb) = (margins(a, ctx), margins(b, ctx));
+            let (core_t, wider) =
+                a.bvh()
+                    .traverse_pairs_nested(b.bvh(), rel, eps, (&ma, &mb), (&ca, &cb), workspace);
+            (core_t, Some(wider))
+        } else {
+            let t = a
+                .bvh()
+                .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
+            (t, None)
+        };
+        let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE, None);
         let links = add_links_to_core(&links(&core), &mut core);
         // Only the leaf pairs and the links set core flags: without either,
         // none is set, and a query the bounds decide does not scan its clouds.
         let any_near = (!t.leaf_pairs.is_empty() || !links.is_empty()) && core.0.iter().any(|&k| k);
         let mut keep = core.clone();
-        if any_near && ctx > SAMPLING_MARGIN {
-            let (ma, mb) = (margins(a, ctx), margins(b, ctx));
-            t = a
-                .bvh()
-                .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context);
+        if let Some(wider) = wider.filter(|_| any_near) {
+            stats.counters.node_pairs_visited += t.node_pairs_visited;
+            t = wider;
+            // The core points are near under the context's rule as well.
+            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context, Some(&core));
         }
         stats.counters.node_pairs_visited += t.node_pairs_visited;
         stats.counters.leaf_pairs = t.leaf_pairs.len();

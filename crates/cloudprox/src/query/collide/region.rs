@@ -206,6 +206,13 @@ impl NearRule {
 /// traversal, run with margins of `context` times each node's largest spacing,
 /// keeps every leaf pair holding such a pair of points, so searching the
 /// partner leaves finds every one.
+///
+/// `found`, when given, holds points already known to be near by this rule
+/// (such as the core points under a wider context: the rule with a larger
+/// context holds every pair the smaller one does): they are not searched
+/// for again, and a pair of leaves whose points are all found is skipped.
+/// The answer is the same as without it.
+#[allow(clippy::too_many_arguments)]
 pub fn near_points(
     leaf_pairs: &[(u32, u32)],
     rel: &Pose,
@@ -214,6 +221,7 @@ pub fn near_points(
     epsilon: Real,
     context: Real,
     own_context: OwnContext<'_>,
+    found: Option<&(Vec<bool>, Vec<bool>)>,
 ) -> (Vec<bool>, Vec<bool>) {
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
     // Each leaf is in many pairs: it is read once.
@@ -233,7 +241,18 @@ pub fn near_points(
     let blocks_a: Vec<&[u32]> = ids_a.iter().map(|&l| bvh_a.node_points(l)).collect();
     let blocks_b: Vec<&[u32]> = ids_b.iter().map(|&l| bvh_b.node_points(l)).collect();
     let rule = NearRule::new(epsilon, context);
-    near_points_in_blocks((&blocks_a, &blocks_b), &pairs, rel, a, b, rule, own_context)
+    let found = found
+        .cloned()
+        .unwrap_or_else(|| (vec![false; a.len()], vec![false; b.len()]));
+    near_points_in_blocks(
+        (&blocks_a, &blocks_b),
+        &pairs,
+        rel,
+        (a, b),
+        rule,
+        own_context,
+        found,
+    )
 }
 
 /// Per sample of A and of B, whether it measures its context in its own
@@ -254,7 +273,8 @@ pub fn near_points_brute_force(
     let (ia, ib) = (all(a.len()), all(b.len()));
     let rule = NearRule::new(epsilon, context);
     let blocks = (&[&ia[..]][..], &[&ib[..]][..]);
-    near_points_in_blocks(blocks, &[(0, 0)], rel, a, b, rule, own_context)
+    let found = (vec![false; a.len()], vec![false; b.len()]);
+    near_points_in_blocks(blocks, &[(0, 0)], rel, (a, b), rule, own_context, found)
 }
 
 /// The near rule over every pair `(i, j)` of the blocks of point indices
@@ -270,10 +290,10 @@ fn near_points_in_blocks(
     blocks: (&[&[u32]], &[&[u32]]),
     pairs: &[(u32, u32)],
     rel: &Pose,
-    a: &PointCloud,
-    b: &PointCloud,
+    (a, b): (&PointCloud, &PointCloud),
     rule: NearRule,
     own_context: OwnContext<'_>,
+    (mut near_a, mut near_b): (Vec<bool>, Vec<bool>),
 ) -> (Vec<bool>, Vec<bool>) {
     // Directions in B's frame, rotated into A's own frame for A's covariances.
     let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
@@ -281,12 +301,15 @@ fn near_points_in_blocks(
     let noise_b = CloudNoise::new(b, Matrix3::identity(), own_context.1);
     let read_a = Blocks::read(blocks.0, |i| noise_a.point(i, rel * a.points()[i]));
     let read_b = Blocks::read(blocks.1, |j| noise_b.point(j, b.points()[j]));
-    let mut near_a = vec![false; a.len()];
-    let mut near_b = vec![false; b.len()];
     // Per block, its points not yet found near: a pair of two blocks whose
     // points are all near can change nothing (deep in an overlap, most pairs).
-    let mut left_a: Vec<usize> = read_a.bounds.iter().map(|bound| bound.run.len()).collect();
-    let mut left_b: Vec<usize> = read_b.bounds.iter().map(|bound| bound.run.len()).collect();
+    let left = |read: &Blocks<'_>, near: &[bool]| -> Vec<usize> {
+        (0..read.bounds.len() as u32)
+            .map(|k| read.block(k).iter().filter(|(i, _)| !near[*i]).count())
+            .collect()
+    };
+    let mut left_a = left(&read_a, &near_a);
+    let mut left_b = left(&read_b, &near_b);
     let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
     for &(ka, kb) in pairs {
         let (la, lb) = (&mut left_a[ka as usize], &mut left_b[kb as usize]);
@@ -663,7 +686,7 @@ mod tests {
                 .flat_map(|&la| leaves(&b).into_iter().map(move |lb| (la, lb)))
                 .collect();
             assert!(pairs.len() > 1000);
-            let got = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None));
+            let got = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None), None);
             assert_eq!(got, (want_a.clone(), want_b.clone()), "lift {lift}");
             let brute = near_points_brute_force(&rel, &a, &b, eps, ctx, (None, None));
             assert_eq!(brute, (want_a.clone(), want_b), "lift {lift}");
@@ -691,7 +714,7 @@ mod tests {
         let mut kept = Vec::new();
         for own in [None, Some(&marked[..])] {
             let (ka, kb) = near_points_brute_force(&id, &a, &b, eps, ctx, (own, None));
-            let (ta, tb) = near_points(&[(0, 0)], &id, &a, &b, eps, ctx, (own, None));
+            let (ta, tb) = near_points(&[(0, 0)], &id, &a, &b, eps, ctx, (own, None), None);
             assert_eq!((&ka, &kb), (&ta, &tb), "one leaf pair is every pair");
             let is_marked = |i: usize| own.is_some_and(|o| o[i]);
             for i in 0..a.len() {
