@@ -154,6 +154,17 @@ fn cone_step(x: &Cone, dx: &Cone, cap: Real) -> Real {
     if a >= 0.0 && dx[0] >= 0.0 {
         return cap; // a direction inside the cone never leaves it
     }
+    // A cone is convex: if the step's end is inside, so is the whole step
+    // (most cones, once another has set a small cap): no root needed.
+    let end = [
+        x[0] + cap * dx[0],
+        x[1] + cap * dx[1],
+        x[2] + cap * dx[2],
+        x[3] + cap * dx[3],
+    ];
+    if end[0] > 0.0 && jdet(&end) > 0.0 {
+        return cap;
+    }
     let b = x[0] * dx[0] - (x[1] * dx[1] + x[2] * dx[2] + x[3] * dx[3]);
     let c = jdet(x);
     let disc = b * b - a * c;
@@ -524,5 +535,10 @@ mod tests {
         }
         // Inside the cone's direction: no bound.
         assert_eq!(cone_step(&x, &[1.0, 0.1, 0.0, 0.0], 5.0), 5.0);
+        // A cap short of the boundary is kept; one past it is cut to it.
+        let dx = [-1.0, 0.3, 0.2, 0.0];
+        let edge = cone_step(&x, &dx, 1e9);
+        assert_eq!(cone_step(&x, &dx, 0.5 * edge), 0.5 * edge);
+        assert_eq!(cone_step(&x, &dx, 2.0 * edge), edge);
     }
 }
