@@ -169,7 +169,7 @@ fn the_screened_bound_prunes_exactly_the_pairs_the_bound_prunes() {
     // Gaps around every decision edge: for each n and epsilon, the gap
     // where n Phi(-x) = epsilon, and a spread around it, where Mills'
     // bracket decides and where it leaves the pair to the bound.
-    let mut checked = [0usize; 2];
+    let (mut checked, mut mills) = ([0usize; 2], 0);
     for eps in [1e-9, 1e-6, 1e-3, 0.1] {
         for n in [2usize, 17, 400, 20_000] {
             let edge = -normal_quantile(eps / n as f64);
@@ -182,6 +182,8 @@ fn the_screened_bound_prunes_exactly_the_pairs_the_bound_prunes() {
                         assert!(exact < eps, "{eps} {n} {x}: {exact}");
                         assert!(b >= exact && b < eps, "{eps} {n} {x}: {b} vs {exact}");
                         checked[0] += 1;
+                        // Mills' upper end, not the bound itself.
+                        mills += usize::from(b > exact);
                     } else {
                         assert!(exact >= eps, "{eps} {n} {x}: {exact}");
                         checked[1] += 1;
@@ -191,9 +193,24 @@ fn the_screened_bound_prunes_exactly_the_pairs_the_bound_prunes() {
         }
     }
     assert!(checked[0] > 10_000 && checked[1] > 10_000, "{checked:?}");
+    assert!(mills > checked[0] / 2, "{mills} of {}", checked[0]);
     // No deviation: pruned at any positive gap, with a zero bound.
     assert_eq!(pruned_within(1e-9, 0.0, 0.0, 5, 1e-3), Some(0.0));
     assert_eq!(pruned_within(0.0, 0.0, 0.0, 5, 1e-3), None);
+    // Far beyond the normal numbers (x = 40, 45), at epsilon 0, NaN or
+    // subnormal, and at a huge count: the bound's own decision.
+    for (x, n, eps) in [
+        (40.0, 3, 1e-300),
+        (45.0, 3, f64::from_bits(1)),
+        (5.0, 10, 0.0),
+        (5.0, 10, f64::NAN),
+        (6.0, 1 << 40, 1e-3),
+    ] {
+        let exact = prune_bound(x, 1.0, 0.0, n);
+        let got = pruned_within(x, 1.0, 0.0, n, eps);
+        assert_eq!(got.is_some(), exact < eps, "{x} {n} {eps}");
+        assert!(got.is_none_or(|b| b >= exact), "{x} {n} {eps}");
+    }
 }
 
 #[test]
@@ -240,14 +257,18 @@ fn the_nested_traversal_is_the_two_traversals() {
             let (pairs, visited, pruned) = by_definition(&ta, &tb, &pose, eps, m);
             assert_eq!(t.leaf_pairs, pairs, "shift {shift}, epsilon {eps}");
             assert_eq!(t.node_pairs_visited, visited);
-            // Mills' ratio sums a little more, by at most 1/x^2 of a pair
-            // (x above 3 here); both are capped at 1.
+            // Mills' ratio sums a little more: by 1/x^2 or so of a pair, x
+            // above 3 at epsilon <= 1e-3 here; both are capped at 1 (and the
+            // larger epsilons' sums reach the cap).
             let pruned = pruned.min(1.0);
             assert!(
                 t.pruned_bound >= pruned && t.pruned_bound <= (1.12 * pruned).min(1.0),
                 "{} vs {pruned}",
                 t.pruned_bound
             );
+            if eps > 0.01 {
+                assert_eq!((t.pruned_bound, pruned), (1.0, 1.0));
+            }
         }
         let (n_in, n_out) =
             ta.traverse_pairs_nested(&tb, &pose, eps, (&ia, &ib), (&oa, &ob), &mut ws);

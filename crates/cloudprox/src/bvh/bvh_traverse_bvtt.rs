@@ -14,10 +14,12 @@ pub struct PairTraversal {
     /// Number of node pairs tested.
     pub node_pairs_visited: usize,
     /// Sum over every pruned node pair of [`prune_bound`] (or, where Mills'
-    /// ratio `phi(x) / x` already puts it below `epsilon`, of that slightly
-    /// larger bound): an upper bound on the probability that any pruned point
+    /// ratio `phi(x) / x` already puts it below `epsilon`, of that larger
+    /// bound: by a relative `1 / x^2` or so, 9% at `x = 3.3`, up to 1.5x
+    /// near `x = 1`): an upper bound on the probability that any pruned point
     /// lies on the wrong side of a plane that separates its node's box from
-    /// the other node's box (capped at 1).
+    /// the other node's box (capped at 1; once the sum reaches the cap, pairs
+    /// beyond every pair's pruning distance add nothing more).
     pub pruned_bound: Real,
 }
 
@@ -47,11 +49,12 @@ pub fn prune_bound(gap: Real, sigma_a: Real, sigma_b: Real, n: usize) -> Real {
 /// Mills' ratio brackets the tail with one exponential: `phi(x) x / (1 + x^2)
 /// < Phi(-x) < phi(x) / x` for `x > 0`. The bracket is a relative `1 / x^2`
 /// or so wide (9% at the closest pairs the default `epsilon`, 1e-3, prunes,
-/// `x` about 3.3; less beyond), far wider than rounding: where `n` times its
-/// upper end is below `epsilon` the pair is pruned and that end returned
-/// (slightly above [`prune_bound`]); where `n` times its lower end reaches
-/// `epsilon` the pair is kept; only between them is [`prune_bound`]
-/// computed.
+/// `x` about 3.3; less beyond), far wider than rounding while its ends are
+/// normal numbers (`x` below about 37; beyond, subnormal rounding could
+/// exceed it, and the exact bound decides): where `n` times its upper end is
+/// below `epsilon` the pair is pruned and that end returned (above
+/// [`prune_bound`]); where `n` times its lower end reaches `epsilon` the
+/// pair is kept; only between them is [`prune_bound`] computed.
 pub(crate) fn pruned_within(
     gap: Real,
     sigma_a: Real,
@@ -63,12 +66,14 @@ pub(crate) fn pruned_within(
     let x = gap / s;
     if s > 0.0 && x > 1.0 {
         let tail = n as Real * (-0.5 * x * x).exp() / SQRT_2PI;
-        let upper = tail / x;
-        if upper < epsilon {
-            return Some(upper);
-        }
-        if tail * x / (1.0 + x * x) >= epsilon {
-            return None;
+        let (lower, upper) = (tail * x / (1.0 + x * x), tail / x);
+        if lower >= Real::MIN_POSITIVE {
+            if upper < epsilon {
+                return Some(upper);
+            }
+            if lower >= epsilon {
+                return None;
+            }
         }
     }
     let bound = prune_bound(gap, sigma_a, sigma_b, n);
@@ -198,11 +203,14 @@ impl Bvh {
 
     /// Two [`Bvh::traverse_pairs`] in one descent: with the `inner` margins
     /// and with the `outer` ones, each at least as large (per node) as the
-    /// inner one. A larger margin only shrinks a pair's gap, so every pair
-    /// the inner traversal keeps the outer one keeps too: the descent runs
-    /// the outer traversal and tags the pairs whose every ancestor the inner
-    /// one kept; the inner traversal is those, in the same order, with the
-    /// same counters. Returns `(inner, outer)`.
+    /// inner one. A larger margin only shrinks a pair's gap, and the bound
+    /// only grows as the gap shrinks, so every pair the inner traversal keeps
+    /// the outer one keeps too (not tested again: the outer result relies on
+    /// that monotony, which holds for the normal numbers [`pruned_within`]
+    /// computes, and is checked in debug builds): the descent runs the outer
+    /// traversal and tags the pairs whose every ancestor the inner one kept;
+    /// the inner traversal is those, in the same order, with the same
+    /// counters. Returns `(inner, outer)`.
     pub(crate) fn traverse_pairs_nested(
         &self,
         other: &Bvh,
@@ -226,7 +234,10 @@ impl Bvh {
                 if inner_kept_above {
                     visited_in += 1;
                     match test.pruned(ia, ib, gap, inner, pruned_in >= 1.0) {
-                        None => return Some(true),
+                        None => {
+                            debug_assert!(test.pruned(ia, ib, gap, outer, false).is_none());
+                            return Some(true);
+                        }
                         Some(bound) => pruned_in += bound,
                     }
                 }
@@ -246,7 +257,7 @@ impl Bvh {
         );
         t_in.node_pairs_visited = visited_in;
         t_in.leaf_pairs = leaves.iter().filter(|l| l.2).map(|l| (l.0, l.1)).collect();
-        t_out.leaf_pairs = leaves.into_iter().map(|l| (l.0, l.1)).collect();
+        t_out.leaf_pairs = leaves.iter().map(|l| (l.0, l.1)).collect();
         t_in.pruned_bound = pruned_in.min(1.0);
         t_out.pruned_bound = pruned_out.min(1.0);
         (t_in, t_out)
@@ -317,25 +328,27 @@ struct PairTest<'t> {
     epsilon: Real,
     keep_within: Real,
     /// Beyond this many deviations every pair is pruned, whatever its
-    /// points: `Phi^-1(epsilon / n)` with `n` all the points of both
-    /// hierarchies (widened far beyond rounding).
+    /// points: `-Phi^-1(epsilon / n)` with `n` all the points of both
+    /// hierarchies (widened far beyond rounding; infinite, pruning nothing
+    /// this way, where `epsilon` is 0).
     prune_beyond: Real,
 }
 
 impl<'t> PairTest<'t> {
     fn new(a: &'t Bvh, b: &'t Bvh, pose: &Pose, epsilon: Real, keep_within: Real) -> Self {
         let all = a.nodes.first().map_or(0, |n| n.count) + b.nodes.first().map_or(0, |n| n.count);
-        let prune_beyond = -normal_quantile(epsilon / all.max(1) as Real) * (1.0 + 1e-6);
+        let z = -normal_quantile(epsilon / all.max(1) as Real);
         Self {
             a,
             b,
             motion: BoxMotion::new(pose),
             epsilon,
             keep_within,
-            prune_beyond: if prune_beyond.is_nan() {
+            // (NaN where `epsilon` is outside [0, 1]: nothing pruned this way.)
+            prune_beyond: if z.is_nan() {
                 Real::INFINITY
             } else {
-                prune_beyond
+                z.max(0.0) * (1.0 + 1e-6)
             },
         }
     }

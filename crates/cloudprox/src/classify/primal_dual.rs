@@ -278,7 +278,7 @@ pub(crate) fn solve_primal_dual(
         // Scalings, the Schur complement S and its per-point pieces.
         let mut sacc = [0.0; PACKED];
         for k in 0..d {
-            sacc[k * (k + 1) / 2 + k] = 1.0;
+            sacc[tri(k) + k] = 1.0;
         }
         for i in 0..n {
             let sc_i = Scaling::new(&sc[i], &yc[i])?;
@@ -302,7 +302,7 @@ pub(crate) fn solve_primal_dual(
                 hi[k] = c1 * (2.0 * v[0] * p[k] - a[k]);
                 let ca = alpha * a[k] + gamma * p[k];
                 let cp = beta * p[k] + gamma * a[k];
-                let at = k * (k + 1) / 2;
+                let at = tri(k);
                 let row = sacc[at..=at + k].iter_mut().zip(&bb[at..=at + k]);
                 for (l, (x, b)) in row.enumerate() {
                     *x += ca * a[l] + cp * p[l] + c1 * b;
@@ -311,7 +311,7 @@ pub(crate) fn solve_primal_dual(
         }
         for k in 0..m {
             for l in 0..=k {
-                let x = sacc[k * (k + 1) / 2 + l];
+                let x = sacc[tri(k) + l];
                 s_mat[(k, l)] = x;
                 s_mat[(l, k)] = x;
             }
@@ -423,12 +423,19 @@ pub(crate) fn solve_primal_dual(
 /// Entries of a packed lower triangle of `MAX_UNKNOWNS` rows.
 const PACKED: usize = MAX_UNKNOWNS * (MAX_UNKNOWNS + 1) / 2;
 
+/// Where row `k` of a packed lower triangle starts (column `l <= k` at
+/// `tri(k) + l`).
+#[inline]
+fn tri(k: usize) -> usize {
+    k * (k + 1) / 2
+}
+
 /// `B^T B` of one point's cone over the first `m` unknowns, as a packed lower
 /// triangle (row `k`, column `l <= k` at `k (k + 1) / 2 + l`).
 fn packed_btb(pd: &ConeData, m: usize) -> [Real; PACKED] {
     let mut out = [0.0; PACKED];
     for k in 0..m {
-        let at = k * (k + 1) / 2;
+        let at = tri(k);
         for l in 0..=k {
             out[at + l] =
                 pd.b[0][k] * pd.b[0][l] + pd.b[1][k] * pd.b[1][l] + pd.b[2][k] * pd.b[2][l];
@@ -538,7 +545,9 @@ mod tests {
         // A cap short of the boundary is kept; one past it is cut to it.
         let dx = [-1.0, 0.3, 0.2, 0.0];
         let edge = cone_step(&x, &dx, 1e9);
-        assert_eq!(cone_step(&x, &dx, 0.5 * edge), 0.5 * edge);
+        for cap in [0.5 * edge, edge * (1.0 - 1e-9)] {
+            assert_eq!(cone_step(&x, &dx, cap), cap);
+        }
         assert_eq!(cone_step(&x, &dx, 2.0 * edge), edge);
     }
 }

@@ -87,10 +87,14 @@ pub(crate) fn near_set(
         let any_near = (!t.leaf_pairs.is_empty() || !links.is_empty()) && core.0.iter().any(|&k| k);
         let mut keep = core.clone();
         if let Some(wider) = wider.filter(|_| any_near) {
-            stats.counters.node_pairs_visited += t.node_pairs_visited;
             t = wider;
-            // The core points are near under the context's rule as well.
-            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context, Some(&core));
+            // With a positive epsilon the context's rule finds every core
+            // point the core's rule found (the links' run starts it may not
+            // find are kept with their runs below): it need not look for them
+            // again. (With 0, a noise-free pair within half a spacing is core
+            // but beyond a single-point element's own context.)
+            let found = (eps > 0.0).then_some(&core);
+            keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context, found);
         }
         stats.counters.node_pairs_visited += t.node_pairs_visited;
         stats.counters.leaf_pairs = t.leaf_pairs.len();

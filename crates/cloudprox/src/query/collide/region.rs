@@ -207,11 +207,12 @@ impl NearRule {
 /// keeps every leaf pair holding such a pair of points, so searching the
 /// partner leaves finds every one.
 ///
-/// `found`, when given, holds points already known to be near by this rule
-/// (such as the core points under a wider context: the rule with a larger
-/// context holds every pair the smaller one does): they are not searched
-/// for again, and a pair of leaves whose points are all found is skipped.
-/// The answer is the same as without it.
+/// `found`, when given, holds points already known to be near (such as the
+/// core points under a wider context: the rule with a larger context holds
+/// every pair the smaller one does): they are not searched for again, and a
+/// pair of leaves whose points are all found is skipped. The answer is
+/// `found` and the points the rule finds: the same as without it where
+/// `found` holds only points the rule finds.
 #[allow(clippy::too_many_arguments)]
 pub fn near_points(
     leaf_pairs: &[(u32, u32)],
@@ -286,6 +287,8 @@ pub fn near_points_brute_force(
 /// ([`NearRule::block_reach`]) is left out of the pair tests: it is near none
 /// of them, and none of them near it, so the result is that of testing every
 /// pair. A pair of blocks whose points have all been found near is skipped.
+/// The flags start as the given ones (`near_a`, `near_b`: points already
+/// known near, see [`near_points`]), and only gain points.
 fn near_points_in_blocks(
     blocks: (&[&[u32]], &[&[u32]]),
     pairs: &[(u32, u32)],
@@ -688,6 +691,31 @@ mod tests {
             assert!(pairs.len() > 1000);
             let got = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None), None);
             assert_eq!(got, (want_a.clone(), want_b.clone()), "lift {lift}");
+            // Started from the points the rule finds with the core's half
+            // spacing of context (a subset), or from every other point it
+            // finds: the same answer.
+            let core = near_points(
+                &pairs,
+                &rel,
+                &a,
+                &b,
+                eps,
+                SAMPLING_MARGIN,
+                (None, None),
+                None,
+            );
+            let every_other = |w: &[bool]| -> Vec<bool> {
+                w.iter()
+                    .enumerate()
+                    .map(|(i, &x)| x && i % 2 == 0)
+                    .collect()
+            };
+            let some = (every_other(&want_a), every_other(&want_b));
+            for found in [&core, &some] {
+                assert!(found.0.iter().any(|&x| x), "lift {lift}");
+                let seeded = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None), Some(found));
+                assert_eq!(seeded, got, "lift {lift}");
+            }
             let brute = near_points_brute_force(&rel, &a, &b, eps, ctx, (None, None));
             assert_eq!(brute, (want_a.clone(), want_b), "lift {lift}");
             // Some points near and some not: the test can tell.
