@@ -1,5 +1,5 @@
 use crate::bvh::bvh_traverse_bvtt::{kept_without_bound, pruned_within};
-use crate::bvh::{prune_bound, Bvh, BvhSettings, BvhWorkspace};
+use crate::bvh::{prune_bound, Bvh, BvhSettings, BvhWorkspace, NodeMargins};
 use crate::math::{Point3, Pose, Vector3};
 use crate::probability::{normal_cdf, normal_quantile};
 
@@ -270,8 +270,23 @@ fn the_nested_traversal_is_the_two_traversals() {
                 assert_eq!((t.pruned_bound, pruned), (1.0, 1.0));
             }
         }
-        let (n_in, n_out) =
-            ta.traverse_pairs_nested(&tb, &pose, eps, (&ia, &ib), (&oa, &ob), &mut ws);
+        let (n_in, wider) = ta.traverse_pairs_nested(
+            &tb,
+            &pose,
+            eps,
+            NodeMargins {
+                a: &ia,
+                b: &ib,
+                scale: 1.0,
+            },
+            NodeMargins {
+                a: &oa,
+                b: &ob,
+                scale: 1.0,
+            },
+            &mut ws,
+        );
+        let n_out = wider.finish(&mut ws);
         assert_eq!(n_in, inner, "shift {shift}, epsilon {eps}");
         assert_eq!(n_out, outer, "shift {shift}, epsilon {eps}");
         differ += usize::from(outer.leaf_pairs.len() > inner.leaf_pairs.len());

@@ -173,12 +173,18 @@ impl Bvh {
         workspace: &mut BvhWorkspace,
     ) -> PairTraversal {
         let test = PairTest::new(self, other, pose, epsilon, keep_within);
+        let margins = NodeMargins {
+            a: margins.0,
+            b: margins.1,
+            scale: 1.0,
+        };
         let mut out = PairTraversal::default();
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
         out.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.tagged_pairs,
+            (0, 0),
             true,
             |ia, ib, _| {
                 let gap = test.distance(ia, ib);
@@ -201,80 +207,93 @@ impl Bvh {
         out
     }
 
-    /// Two [`Bvh::traverse_pairs`] in one descent: with the `inner` margins
-    /// and with the `outer` ones, each at least as large (per node) as the
-    /// inner one. A larger margin only shrinks a pair's gap, and the bound
-    /// only grows as the gap shrinks, so every pair the inner traversal keeps
-    /// the outer one keeps too (not tested again: the outer result relies on
-    /// that monotony, which holds for the normal numbers [`pruned_within`]
-    /// computes, and is checked in debug builds): the descent runs the outer
-    /// traversal and tags the pairs whose every ancestor the inner one kept;
-    /// the inner traversal is those, in the same order, with the same
-    /// counters. Returns `(inner, outer)`.
-    pub(crate) fn traverse_pairs_nested(
-        &self,
-        other: &Bvh,
+    /// The traversal with the `inner` margins, and what the one with the
+    /// `outer` margins (each at least as large, per node, as the inner one)
+    /// adds to it, to be finished only if needed ([`WiderTraversal::finish`]).
+    ///
+    /// A larger margin only shrinks a pair's gap, and the bound only grows as
+    /// the gap shrinks, so every pair the inner traversal keeps the outer one
+    /// keeps too (not tested again: that monotony holds for the normal numbers
+    /// [`pruned_within`] computes, and is checked in debug builds). Where the
+    /// inner traversal prunes a pair, the outer test runs on the same
+    /// distance: a pair it prunes too is recorded with its bound, one it
+    /// keeps is recorded to be descended later, each at its place in the
+    /// descent, so that the finished outer traversal has the leaf pairs in
+    /// the order, the visits and the pruned sum of its own descent. The inner
+    /// traversal costs about what it did alone (a near miss the inner margins
+    /// prune stays cheap); a query that needs both descends each node pair
+    /// once.
+    pub(crate) fn traverse_pairs_nested<'t>(
+        &'t self,
+        other: &'t Bvh,
         pose: &Pose,
         epsilon: Real,
-        inner: (&[Real], &[Real]),
-        outer: (&[Real], &[Real]),
+        inner: NodeMargins<'_>,
+        outer: NodeMargins<'t>,
         workspace: &mut BvhWorkspace,
-    ) -> (PairTraversal, PairTraversal) {
+    ) -> (PairTraversal, WiderTraversal<'t>) {
         let test = PairTest::new(self, other, pose, epsilon, kept_without_bound(epsilon));
-        let (mut t_in, mut t_out) = (PairTraversal::default(), PairTraversal::default());
+        let mut t_in = PairTraversal::default();
         let (mut pruned_in, mut pruned_out) = (0.0, 0.0);
-        let mut visited_in = 0;
-        let mut leaves: Vec<(u32, u32, bool)> = Vec::new();
-        t_out.node_pairs_visited = self.descend_pairs(
+        let mut steps = Vec::new();
+        let mut leaf_pairs = Vec::new();
+        t_in.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.tagged_pairs,
+            (0, 0),
             true,
-            |ia, ib, inner_kept_above| {
+            |ia, ib, _| {
                 let gap = test.distance(ia, ib);
-                if inner_kept_above {
-                    visited_in += 1;
-                    match test.pruned(ia, ib, gap, inner, pruned_in >= 1.0) {
-                        None => {
-                            debug_assert!(test.pruned(ia, ib, gap, outer, false).is_none());
-                            return Some(true);
-                        }
-                        Some(bound) => pruned_in += bound,
+                let Some(bound) = test.pruned(ia, ib, gap, inner, pruned_in >= 1.0) else {
+                    debug_assert!(test.pruned(ia, ib, gap, outer, false).is_none());
+                    // A kept pair of leaves (the descent's `leaf` below).
+                    if self.nodes[ia as usize].is_leaf() && other.nodes[ib as usize].is_leaf() {
+                        leaf_pairs.push((ia, ib));
+                        steps.push(Step::Leaf(ia, ib));
                     }
-                }
+                    return Some(true);
+                };
+                pruned_in += bound;
+                // (The outer sum so far leaves out the pairs still to be
+                // descended: a lower bound, so its cap is reached no sooner.)
                 match test.pruned(ia, ib, gap, outer, pruned_out >= 1.0) {
-                    Some(bound) => {
-                        pruned_out += bound;
-                        None
+                    Some(outer_bound) => {
+                        pruned_out += outer_bound;
+                        steps.push(Step::Pruned(outer_bound));
                     }
-                    None => Some(false),
+                    None => steps.push(Step::Descend(ia, ib)),
                 }
+                None
             },
             |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
-            |ia, ib, inner_kept| {
-                leaves.push((ia, ib, inner_kept));
-                true
-            },
+            |_, _, _| true,
         );
-        t_in.node_pairs_visited = visited_in;
-        t_in.leaf_pairs = leaves.iter().filter(|l| l.2).map(|l| (l.0, l.1)).collect();
-        t_out.leaf_pairs = leaves.iter().map(|l| (l.0, l.1)).collect();
+        t_in.leaf_pairs = leaf_pairs;
         t_in.pruned_bound = pruned_in.min(1.0);
-        t_out.pruned_bound = pruned_out.min(1.0);
-        (t_in, t_out)
+        let wider = WiderTraversal {
+            test,
+            margins: outer,
+            steps,
+            visited: t_in.node_pairs_visited,
+        };
+        (t_in, wider)
     }
 
-    /// The bounding volume test tree of `self` and `other`: from the root pair
-    /// (tagged `root`), every node pair for which `keep` gives a tag is
+    /// The bounding volume test tree of `self` and `other`: from the pair of
+    /// nodes `start` (the roots: `(0, 0)`; tagged `root`), every node pair for
+    /// which `keep` gives a tag is
     /// descended, its children carrying that tag (where both nodes have
     /// children, `self`'s node is split when `split_self` says so; both nodes
     /// leaves: `leaf` is called with it), until `leaf` returns `false`.
     /// Returns the number of node pairs tested. The traversals differ in
     /// `keep` (what bounds a node pair, and what its descendants should know
     /// of it), in which node they split first and in what a leaf pair does.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn descend_pairs<T: Copy>(
         &self,
         other: &Bvh,
         stack: &mut Vec<(u32, u32, T)>,
+        (root_a, root_b): (u32, u32),
         root: T,
         mut keep: impl FnMut(u32, u32, T) -> Option<T>,
         split_self: impl Fn(u32, u32) -> bool,
@@ -282,7 +301,7 @@ impl Bvh {
     ) -> usize {
         let mut visited = 0;
         stack.clear();
-        stack.push((0, 0, root));
+        stack.push((root_a, root_b, root));
         while let Some((ia, ib, above)) = stack.pop() {
             visited += 1;
             let Some(tag) = keep(ia, ib, above) else {
@@ -315,6 +334,27 @@ impl Bvh {
             }
         }
         visited
+    }
+}
+
+/// Per-node margins of a pair traversal: `scale` times each node's value in
+/// `a` (the first hierarchy's nodes) and `b` (the second's); an empty slice:
+/// none. A pair's margin is the larger of its two nodes'.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeMargins<'m> {
+    /// Per node of the first hierarchy.
+    pub a: &'m [Real],
+    /// Per node of the second hierarchy.
+    pub b: &'m [Real],
+    /// Factor on every value (the near set's: spacings of context).
+    pub scale: Real,
+}
+
+impl NodeMargins<'_> {
+    /// The margin of the pair `(ia, ib)`.
+    fn of(&self, ia: u32, ib: u32) -> Real {
+        let one = |m: &[Real], i: u32| m.get(i as usize).map_or(0.0, |x| x * self.scale);
+        one(self.a, ia).max(one(self.b, ib))
     }
 }
 
@@ -360,8 +400,7 @@ impl<'t> PairTest<'t> {
     }
 
     /// The pair's bound if it prunes the pair, given the boxes' `distance`
-    /// and per-node `margins` (the larger of the two nodes' is subtracted;
-    /// an empty slice: none). With `saturated` (the caller's sum of bounds
+    /// and per-node `margins` (the larger of the two nodes' is subtracted). With `saturated` (the caller's sum of bounds
     /// has reached its cap of 1, so only the decision matters), a pair
     /// beyond [`PairTest::prune_beyond`] deviations is pruned with a bound
     /// of 0, without computing it.
@@ -370,12 +409,11 @@ impl<'t> PairTest<'t> {
         ia: u32,
         ib: u32,
         distance: Real,
-        (margin_a, margin_b): (&[Real], &[Real]),
+        margins: NodeMargins<'_>,
         saturated: bool,
     ) -> Option<Real> {
-        let margin = |m: &[Real], i: u32| m.get(i as usize).copied().unwrap_or(0.0);
         let (na, nb) = (&self.a.nodes[ia as usize], &self.b.nodes[ib as usize]);
-        let gap = (distance - margin(margin_a, ia).max(margin(margin_b, ib))).max(0.0);
+        let gap = (distance - margins.of(ia, ib)).max(0.0);
         // Close pairs are kept without the Gaussian tail (most pairs of an
         // overlap); the bound decides the others.
         let sigma = na.sigma_max + nb.sigma_max;
@@ -392,5 +430,78 @@ impl<'t> PairTest<'t> {
             (na.count + nb.count) as usize,
             self.epsilon,
         )
+    }
+}
+
+/// One step of the outer descent that [`Bvh::traverse_pairs_nested`]'s inner
+/// one took or left, in the descent's order.
+enum Step {
+    /// A leaf pair both keep.
+    Leaf(u32, u32),
+    /// A pair both prune, with its outer bound.
+    Pruned(Real),
+    /// A pair the inner traversal pruned and the outer keeps: its
+    /// descendants are the outer descent's alone.
+    Descend(u32, u32),
+}
+
+/// The rest of an outer traversal after [`Bvh::traverse_pairs_nested`].
+pub(crate) struct WiderTraversal<'t> {
+    test: PairTest<'t>,
+    margins: NodeMargins<'t>,
+    steps: Vec<Step>,
+    visited: usize,
+}
+
+impl WiderTraversal<'_> {
+    /// The outer traversal, as [`Bvh::traverse_pairs`] with the outer margins
+    /// gives it: the recorded steps in order, each pair left to descend
+    /// descended where it was met.
+    pub(crate) fn finish(self, workspace: &mut BvhWorkspace) -> PairTraversal {
+        let test = &self.test;
+        let (a, b) = (test.a, test.b);
+        let margins = self.margins;
+        let mut out = PairTraversal {
+            node_pairs_visited: self.visited,
+            ..PairTraversal::default()
+        };
+        let mut pruned = 0.0;
+        for step in &self.steps {
+            match *step {
+                Step::Leaf(ia, ib) => out.leaf_pairs.push((ia, ib)),
+                Step::Pruned(bound) => pruned += bound,
+                Step::Descend(ia, ib) => {
+                    // The pair itself was visited (and kept) already.
+                    let mut first = true;
+                    let visited = a.descend_pairs(
+                        b,
+                        &mut workspace.tagged_pairs,
+                        (ia, ib),
+                        true,
+                        |ja, jb, _| {
+                            if std::mem::take(&mut first) {
+                                return Some(true);
+                            }
+                            let gap = test.distance(ja, jb);
+                            match test.pruned(ja, jb, gap, margins, pruned >= 1.0) {
+                                Some(bound) => {
+                                    pruned += bound;
+                                    None
+                                }
+                                None => Some(true),
+                            }
+                        },
+                        |ja, jb| a.nodes[ja as usize].count >= b.nodes[jb as usize].count,
+                        |ja, jb, _| {
+                            out.leaf_pairs.push((ja, jb));
+                            true
+                        },
+                    );
+                    out.node_pairs_visited += visited - 1;
+                }
+            }
+        }
+        out.pruned_bound = pruned.min(1.0);
+        out
     }
 }

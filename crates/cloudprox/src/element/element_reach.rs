@@ -309,6 +309,7 @@ pub(crate) fn surfaces_may_reach(
     let visited = a.tree.descend_pairs(
         &b.tree,
         &mut workspace.tagged_pairs,
+        (0, 0),
         true,
         |ia, ib, _| {
             let (ia, ib) = (ia as usize, ib as usize);

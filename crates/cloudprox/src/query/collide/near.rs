@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use crate::bvh::{Bvh, BvhWorkspace};
+use crate::bvh::{Bvh, BvhWorkspace, NodeMargins};
 use crate::cloud::PointCloud;
 use crate::math::Pose;
 use crate::query::collide::region::{
@@ -65,29 +65,31 @@ pub(crate) fn near_set(
     let ctx = request.near_context.max(SAMPLING_MARGIN);
     let eps = request.prune_epsilon;
     if request.use_hierarchy {
-        let (ma, mb) = (margins(a, SAMPLING_MARGIN), margins(b, SAMPLING_MARGIN));
-        // The core's leaf pairs and, where the context reaches farther, the
-        // context's, in one descent (the second holds the first).
-        let (mut t, wider) = if ctx > SAMPLING_MARGIN {
-            let (ca, cb) = (margins(a, ctx), margins(b, ctx));
-            let (core_t, wider) =
-                a.bvh()
-                    .traverse_pairs_nested(b.bvh(), rel, eps, (&ma, &mb), (&ca, &cb), workspace);
-            (core_t, Some(wider))
-        } else {
-            let t = a
-                .bvh()
-                .traverse_pairs(b.bvh(), rel, eps, &ma, &mb, workspace);
-            (t, None)
+        // Margins of so many spacings: each node's largest, scaled.
+        let margins = |scale: Real| NodeMargins {
+            a: a.node_spacing(),
+            b: b.node_spacing(),
+            scale,
         };
+        // The core's leaf pairs and what the context's traversal adds to
+        // them, finished only if a core point is found: each node pair is
+        // descended once.
+        let (mut t, wider) = a.bvh().traverse_pairs_nested(
+            b.bvh(),
+            rel,
+            eps,
+            margins(SAMPLING_MARGIN),
+            margins(ctx),
+            workspace,
+        );
         let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE, None);
         let links = add_links_to_core(&links(&core), &mut core);
         // Only the leaf pairs and the links set core flags: without either,
         // none is set, and a query the bounds decide does not scan its clouds.
         let any_near = (!t.leaf_pairs.is_empty() || !links.is_empty()) && core.0.iter().any(|&k| k);
         let mut keep = core.clone();
-        if let Some(wider) = wider.filter(|_| any_near) {
-            t = wider;
+        if any_near && ctx > SAMPLING_MARGIN {
+            t = wider.finish(workspace);
             // With a positive epsilon the context's rule finds every core
             // point the core's rule found (the links' run starts it may not
             // find are kept with their runs below): it need not look for them
@@ -203,9 +205,4 @@ fn leaf_of(bvh: &Bvh) -> Vec<u32> {
         }
     }
     leaf
-}
-
-/// Per-node margins of `spacings` sampling spacings.
-fn margins(cloud: &PointCloud, spacings: Real) -> Vec<Real> {
-    cloud.node_spacing().iter().map(|s| s * spacings).collect()
 }
