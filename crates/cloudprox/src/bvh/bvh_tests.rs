@@ -149,7 +149,11 @@ fn the_shortcut_changes_no_traversal() {
             &tb,
             &Pose::identity(),
             eps,
-            (&[], &margins),
+            NodeMargins {
+                a: &[],
+                b: &margins,
+                scale: 1.0,
+            },
             f64::NEG_INFINITY,
             &mut ws,
         );
@@ -224,9 +228,9 @@ fn the_nested_traversal_is_the_two_traversals() {
     let settings = BvhSettings { leaf_max_points: 8 };
     let ta = Bvh::build(&a, &sa, &settings).unwrap();
     let mut ws = BvhWorkspace::default();
-    let spacing = |t: &Bvh, k: f64| -> Vec<f64> {
+    let spacing = |t: &Bvh| -> Vec<f64> {
         (0..t.nodes().len())
-            .map(|i| k * 0.01 * (1.0 + (i % 7) as f64 / 7.0))
+            .map(|i| 0.01 * (1.0 + (i % 7) as f64 / 7.0))
             .collect()
     };
     let mut differ = 0;
@@ -249,8 +253,12 @@ fn the_nested_traversal_is_the_two_traversals() {
             nalgebra::Translation3::new(0.01, -0.02, 0.0),
             nalgebra::UnitQuaternion::from_euler_angles(angle, 0.5 * angle, 0.0),
         );
-        let (ia, ib) = (spacing(&ta, 0.5), spacing(&tb, 0.5));
-        let (oa, ob) = (spacing(&ta, 2.0), spacing(&tb, 2.0));
+        // Margins as the near set gives them: each node's spacing times a
+        // factor (half a spacing inside, two outside).
+        let (sa_nodes, sb_nodes) = (spacing(&ta), spacing(&tb));
+        let times = |v: &[f64], k: f64| -> Vec<f64> { v.iter().map(|x| x * k).collect() };
+        let (ia, ib) = (times(&sa_nodes, 0.5), times(&sb_nodes, 0.5));
+        let (oa, ob) = (times(&sa_nodes, 2.0), times(&sb_nodes, 2.0));
         let inner = ta.traverse_pairs(&tb, &pose, eps, &ia, &ib, &mut ws);
         let outer = ta.traverse_pairs(&tb, &pose, eps, &oa, &ob, &mut ws);
         for (t, m) in [(&inner, (&ia[..], &ib[..])), (&outer, (&oa[..], &ob[..]))] {
@@ -275,14 +283,14 @@ fn the_nested_traversal_is_the_two_traversals() {
             &pose,
             eps,
             NodeMargins {
-                a: &ia,
-                b: &ib,
-                scale: 1.0,
+                a: &sa_nodes,
+                b: &sb_nodes,
+                scale: 0.5,
             },
             NodeMargins {
-                a: &oa,
-                b: &ob,
-                scale: 1.0,
+                a: &sa_nodes,
+                b: &sb_nodes,
+                scale: 2.0,
             },
             &mut ws,
         );

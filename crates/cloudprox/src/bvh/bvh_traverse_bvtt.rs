@@ -154,7 +154,11 @@ impl Bvh {
             other,
             pose,
             epsilon,
-            (margin_self, margin_other),
+            NodeMargins {
+                a: margin_self,
+                b: margin_other,
+                scale: 1.0,
+            },
             keep_within,
             workspace,
         )
@@ -168,36 +172,21 @@ impl Bvh {
         other: &Bvh,
         pose: &Pose,
         epsilon: Real,
-        margins: (&[Real], &[Real]),
+        margins: NodeMargins<'_>,
         keep_within: Real,
         workspace: &mut BvhWorkspace,
     ) -> PairTraversal {
         let test = PairTest::new(self, other, pose, epsilon, keep_within);
-        let margins = NodeMargins {
-            a: margins.0,
-            b: margins.1,
-            scale: 1.0,
-        };
         let mut out = PairTraversal::default();
         let mut pruned_bound = 0.0;
         let mut leaf_pairs = Vec::new();
         out.node_pairs_visited = self.descend_pairs(
             other,
-            &mut workspace.tagged_pairs,
+            &mut workspace.pair_stack,
             (0, 0),
-            true,
-            |ia, ib, _| {
-                let gap = test.distance(ia, ib);
-                match test.pruned(ia, ib, gap, margins, pruned_bound >= 1.0) {
-                    Some(bound) => {
-                        pruned_bound += bound;
-                        None
-                    }
-                    None => Some(true),
-                }
-            },
-            |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
-            |ia, ib, _| {
+            |ia, ib| test.keeps(ia, ib, margins, &mut pruned_bound),
+            |ia, ib| test.split_first(ia, ib),
+            |ia, ib| {
                 leaf_pairs.push((ia, ib));
                 true
             },
@@ -239,10 +228,9 @@ impl Bvh {
         let mut leaf_pairs = Vec::new();
         t_in.node_pairs_visited = self.descend_pairs(
             other,
-            &mut workspace.tagged_pairs,
+            &mut workspace.pair_stack,
             (0, 0),
-            true,
-            |ia, ib, _| {
+            |ia, ib| {
                 let gap = test.distance(ia, ib);
                 let Some(bound) = test.pruned(ia, ib, gap, inner, pruned_in >= 1.0) else {
                     debug_assert!(test.pruned(ia, ib, gap, outer, false).is_none());
@@ -251,7 +239,7 @@ impl Bvh {
                         leaf_pairs.push((ia, ib));
                         steps.push(Step::Leaf(ia, ib));
                     }
-                    return Some(true);
+                    return true;
                 };
                 pruned_in += bound;
                 // (The outer sum so far leaves out the pairs still to be
@@ -263,10 +251,10 @@ impl Bvh {
                     }
                     None => steps.push(Step::Descend(ia, ib)),
                 }
-                None
+                false
             },
-            |ia, ib| self.nodes[ia as usize].count >= other.nodes[ib as usize].count,
-            |_, _, _| true,
+            |ia, ib| test.split_first(ia, ib),
+            |_, _| true,
         );
         t_in.leaf_pairs = leaf_pairs;
         t_in.pruned_bound = pruned_in.min(1.0);
@@ -280,55 +268,51 @@ impl Bvh {
     }
 
     /// The bounding volume test tree of `self` and `other`: from the pair of
-    /// nodes `start` (the roots: `(0, 0)`; tagged `root`), every node pair for
-    /// which `keep` gives a tag is
-    /// descended, its children carrying that tag (where both nodes have
-    /// children, `self`'s node is split when `split_self` says so; both nodes
-    /// leaves: `leaf` is called with it), until `leaf` returns `false`.
-    /// Returns the number of node pairs tested. The traversals differ in
-    /// `keep` (what bounds a node pair, and what its descendants should know
-    /// of it), in which node they split first and in what a leaf pair does.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn descend_pairs<T: Copy>(
+    /// nodes `(root_a, root_b)` (the roots: `(0, 0)`), every node pair for
+    /// which `keep` holds is descended (where both nodes have children,
+    /// `self`'s node is split when `split_self` says so; both nodes leaves:
+    /// `leaf` is called), until `leaf` returns `false`. Returns the number of
+    /// node pairs tested. The traversals differ in `keep` (what bounds a node
+    /// pair), in which node they split first and in what a leaf pair does.
+    pub(crate) fn descend_pairs(
         &self,
         other: &Bvh,
-        stack: &mut Vec<(u32, u32, T)>,
+        stack: &mut Vec<(u32, u32)>,
         (root_a, root_b): (u32, u32),
-        root: T,
-        mut keep: impl FnMut(u32, u32, T) -> Option<T>,
+        mut keep: impl FnMut(u32, u32) -> bool,
         split_self: impl Fn(u32, u32) -> bool,
-        mut leaf: impl FnMut(u32, u32, T) -> bool,
+        mut leaf: impl FnMut(u32, u32) -> bool,
     ) -> usize {
         let mut visited = 0;
         stack.clear();
-        stack.push((root_a, root_b, root));
-        while let Some((ia, ib, above)) = stack.pop() {
+        stack.push((root_a, root_b));
+        while let Some((ia, ib)) = stack.pop() {
             visited += 1;
-            let Some(tag) = keep(ia, ib, above) else {
+            if !keep(ia, ib) {
                 continue;
-            };
+            }
             let (na, nb) = (&self.nodes[ia as usize], &other.nodes[ib as usize]);
             match (na.children, nb.children) {
                 (None, None) => {
-                    if !leaf(ia, ib, tag) {
+                    if !leaf(ia, ib) {
                         break;
                     }
                 }
                 (Some([l, r]), None) => {
-                    stack.push((l, ib, tag));
-                    stack.push((r, ib, tag));
+                    stack.push((l, ib));
+                    stack.push((r, ib));
                 }
                 (None, Some([l, r])) => {
-                    stack.push((ia, l, tag));
-                    stack.push((ia, r, tag));
+                    stack.push((ia, l));
+                    stack.push((ia, r));
                 }
                 (Some([al, ar]), Some([bl, br])) => {
                     if split_self(ia, ib) {
-                        stack.push((al, ib, tag));
-                        stack.push((ar, ib, tag));
+                        stack.push((al, ib));
+                        stack.push((ar, ib));
                     } else {
-                        stack.push((ia, bl, tag));
-                        stack.push((ia, br, tag));
+                        stack.push((ia, bl));
+                        stack.push((ia, br));
                     }
                 }
             }
@@ -391,6 +375,26 @@ impl<'t> PairTest<'t> {
                 z.max(0.0) * (1.0 + 1e-6)
             },
         }
+    }
+
+    /// Whether the pair `(ia, ib)` is kept with `margins`; if not, its bound
+    /// is added to `sum` (a running sum of pruned bounds, capped at 1 where
+    /// it is read: see [`PairTest::pruned`]'s `saturated`).
+    fn keeps(&self, ia: u32, ib: u32, margins: NodeMargins<'_>, sum: &mut Real) -> bool {
+        let gap = self.distance(ia, ib);
+        match self.pruned(ia, ib, gap, margins, *sum >= 1.0) {
+            Some(bound) => {
+                *sum += bound;
+                false
+            }
+            None => true,
+        }
+    }
+
+    /// Whether the first hierarchy's node of a pair is split first: the one
+    /// with more points.
+    fn split_first(&self, ia: u32, ib: u32) -> bool {
+        self.a.nodes[ia as usize].count >= self.b.nodes[ib as usize].count
     }
 
     /// The distance between the boxes of node `ia` (moved) and node `ib`.
@@ -475,24 +479,13 @@ impl WiderTraversal<'_> {
                     let mut first = true;
                     let visited = a.descend_pairs(
                         b,
-                        &mut workspace.tagged_pairs,
+                        &mut workspace.pair_stack,
                         (ia, ib),
-                        true,
-                        |ja, jb, _| {
-                            if std::mem::take(&mut first) {
-                                return Some(true);
-                            }
-                            let gap = test.distance(ja, jb);
-                            match test.pruned(ja, jb, gap, margins, pruned >= 1.0) {
-                                Some(bound) => {
-                                    pruned += bound;
-                                    None
-                                }
-                                None => Some(true),
-                            }
+                        |ja, jb| {
+                            std::mem::take(&mut first) || test.keeps(ja, jb, margins, &mut pruned)
                         },
-                        |ja, jb| a.nodes[ja as usize].count >= b.nodes[jb as usize].count,
-                        |ja, jb, _| {
+                        |ja, jb| test.split_first(ja, jb),
+                        |ja, jb| {
                             out.leaf_pairs.push((ja, jb));
                             true
                         },

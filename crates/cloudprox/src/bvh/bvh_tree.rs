@@ -89,7 +89,6 @@ impl Bvh {
 #[derive(Debug, Clone, Default)]
 pub struct BvhWorkspace {
     pub(crate) pair_stack: Vec<(u32, u32)>,
-    pub(crate) tagged_pairs: Vec<(u32, u32, bool)>,
     pub(crate) node_heap: Vec<(Real, u32)>,
     pub(crate) node_stack: Vec<u32>,
 }

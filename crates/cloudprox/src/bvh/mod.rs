@@ -35,7 +35,7 @@ mod point_search;
 mod bvh_tests;
 
 pub use aabb::{Aabb, BoxMotion};
-pub(crate) use bvh_traverse_bvtt::NodeMargins;
+pub(crate) use bvh_traverse_bvtt::{kept_without_bound, NodeMargins};
 pub use bvh_traverse_bvtt::{prune_bound, PairTraversal};
 pub use bvh_tree::{Bvh, BvhNode, BvhSettings, BvhWorkspace};
 

@@ -308,21 +308,19 @@ pub(crate) fn surfaces_may_reach(
     let mut posed: Vec<PosedHull> = Vec::new();
     let visited = a.tree.descend_pairs(
         &b.tree,
-        &mut workspace.tagged_pairs,
+        &mut workspace.pair_stack,
         (0, 0),
-        true,
-        |ia, ib, _| {
+        |ia, ib| {
             let (ia, ib) = (ia as usize, ib as usize);
             let only = surfaces_only();
             let (na, nb) = (a.bounds(only), b.bounds(only));
-            (na.any[ia]
+            na.any[ia]
                 && nb.any[ib]
                 && !boxes.apart(
                     &na.boxes[ia],
                     &nb.boxes[ib],
                     NodeBounds::limit(na, ia, nb, ib, reach_sds),
-                ))
-            .then_some(true)
+                )
         },
         // The node whose box, grown by its reach, is the larger first: hulls
         // differ in size and noise far more than points do.
@@ -334,7 +332,7 @@ pub(crate) fn surfaces_may_reach(
             let only = surfaces_only();
             size(a.bounds(only), ia) >= size(b.bounds(only), ib)
         },
-        |la, lb, _| {
+        |la, lb| {
             let own = a.tree.node_points(la);
             posed.clear();
             posed.extend(

@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use crate::bvh::{Bvh, BvhWorkspace, NodeMargins};
+use crate::bvh::{kept_without_bound, Bvh, BvhWorkspace, NodeMargins};
 use crate::cloud::PointCloud;
 use crate::math::Pose;
 use crate::query::collide::region::{
@@ -71,31 +71,46 @@ pub(crate) fn near_set(
             b: b.node_spacing(),
             scale,
         };
-        // The core's leaf pairs and what the context's traversal adds to
-        // them, finished only if a core point is found: each node pair is
-        // descended once.
-        let (mut t, wider) = a.bvh().traverse_pairs_nested(
-            b.bvh(),
-            rel,
-            eps,
-            margins(SAMPLING_MARGIN),
-            margins(ctx),
-            workspace,
-        );
+        // The core's leaf pairs and, where the context reaches farther, what
+        // the context's traversal adds to them, finished only if a core point
+        // is found: each node pair is descended once.
+        let (mut t, wider) = if ctx > SAMPLING_MARGIN {
+            let (t, wider) = a.bvh().traverse_pairs_nested(
+                b.bvh(),
+                rel,
+                eps,
+                margins(SAMPLING_MARGIN),
+                margins(ctx),
+                workspace,
+            );
+            (t, Some(wider))
+        } else {
+            let t = a.bvh().traverse_pairs_keeping(
+                b.bvh(),
+                rel,
+                eps,
+                margins(SAMPLING_MARGIN),
+                kept_without_bound(eps),
+                workspace,
+            );
+            (t, None)
+        };
         let mut core = near_points(&t.leaf_pairs, rel, a, b, eps, SAMPLING_MARGIN, NONE, None);
         let links = add_links_to_core(&links(&core), &mut core);
         // Only the leaf pairs and the links set core flags: without either,
         // none is set, and a query the bounds decide does not scan its clouds.
         let any_near = (!t.leaf_pairs.is_empty() || !links.is_empty()) && core.0.iter().any(|&k| k);
         let mut keep = core.clone();
-        if any_near && ctx > SAMPLING_MARGIN {
+        if let Some(wider) = wider.filter(|_| any_near) {
             t = wider.finish(workspace);
-            // With a positive epsilon the context's rule finds every core
-            // point the core's rule found (the links' run starts it may not
-            // find are kept with their runs below): it need not look for them
-            // again. (With 0, a noise-free pair within half a spacing is core
-            // but beyond a single-point element's own context.)
-            let found = (eps > 0.0).then_some(&core);
+            // Where the rule's reach in deviations, `-Phi^-1(epsilon / 2)`, is
+            // finite, the context's rule finds every core point the core's
+            // rule found (the links' run starts it may not find are kept with
+            // their runs below): it need not look for them again. (Where it is
+            // infinite, epsilon / 2 rounding to 0, a noise-free pair within
+            // half a spacing is core but beyond a single-point element's own
+            // context.)
+            let found = (0.5 * eps > 0.0).then_some(&core);
             keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context, found);
         }
         stats.counters.node_pairs_visited += t.node_pairs_visited;
