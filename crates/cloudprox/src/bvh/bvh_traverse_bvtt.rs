@@ -225,7 +225,6 @@ impl Bvh {
         let mut t_in = PairTraversal::default();
         let (mut pruned_in, mut pruned_out) = (0.0, 0.0);
         let mut steps = Vec::new();
-        let mut leaf_pairs = Vec::new();
         t_in.node_pairs_visited = self.descend_pairs(
             other,
             &mut workspace.pair_stack,
@@ -236,7 +235,6 @@ impl Bvh {
                     debug_assert!(test.pruned(ia, ib, gap, outer, false).is_none());
                     // A kept pair of leaves (the descent's `leaf` below).
                     if self.nodes[ia as usize].is_leaf() && other.nodes[ib as usize].is_leaf() {
-                        leaf_pairs.push((ia, ib));
                         steps.push(Step::Leaf(ia, ib));
                     }
                     return true;
@@ -256,7 +254,14 @@ impl Bvh {
             |ia, ib| test.split_first(ia, ib),
             |_, _| true,
         );
-        t_in.leaf_pairs = leaf_pairs;
+        // The inner leaf pairs are the recorded ones, in order.
+        t_in.leaf_pairs = steps
+            .iter()
+            .filter_map(|step| match *step {
+                Step::Leaf(ia, ib) => Some((ia, ib)),
+                _ => None,
+            })
+            .collect();
         t_in.pruned_bound = pruned_in.min(1.0);
         let wider = WiderTraversal {
             test,
