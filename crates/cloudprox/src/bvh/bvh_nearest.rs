@@ -4,6 +4,29 @@ use crate::bvh::{Bvh, BvhWorkspace};
 use crate::math::Point3;
 use crate::Real;
 
+/// Offers point `j` at squared distance `d2` to `out`, the `k` (at least 1)
+/// nearest so far sorted by distance and, where distances tie, by index: it
+/// enters only before the `k`-th, which then leaves (ties at the `k`-th
+/// distance go to the smaller index, as in the hashed grid's k-NN). Moved
+/// into place by swaps: `k` is small, a shift by `Vec::insert` costs a
+/// `memcpy` call.
+#[inline]
+pub(crate) fn offer_nearest(out: &mut Vec<(Real, u32)>, k: usize, d2: Real, j: u32) {
+    let before = |&(d, i): &(Real, u32)| d < d2 || (d == d2 && i < j);
+    if out.len() < k {
+        out.push((d2, j));
+    } else if before(&out[k - 1]) {
+        return;
+    } else {
+        out[k - 1] = (d2, j);
+    }
+    let mut p = out.len() - 1;
+    while p > 0 && !before(&out[p - 1]) {
+        out.swap(p - 1, p);
+        p -= 1;
+    }
+}
+
 impl Bvh {
     /// The `k` points nearest to `query`, as `(squared distance, point index)`
     /// sorted by distance and, where distances tie, by index (so ties at the
@@ -33,15 +56,7 @@ impl Bvh {
             match node.children {
                 None => {
                     for &i in self.node_points(id) {
-                        let d2 = (points[i as usize] - query).norm_squared();
-                        // Ties at the k-th distance go to the smaller index
-                        // (as in the hashed grid's k-NN).
-                        let before = |&(d, j): &(Real, u32)| d < d2 || (d == d2 && j < i);
-                        if out.len() < k || !before(&out[k - 1]) {
-                            let pos = out.partition_point(before);
-                            out.insert(pos, (d2, i));
-                            out.truncate(k);
-                        }
+                        offer_nearest(out, k, (points[i as usize] - query).norm_squared(), i);
                     }
                 }
                 Some([l, r]) => {

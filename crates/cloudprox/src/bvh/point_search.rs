@@ -14,6 +14,7 @@
 use std::borrow::Cow;
 use std::cell::RefCell;
 
+use crate::bvh::bvh_nearest::offer_nearest;
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::math::Point3;
 use crate::Real;
@@ -70,16 +71,9 @@ impl<'a> PointSearch<'a> {
         if k == 0 {
             return;
         }
-        out.extend(
-            self.points
-                .iter()
-                .zip(0u32..)
-                .map(|(y, j)| ((y - x).norm_squared(), j)),
-        );
-        let order = |a: &(Real, u32), b: &(Real, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        out.select_nth_unstable_by(k - 1, order);
-        out.truncate(k);
-        out.sort_unstable_by(order);
+        for (y, j) in self.points.iter().zip(0u32..) {
+            offer_nearest(out, k, (y - x).norm_squared(), j);
+        }
     }
 
     /// The points with `(p - x).norm() <= r`, into `out`, in index order.
@@ -181,6 +175,39 @@ mod tests {
             .map(|i| Point3::new((i % 30) as Real * 0.01, (i / 30) as Real * 0.01, 0.0))
             .collect();
         check(&lattice, &[0.01, 0.02 * std::f64::consts::SQRT_2, 0.03]);
+    }
+
+    #[test]
+    fn the_nearest_are_the_first_of_all_points_sorted_by_distance_then_index() {
+        // The reference sorts every point, independently of the insertion
+        // both searches share; a lattice makes most k-th distances ties.
+        let lattice: Vec<Point3> = (0..400)
+            .map(|i| Point3::new((i % 20) as Real, (i / 20) as Real, 0.0))
+            .collect();
+        let (tree, scan) = (
+            PointSearch::new(&lattice[..]),
+            PointSearch::scan(&lattice[..]),
+        );
+        let mut out = Vec::new();
+        for q in [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(7.0, 9.0, 0.0),
+            Point3::new(7.5, 9.5, 1.0),
+            Point3::new(19.0, 3.5, 0.0),
+        ] {
+            let mut all: Vec<(Real, u32)> = lattice
+                .iter()
+                .zip(0u32..)
+                .map(|(p, j)| ((p - q).norm_squared(), j))
+                .collect();
+            all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for k in [1, 2, 5, 9, 40] {
+                for search in [&tree, &scan] {
+                    search.nearest(&q, k, &mut out);
+                    assert_eq!(out, all[..k], "query {q:?}, k {k}");
+                }
+            }
+        }
     }
 
     #[test]

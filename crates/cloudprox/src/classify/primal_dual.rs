@@ -207,20 +207,34 @@ pub(crate) struct Solution {
     pub iterations: u32,
 }
 
-/// The primal-dual method on the cones `data` (surface dimension `d`).
+/// The primal-dual method on the cones `data` (surface dimension `d`: 3 or
+/// 9, the linear and quadric surfaces; `None` for any other).
 pub(crate) fn solve_primal_dual(
     data: &[ConeData],
     d: usize,
     lambda: Real,
     tol: Real,
 ) -> Option<Solution> {
+    // One solver per number of unknowns, so that every per-point loop over
+    // them has a constant length (unrolled; the same operations in the same
+    // order, so the same results as a loop over a run-time length).
+    match d + 1 {
+        4 => solve_fixed::<4>(data, lambda, tol),
+        MAX_UNKNOWNS => solve_fixed::<MAX_UNKNOWNS>(data, lambda, tol),
+        _ => None,
+    }
+}
+
+/// [`solve_primal_dual`] with `M = d + 1` unknowns `z = (w, b)`.
+fn solve_fixed<const M: usize>(data: &[ConeData], lambda: Real, tol: Real) -> Option<Solution> {
     let n = data.len();
-    let m = d + 1;
+    let m = M;
+    let d = M - 1;
     let nu = (2 * n) as Real;
 
     // Start: x = 0 with unit slacks, s and y on the cones' axes, y splitting
     // lambda between each point's two constraints (dual residual zero in xi).
-    let mut z = vec![0.0; m];
+    let mut z = [0.0; M];
     let mut xi = vec![1.0; n];
     let mut sc: Vec<Cone> = vec![[1.0, 0.0, 0.0, 0.0]; n];
     let mut yc: Vec<Cone> = vec![[0.5 * lambda, 0.0, 0.0, 0.0]; n];
@@ -231,12 +245,12 @@ pub(crate) fn solve_primal_dual(
     let mut scal = vec![Scaling::default(); n];
     let mut rs: Vec<Cone> = vec![[0.0; 4]; n];
     let mut rsn = vec![0.0; n];
-    let mut rz = vec![0.0; m];
+    let mut rz = [0.0; M];
     let mut rxi = vec![0.0; n];
     let mut delta = vec![0.0; n];
-    let mut hcol = vec![0.0; n * m];
+    let mut hcol: Vec<[Real; M]> = vec![[0.0; M]; n];
     let mut s_mat = DMatrix::<Real>::zeros(m, m);
-    let (mut aff, mut cor) = (Direction::new(n, m), Direction::new(n, m));
+    let (mut aff, mut cor) = (Direction::<M>::new(n), Direction::<M>::new(n));
     // Each point's `B^T B` (packed lower triangle), fixed over the iterations:
     // the Schur complement then adds three terms per entry, not five.
     let btb: Vec<[Real; PACKED]> = data.iter().map(|pd| packed_btb(pd, m)).collect();
@@ -284,10 +298,10 @@ pub(crate) fn solve_primal_dual(
             let sc_i = Scaling::new(&sc[i], &yc[i])?;
             scal[i] = sc_i;
             let pd = &data[i];
-            let a = &pd.a[..m];
+            let a = &pd.a;
             let v = [sc_i.w[0], -sc_i.w[1], -sc_i.w[2], -sc_i.w[3]];
             let c1 = 1.0 / (sc_i.eta * sc_i.eta);
-            let mut p = [0.0; MAX_UNKNOWNS];
+            let mut p = [0.0; M];
             pd.add_transposed(&v, &mut p);
             let di = c1 * (2.0 * v[0] * v[0] - 1.0) + yn[i] / sn[i];
             delta[i] = di;
@@ -296,7 +310,7 @@ pub(crate) fn solve_primal_dual(
             let alpha = -c1 - c1 * c1 * inv_d;
             let beta = 2.0 * c1 - 4.0 * c1 * c1 * v[0] * v[0] * inv_d;
             let gamma = 2.0 * c1 * c1 * v[0] * inv_d;
-            let hi = &mut hcol[i * m..(i + 1) * m];
+            let hi = &mut hcol[i];
             let bb = &btb[i];
             for k in 0..m {
                 hi[k] = c1 * (2.0 * v[0] * p[k] - a[k]);
@@ -322,12 +336,9 @@ pub(crate) fn solve_primal_dual(
         // `W^-1 ds + W dy = lambda \ rc`, given `wq = W (lambda \ rc)` per cone
         // and `wqn = rc / y` per half-line, with the largest step that keeps
         // `s` and `y` in their cones.
-        let solve_dir = |wq: &[Cone], wqn: &[Real], dir: &mut Direction| -> Option<Real> {
+        let solve_dir = |wq: &[Cone], wqn: &[Real], dir: &mut Direction<M>| -> Option<Real> {
             // t = W^-2 (wq + r_s), and the reduced right-hand side.
-            let mut rhs_z = DVector::<Real>::zeros(m);
-            for k in 0..m {
-                rhs_z[k] = -rz[k];
-            }
+            let mut rhs_z = rz.map(|x| -x);
             for i in 0..n {
                 let u = [
                     wq[i][0] + rs[i][0],
@@ -339,19 +350,19 @@ pub(crate) fn solve_primal_dual(
                 dir.tc[i] = t;
                 let tn = yn[i] / sn[i] * (wqn[i] + rsn[i]);
                 dir.tn[i] = tn;
-                data[i].add_transposed(&t, rhs_z.as_mut_slice());
+                data[i].add_transposed(&t, &mut rhs_z);
                 let rhs_xi = -rxi[i] + t[0] + tn;
                 dir.rhs_xi[i] = rhs_xi;
                 let f = rhs_xi / delta[i];
-                for (r, h) in rhs_z.iter_mut().zip(&hcol[i * m..(i + 1) * m]) {
+                for (r, h) in rhs_z.iter_mut().zip(&hcol[i]) {
                     *r -= h * f;
                 }
             }
-            let dz = chol.solve(&rhs_z);
+            let dz = chol.solve(&DVector::from_column_slice(&rhs_z));
             dir.dz.copy_from_slice(dz.as_slice());
             let mut alpha: Real = 1.0 / STEP_FRACTION;
             for i in 0..n {
-                let hi = &hcol[i * m..(i + 1) * m];
+                let hi = &hcol[i];
                 let hdz: Real = hi.iter().zip(&dir.dz).map(|(a, b)| a * b).sum();
                 let dxi = (dir.rhs_xi[i] - hdz) / delta[i];
                 dir.dxi[i] = dxi;
@@ -454,8 +465,8 @@ fn finite_solution(z: &[Real], xi: &[Real], d: usize, iterations: u32) -> Option
 }
 
 /// One Newton direction of every variable, with its scratch.
-struct Direction {
-    dz: Vec<Real>,
+struct Direction<const M: usize> {
+    dz: [Real; M],
     dxi: Vec<Real>,
     dsc: Vec<Cone>,
     dyc: Vec<Cone>,
@@ -466,10 +477,10 @@ struct Direction {
     rhs_xi: Vec<Real>,
 }
 
-impl Direction {
-    fn new(n: usize, m: usize) -> Self {
+impl<const M: usize> Direction<M> {
+    fn new(n: usize) -> Self {
         Self {
-            dz: vec![0.0; m],
+            dz: [0.0; M],
             dxi: vec![0.0; n],
             dsc: vec![[0.0; 4]; n],
             dyc: vec![[0.0; 4]; n],
@@ -517,6 +528,31 @@ mod tests {
         let q = jdiv(&l, &jprod(&l, &x));
         for k in 0..4 {
             assert!((q[k] - x[k]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn only_the_surfaces_numbers_of_unknowns_are_solved() {
+        // The linear and quadric surfaces (3 and 9 coefficients) have their
+        // own solvers; any other dimension is refused (the caller falls back
+        // to Clarabel), not solved with a wrong layout.
+        let mut cone = ConeData {
+            a: [0.0; MAX_UNKNOWNS],
+            b: [[0.0; MAX_UNKNOWNS]; 3],
+        };
+        // `a . z` reads `w_0 + b` (linear: `b` is z_3) or `w_0 + w_3 + b`
+        // (quadric: `b` is z_9).
+        for k in [0, 3, 9] {
+            cone.a[k] = 1.0;
+        }
+        let mut other = cone;
+        other.a = cone.a.map(|x| -x);
+        let data = [cone, other];
+        for d in [3, 9] {
+            assert!(solve_primal_dual(&data, d, 1.0, 1e-8).is_some(), "d = {d}");
+        }
+        for d in [0, 2, 5, 10] {
+            assert!(solve_primal_dual(&data, d, 1.0, 1e-8).is_none(), "d = {d}");
         }
     }
 

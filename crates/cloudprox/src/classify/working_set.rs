@@ -61,7 +61,7 @@ pub(crate) fn solve_reduced(
             if in_set[i] {
                 continue;
             }
-            let g = data[i].apply(&z);
+            let g = data[i].apply_slice(&z);
             let u = g[0] - 1.0;
             let viol = (g[1] * g[1] + g[2] * g[2] + g[3] * g[3]).sqrt() - u;
             if viol > 1e-9 * (1.0 + u.abs()) {
@@ -99,14 +99,15 @@ fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
     if n <= WORKING_SET_TREE_MIN {
         // Every pair of opposite labels once, each distance updating both ends.
         let mut d2 = vec![Real::INFINITY; n];
-        for i in 0..n {
-            for j in i + 1..n {
-                if labels[j] != labels[i] {
-                    let d = (norm.u[i] - norm.u[j]).norm_squared();
-                    d2[i] = d2[i].min(d);
-                    d2[j] = d2[j].min(d);
-                }
+        let (pos, neg): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == 1.0);
+        for &i in &pos {
+            let mut best = Real::INFINITY;
+            for &j in &neg {
+                let d = (norm.u[i] - norm.u[j]).norm_squared();
+                best = best.min(d);
+                d2[j] = d2[j].min(d);
             }
+            d2[i] = best;
         }
         return d2;
     }
@@ -160,29 +161,32 @@ mod tests {
     use crate::sample::{add_noise, sphere};
 
     #[test]
-    fn the_nearest_opposite_point_from_the_hierarchies_is_the_brute_forces() {
+    fn the_nearest_opposite_point_is_the_brute_forces() {
         // Two interpenetrating noisy spheres, above the size where the
-        // hierarchies take over; and one label alone (no opposite point).
-        let a = add_noise(&sphere(&Point3::origin(), 0.1, 700), 0.002, 1);
-        let b = add_noise(&sphere(&Point3::new(0.15, 0.0, 0.0), 0.1, 500), 0.002, 2);
-        let points: Vec<Point3> = a.iter().chain(&b).copied().collect();
-        let labels: Vec<Real> = (0..points.len())
-            .map(|i| if i < a.len() { 1.0 } else { -1.0 })
-            .collect();
-        let covs = vec![Matrix3::identity() * 4e-6; points.len()];
-        let norm = Normalized::new(&points, &covs);
-        assert!(points.len() > WORKING_SET_TREE_MIN);
-        let fast = nearest_opposite(&norm, &labels);
-        for (i, &d2) in fast.iter().enumerate() {
-            let brute = (0..points.len())
-                .filter(|&j| labels[j] != labels[i])
-                .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
-                .fold(Real::INFINITY, Real::min);
-            assert_eq!(d2, brute, "point {i}");
+        // hierarchies take over and below it (the scan over opposite pairs);
+        // and one label alone (no opposite point).
+        for (na, nb) in [(700, 500), (150, 90)] {
+            let a = add_noise(&sphere(&Point3::origin(), 0.1, na), 0.002, 1);
+            let b = add_noise(&sphere(&Point3::new(0.15, 0.0, 0.0), 0.1, nb), 0.002, 2);
+            let points: Vec<Point3> = a.iter().chain(&b).copied().collect();
+            let labels: Vec<Real> = (0..points.len())
+                .map(|i| if i < a.len() { 1.0 } else { -1.0 })
+                .collect();
+            let covs = vec![Matrix3::identity() * 4e-6; points.len()];
+            let norm = Normalized::new(&points, &covs);
+            assert_eq!(points.len() > WORKING_SET_TREE_MIN, na == 700);
+            let fast = nearest_opposite(&norm, &labels);
+            for (i, &d2) in fast.iter().enumerate() {
+                let brute = (0..points.len())
+                    .filter(|&j| labels[j] != labels[i])
+                    .map(|j| (norm.u[i] - norm.u[j]).norm_squared())
+                    .fold(Real::INFINITY, Real::min);
+                assert_eq!(d2, brute, "{na} + {nb} points, point {i}");
+            }
+            let alone = vec![1.0; points.len()];
+            assert!(nearest_opposite(&norm, &alone)
+                .iter()
+                .all(|d| d.is_infinite()));
         }
-        let alone = vec![1.0; points.len()];
-        assert!(nearest_opposite(&norm, &alone)
-            .iter()
-            .all(|d| d.is_infinite()));
     }
 }

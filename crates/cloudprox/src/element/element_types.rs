@@ -173,20 +173,16 @@ impl SurfaceElement {
             return false;
         }
         let h2 = h * h;
-        for di in -1..=1 {
-            for dj in -1..=1 {
-                let key = (ci.saturating_add(di), cj.saturating_add(dj));
-                let start = self.footprint.partition_point(|p| (p.0, p.1) < key);
-                let hit = self.footprint[start..]
-                    .iter()
-                    .take_while(|p| (p.0, p.1) == key)
-                    .any(|p| (Real::from(p.2) - u).powi(2) + (Real::from(p.3) - v).powi(2) <= h2);
-                if hit {
-                    return true;
-                }
-            }
-        }
-        false
+        // The three cells of a row around `cj` are one run of the sorted cells.
+        let (j0, j1) = (cj.saturating_sub(1), cj.saturating_add(1));
+        (-1..=1).any(|di| {
+            let row = ci.saturating_add(di);
+            let start = self.footprint.partition_point(|p| (p.0, p.1) < (row, j0));
+            self.footprint[start..]
+                .iter()
+                .take_while(|p| p.0 == row && p.1 <= j1)
+                .any(|p| (Real::from(p.2) - u).powi(2) + (Real::from(p.3) - v).powi(2) <= h2)
+        })
     }
 
     /// The covariance of a point of the fitted surface whose height variance is
