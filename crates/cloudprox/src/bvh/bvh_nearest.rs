@@ -4,14 +4,15 @@ use crate::bvh::{Bvh, BvhWorkspace};
 use crate::math::Point3;
 use crate::Real;
 
-/// Offers point `j` at squared distance `d2` to `out`, the `k` (at least 1)
-/// nearest so far sorted by distance and, where distances tie, by index: it
-/// enters only before the `k`-th, which then leaves (ties at the `k`-th
-/// distance go to the smaller index, as in the hashed grid's k-NN). Moved
-/// into place by swaps: `k` is small, a shift by `Vec::insert` costs a
-/// `memcpy` call.
+/// Offers point `j` at squared distance `d2` (not NaN: the points are
+/// finite) to `out`, the `k` (at least 1) nearest so far, at most `k` of
+/// them, sorted by distance and, where distances tie, by index: it enters
+/// only before the `k`-th, which then leaves (ties at the `k`-th distance go
+/// to the smaller index, as in the hashed grid's k-NN). Moved into place by
+/// swaps: `k` is small, a shift by `Vec::insert` costs a `memcpy` call.
 #[inline]
 pub(crate) fn offer_nearest(out: &mut Vec<(Real, u32)>, k: usize, d2: Real, j: u32) {
+    debug_assert!(k > 0 && out.len() <= k && !d2.is_nan());
     let before = |&(d, i): &(Real, u32)| d < d2 || (d == d2 && i < j);
     if out.len() < k {
         out.push((d2, j));

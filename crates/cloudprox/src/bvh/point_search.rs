@@ -1,11 +1,12 @@
 //! Neighbourhood queries over a set of points during a query (a patch side's
 //! points, a region's element means): a hierarchy built for the query above
-//! [`SEARCH_TREE_MIN`] points, a scan over every point below (and, in the
-//! tests, as the reference).
+//! [`SEARCH_TREE_MIN`] points, a scan over every point below (the tests
+//! compare the two, and both with a full sort of every point).
 //!
 //! Ties at the `k`-th distance go to the smaller index in both, as in the
 //! hashed grid's k-NN: a grid-sampled surface (a depth image, a lattice)
-//! gives many, and which of them is taken changes a neighbourhood.
+//! gives many, and which of them is taken changes a neighbourhood. Both keep
+//! their `k` nearest with the same insertion (`offer_nearest`).
 //!
 //! [`super::knn_of_every_point`] is the other k-NN of the crate: a whole
 //! cloud's, in parallel, when the cloud is prepared; this one runs inside one
@@ -45,7 +46,7 @@ impl<'a> PointSearch<'a> {
         Self { points, tree }
     }
 
-    /// A search that scans every point (the tests' reference).
+    /// A search that scans every point (compared with the hierarchy in tests).
     #[cfg(test)]
     pub(crate) fn scan(points: impl Into<Cow<'a, [Point3]>>) -> Self {
         Self {
@@ -201,10 +202,11 @@ mod tests {
                 .map(|(p, j)| ((p - q).norm_squared(), j))
                 .collect();
             all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for k in [1, 2, 5, 9, 40] {
+            // Beyond the number of points: all of them.
+            for k in [1, 2, 5, 9, 40, 400, 450] {
                 for search in [&tree, &scan] {
                     search.nearest(&q, k, &mut out);
-                    assert_eq!(out, all[..k], "query {q:?}, k {k}");
+                    assert_eq!(out, all[..k.min(all.len())], "query {q:?}, k {k}");
                 }
             }
         }

@@ -197,8 +197,9 @@ impl ConeData {
     /// solver's loops unroll).
     #[inline]
     pub fn apply<const M: usize>(&self, z: &[Real; M]) -> [Real; 4] {
+        const { assert!(M <= MAX_UNKNOWNS) };
         let mut g = [0.0; 4];
-        for (k, &zk) in z.iter().enumerate().take(MAX_UNKNOWNS) {
+        for (k, &zk) in z.iter().enumerate() {
             g[0] += self.a[k] * zk;
             g[1] += self.b[0][k] * zk;
             g[2] += self.b[1][k] * zk;
@@ -207,20 +208,11 @@ impl ConeData {
         g
     }
 
-    /// [`ConeData::apply`] on the first `z.len()` (at most [`MAX_UNKNOWNS`])
-    /// unknowns.
-    pub fn apply_slice(&self, z: &[Real]) -> [Real; 4] {
-        let mut padded = [0.0; MAX_UNKNOWNS];
-        for (p, x) in padded.iter_mut().zip(z) {
-            *p = *x;
-        }
-        self.apply(&padded)
-    }
-
     /// `out += t_0 a + B^T t_(1:3)` over the first `M` unknowns.
     #[inline]
     pub fn add_transposed<const M: usize>(&self, t: &[Real; 4], out: &mut [Real; M]) {
-        for (k, o) in out.iter_mut().enumerate().take(MAX_UNKNOWNS) {
+        const { assert!(M <= MAX_UNKNOWNS) };
+        for (k, o) in out.iter_mut().enumerate() {
             *o +=
                 t[0] * self.a[k] + t[1] * self.b[0][k] + t[2] * self.b[1][k] + t[3] * self.b[2][k];
         }

@@ -17,7 +17,7 @@
 
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
 use crate::classify::primal_dual::{solve_primal_dual, Solution};
-use crate::classify::problem::{cone_data, ConeData, Normalized};
+use crate::classify::problem::{cone_data, ConeData, Normalized, MAX_UNKNOWNS};
 use crate::classify::Surface;
 use crate::math::Point3;
 use crate::Real;
@@ -54,14 +54,16 @@ pub(crate) fn solve_reduced(
         let subset: Vec<ConeData> = idx.iter().map(|&i| data[i]).collect();
         let sol = solve_primal_dual(&subset, d, lambda, tol)?;
         iterations += sol.iterations;
-        let mut z = sol.w.clone();
-        z.push(sol.b);
+        // `(w, b)`, zeros after: the cones' coefficients there are zero too.
+        let mut z = [0.0; MAX_UNKNOWNS];
+        z[..d].copy_from_slice(&sol.w);
+        z[d] = sol.b;
         let mut violated = false;
         for i in 0..n {
             if in_set[i] {
                 continue;
             }
-            let g = data[i].apply_slice(&z);
+            let g = data[i].apply(&z);
             let u = g[0] - 1.0;
             let viol = (g[1] * g[1] + g[2] * g[2] + g[3] * g[3]).sqrt() - u;
             if viol > 1e-9 * (1.0 + u.abs()) {
@@ -89,17 +91,19 @@ pub(crate) fn solve_reduced(
 }
 
 /// Above this many points the nearest opposite point is found with a
-/// hierarchy over each cloud's points instead of by testing every pair.
+/// hierarchy over each cloud's points instead of by testing every opposite
+/// pair.
 const WORKING_SET_TREE_MIN: usize = 512;
 
 /// The squared distance from each point to the nearest point of the other
 /// label (infinite when there is none).
 fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
     let n = labels.len();
+    // The labels are +1 and -1 ([`super::train`] accepts no other).
+    let (pos, neg): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == 1.0);
+    let mut d2 = vec![Real::INFINITY; n];
     if n <= WORKING_SET_TREE_MIN {
         // Every pair of opposite labels once, each distance updating both ends.
-        let mut d2 = vec![Real::INFINITY; n];
-        let (pos, neg): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == 1.0);
         for &i in &pos {
             let mut best = Real::INFINITY;
             for &j in &neg {
@@ -112,17 +116,15 @@ fn nearest_opposite(norm: &Normalized, labels: &[Real]) -> Vec<Real> {
         return d2;
     }
     // One hierarchy per label, each queried by the other label's points.
-    let mut d2 = vec![Real::INFINITY; n];
     let mut ws = BvhWorkspace::default();
     let mut out = Vec::with_capacity(1);
-    for label in [1.0, -1.0] {
-        let (own, other): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| labels[i] == label);
+    for (own, other) in [(&pos, &neg), (&neg, &pos)] {
         let points: Vec<Point3> = other.iter().map(|&j| Point3::from(norm.u[j])).collect();
         let Ok(tree) = Bvh::build(&points, &vec![0.0; points.len()], &BvhSettings::default())
         else {
             continue; // no point of the other label
         };
-        for i in own {
+        for &i in own {
             tree.nearest_k(&points, &Point3::from(norm.u[i]), 1, &mut ws, &mut out);
             if let Some(&(d, _)) = out.first() {
                 d2[i] = d;

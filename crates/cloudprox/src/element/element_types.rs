@@ -298,3 +298,74 @@ impl SurfaceElements {
         self.elements.iter().filter(|e| !e.is_point()).count()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat element whose footprint holds `points` (tangential coordinates).
+    fn element_with_footprint(points: &[(Real, Real)], spacing: Real) -> SurfaceElement {
+        let mut footprint: Vec<FootprintPoint> = points
+            .iter()
+            .map(|&(u, v)| {
+                let (i, j) = footprint_cell(u, v, spacing);
+                (i, j, u as f32, v as f32)
+            })
+            .collect();
+        footprint.sort_unstable_by_key(|a| (a.0, a.1));
+        SurfaceElement {
+            first: 0,
+            count: points.len() as u32,
+            mean: Point3::origin(),
+            normal: Vector3::z(),
+            tangents: [Vector3::x(), Vector3::y()],
+            extent: [[-1.0, 1.0], [-1.0, 1.0]],
+            probes: Vec::new(),
+            spacing,
+            cov_mean: Matrix3::zeros(),
+            height: [0.0; 3],
+            height_cov: SMatrix::zeros(),
+            common_var: 0.0,
+            footprint,
+        }
+    }
+
+    /// The definition: some footprint point within one spacing.
+    fn brute(e: &SurfaceElement, u: Real, v: Real) -> bool {
+        e.footprint.iter().any(|p| {
+            (Real::from(p.2) - u).powi(2) + (Real::from(p.3) - v).powi(2) <= e.spacing * e.spacing
+        })
+    }
+
+    #[test]
+    fn covers_is_some_footprint_point_within_a_spacing() {
+        // A square sampled with a ring left out: holes, edges and sparse spots.
+        let mut uniform = crate::sample::lcg_uniform(11);
+        let pts: Vec<(Real, Real)> = (0..400)
+            .map(|_| (2.0 * uniform() - 1.0, 2.0 * uniform() - 1.0))
+            .filter(|(u, v)| !(0.4..0.6).contains(&u.hypot(*v)))
+            .collect();
+        let e = element_with_footprint(&pts, 0.05);
+        let mut hits = 0;
+        for _ in 0..5000 {
+            let (u, v) = (2.4 * uniform() - 1.2, 2.4 * uniform() - 1.2);
+            let covered = brute(&e, u, v);
+            assert_eq!(e.covers(u, v), covered, "({u}, {v})");
+            hits += usize::from(covered);
+        }
+        assert!((500..4500).contains(&hits), "{hits} of 5000 covered");
+        // Cells saturated at both ends of i32 (coordinates 1e12 spacings out).
+        let far = element_with_footprint(&[(-1e3, 0.0), (1e3, 0.0), (1e3, 1e-10)], 1e-9);
+        for (u, v) in [
+            (1e3, 0.0),
+            (1e3 + 5e-10, 0.0),
+            (-1e3, 5e-10),
+            (-1e3, 2e-9),
+            (0.0, 0.0),
+            (1e3, -2e-9),
+        ] {
+            assert_eq!(far.covers(u, v), brute(&far, u, v), "({u}, {v})");
+        }
+        assert!(far.covers(1e3 + 5e-10, 0.0) && !far.covers(-1e3, 2e-9));
+    }
+}
