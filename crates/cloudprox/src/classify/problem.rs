@@ -194,7 +194,8 @@ pub(crate) struct ConeData {
 
 impl ConeData {
     /// `(a . z, B z)` over the first `M` unknowns (a constant length, so the
-    /// solver's loops unroll).
+    /// solver's loops unroll; the working set's check passes all
+    /// [`MAX_UNKNOWNS`], zero past the surface's own).
     #[inline]
     pub fn apply<const M: usize>(&self, z: &[Real; M]) -> [Real; 4] {
         const { assert!(M <= MAX_UNKNOWNS) };
