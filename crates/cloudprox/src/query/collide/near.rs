@@ -110,7 +110,7 @@ pub(crate) fn near_set(
             // infinite, epsilon / 2 rounding to 0, a noise-free pair within
             // half a spacing is core but beyond a single-point element's own
             // context.)
-            let found = (0.5 * eps > 0.0).then_some(&core);
+            let found = (0.5 * eps > 0.0).then(|| std::mem::take(&mut keep));
             keep = near_points(&t.leaf_pairs, rel, a, b, eps, ctx, own_context, found);
         }
         stats.counters.node_pairs_visited += t.node_pairs_visited;

@@ -222,7 +222,7 @@ pub fn near_points(
     epsilon: Real,
     context: Real,
     own_context: OwnContext<'_>,
-    found: Option<&(Vec<bool>, Vec<bool>)>,
+    found: Option<(Vec<bool>, Vec<bool>)>,
 ) -> (Vec<bool>, Vec<bool>) {
     let (bvh_a, bvh_b) = (a.bvh(), b.bvh());
     // Each leaf is in many pairs: it is read once.
@@ -242,9 +242,6 @@ pub fn near_points(
     let blocks_a: Vec<&[u32]> = ids_a.iter().map(|&l| bvh_a.node_points(l)).collect();
     let blocks_b: Vec<&[u32]> = ids_b.iter().map(|&l| bvh_b.node_points(l)).collect();
     let rule = NearRule::new(epsilon, context);
-    let found = found
-        .cloned()
-        .unwrap_or_else(|| (vec![false; a.len()], vec![false; b.len()]));
     near_points_in_blocks(
         (&blocks_a, &blocks_b),
         &pairs,
@@ -274,8 +271,7 @@ pub fn near_points_brute_force(
     let (ia, ib) = (all(a.len()), all(b.len()));
     let rule = NearRule::new(epsilon, context);
     let blocks = (&[&ia[..]][..], &[&ib[..]][..]);
-    let found = (vec![false; a.len()], vec![false; b.len()]);
-    near_points_in_blocks(blocks, &[(0, 0)], rel, (a, b), rule, own_context, found)
+    near_points_in_blocks(blocks, &[(0, 0)], rel, (a, b), rule, own_context, None)
 }
 
 /// The near rule over every pair `(i, j)` of the blocks of point indices
@@ -287,8 +283,8 @@ pub fn near_points_brute_force(
 /// ([`NearRule::block_reach`]) is left out of the pair tests: it is near none
 /// of them, and none of them near it, so the result is that of testing every
 /// pair. A pair of blocks whose points have all been found near is skipped.
-/// The flags start as the given ones (`near_a`, `near_b`: points already
-/// known near, see [`near_points`]), and only gain points.
+/// The flags start as the `found` ones (points already known near, see
+/// [`near_points`]; none without), and only gain points.
 fn near_points_in_blocks(
     blocks: (&[&[u32]], &[&[u32]]),
     pairs: &[(u32, u32)],
@@ -296,7 +292,7 @@ fn near_points_in_blocks(
     (a, b): (&PointCloud, &PointCloud),
     rule: NearRule,
     own_context: OwnContext<'_>,
-    (mut near_a, mut near_b): (Vec<bool>, Vec<bool>),
+    found: Option<(Vec<bool>, Vec<bool>)>,
 ) -> (Vec<bool>, Vec<bool>) {
     // Directions in B's frame, rotated into A's own frame for A's covariances.
     let to_a = rel.rotation.inverse().to_rotation_matrix().into_inner();
@@ -306,13 +302,23 @@ fn near_points_in_blocks(
     let read_b = Blocks::read(blocks.1, |j| noise_b.point(j, b.points()[j]));
     // Per block, its points not yet found near: a pair of two blocks whose
     // points are all near can change nothing (deep in an overlap, most pairs).
-    let left = |read: &Blocks<'_>, near: &[bool]| -> Vec<usize> {
-        (0..read.bounds.len() as u32)
-            .map(|k| read.block(k).iter().filter(|(i, _)| !near[*i]).count())
+    // With nothing found, every point of each block (no counting pass).
+    let left = |read: &Blocks<'_>, near: Option<&[bool]>| -> Vec<usize> {
+        (0..read.bounds.len())
+            .map(|k| match near {
+                Some(near) => read
+                    .block(k as u32)
+                    .iter()
+                    .filter(|(i, _)| !near[*i])
+                    .count(),
+                None => read.bounds[k].run.len(),
+            })
             .collect()
     };
-    let mut left_a = left(&read_a, &near_a);
-    let mut left_b = left(&read_b, &near_b);
+    let mut left_a = left(&read_a, found.as_ref().map(|f| &f.0[..]));
+    let mut left_b = left(&read_b, found.as_ref().map(|f| &f.1[..]));
+    let (mut near_a, mut near_b) =
+        found.unwrap_or_else(|| (vec![false; a.len()], vec![false; b.len()]));
     let (mut kept_a, mut kept_b) = (Vec::new(), Vec::new());
     for &(ka, kb) in pairs {
         let (la, lb) = (&mut left_a[ka as usize], &mut left_b[kb as usize]);
@@ -713,7 +719,16 @@ mod tests {
             let some = (every_other(&want_a), every_other(&want_b));
             for found in [&core, &some] {
                 assert!(found.0.iter().any(|&x| x), "lift {lift}");
-                let seeded = near_points(&pairs, &rel, &a, &b, eps, ctx, (None, None), Some(found));
+                let seeded = near_points(
+                    &pairs,
+                    &rel,
+                    &a,
+                    &b,
+                    eps,
+                    ctx,
+                    (None, None),
+                    Some(found.clone()),
+                );
                 assert_eq!(seeded, got, "lift {lift}");
             }
             let brute = near_points_brute_force(&rel, &a, &b, eps, ctx, (None, None));
