@@ -13,7 +13,7 @@ A cloud side goes through
    and pixels; voxel downsampling merges covariances);
 4. a :class:`cloudprox.PointCloud` with the discretization part added.
 
-Steps 2-4 run in the Rust core (``cloudprox::cloud::ScanPipeline``, here
+Steps 2-4 run in the Rust core (``cloudprox::scan::ScanPipeline``, here
 :func:`cloudprox._native.scan_to_cloud`); this module parses the command line's
 poses, sensors and filter steps into its arguments.
 """

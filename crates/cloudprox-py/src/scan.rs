@@ -1,9 +1,9 @@
 //! The scan pipeline: `ScanStep`, `scan_to_cloud` and its `ScanResult` (the
-//! core's `cloud::ScanPipeline`).
+//! core's `scan::ScanPipeline`).
 
-use cloudprox::cloud::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
 use cloudprox::filter::SOR_DEFAULT_STD_RATIO;
 use cloudprox::math::Point3;
+use cloudprox::scan::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
 use pyo3::prelude::*;
 
 use crate::cloud::{discretization_settings, PyPointCloud};

@@ -16,7 +16,8 @@
 //!
 //! | stage | module |
 //! |---|---|
-//! | points, covariances, poses; from a scan file's points to a cloud ([`cloud::ScanPipeline`]) | [`cloud`] |
+//! | points, covariances, poses | [`cloud`] |
+//! | from a scan file's points to a cloud: sensor noise, filter steps, discretization ([`scan::ScanPipeline`]) | [`scan`] |
 //! | noise models, discretization error, robustness radius | [`uncertainty`] |
 //! | surface elements: the surfaces the points sample, at the resolution the data supports | [`element`] |
 //! | bounding volume hierarchy with noise-inflated pruning | [`bvh`] |
@@ -64,6 +65,7 @@ pub mod probability;
 pub mod query;
 pub mod robot;
 pub mod sample;
+pub mod scan;
 pub mod shape;
 pub mod uncertainty;
 

@@ -34,6 +34,7 @@ mod io_ply;
 mod io_pointcloud2;
 mod io_stl;
 mod io_xyz;
+mod module_layers;
 mod robot_collide;
 mod robot_model;
 mod scan_pipeline;

@@ -1,13 +1,13 @@
-//! The scan pipeline (`cloud::ScanPipeline`) and `CloudData::select`: subsets
+//! The scan pipeline (`scan::ScanPipeline`) and `CloudData::select`: subsets
 //! stay aligned, the pipeline agrees with the same steps done by hand, and bad
 //! input gives errors that name the problem.
 
-use cloudprox::cloud::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
 use cloudprox::element::ElementSettings;
 use cloudprox::filter::{self, SelfFilter, ShadowSettings};
 use cloudprox::io::{CloudData, Grid};
 use cloudprox::prelude::*;
 use cloudprox::sample::NormalRng;
+use cloudprox::scan::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
 
 const W: usize = 48;
 const H: usize = 36;
@@ -306,7 +306,7 @@ fn a_step_that_removes_every_point_is_reported_and_stops_the_pipeline() {
 #[test]
 fn bad_input_gives_errors_naming_the_problem() {
     let data = organized_scan(&sensor_pose());
-    let msg = |r: Result<cloudprox::cloud::Scan>| r.unwrap_err().to_string();
+    let msg = |r: Result<cloudprox::scan::Scan>| r.unwrap_err().to_string();
     let iso = ScanPipeline::new(ScanNoise::Isotropic(0.001));
 
     let empty = CloudData {

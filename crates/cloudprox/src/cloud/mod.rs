@@ -1,17 +1,13 @@
-//! Point clouds with per-point uncertainty, rigid poses, and the scan pipeline
-//! that makes a cloud from a file's points ([`ScanPipeline`]).
+//! Point clouds with per-point uncertainty and rigid poses (a scan file's
+//! points become a cloud through [`crate::scan::ScanPipeline`]).
 
 mod from_mesh;
 mod point_cloud;
 mod pose;
-pub mod scan;
 
 pub use point_cloud::{PointCloud, MAX_COORDINATE};
 pub(crate) use pose::validate_pose;
 pub use pose::{
     pose_from_matrix, pose_from_quaternion, pose_from_rotation_vector, pose_from_rpy,
     pose_from_translation, pose_look_at, pose_to_matrix, random_rotations, unit_quaternion,
-};
-pub use scan::{
-    FilteredScan, Scan, ScanNoise, ScanPipeline, ScanStep, SensorPlacement, StepReport,
 };

@@ -22,7 +22,7 @@
 //! merges the members' covariances into its centroid's.
 //!
 //! ```
-//! use cloudprox::cloud::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
+//! use cloudprox::scan::{ScanNoise, ScanPipeline, ScanStep, SensorPlacement};
 //! use cloudprox::io::CloudData;
 //! use cloudprox::math::Point3;
 //! use cloudprox::uncertainty::{DepthCamera, SensorModel};
