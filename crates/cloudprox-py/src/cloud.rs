@@ -3,7 +3,6 @@
 use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
-use cloudprox::element::ElementSettings;
 use cloudprox::uncertainty::DiscretizationSettings;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -209,11 +208,7 @@ impl PyPointCloud {
                 None => cloud,
             };
             if let Some(rho) = noise_correlation {
-                let settings = ElementSettings {
-                    noise_correlation: rho,
-                    ..*cloud.element_settings()
-                };
-                cloud.set_element_settings(settings)?;
+                cloud.set_noise_correlation(rho)?;
             }
             Ok(cloud)
         })?;
@@ -379,11 +374,7 @@ impl PyPointCloud {
                 };
                 root = root.with_discretization(&settings)?;
             }
-            let settings = ElementSettings {
-                noise_correlation: rho,
-                ..*root.element_settings()
-            };
-            root.set_element_settings(settings)?;
+            root.set_noise_correlation(rho)?;
             let root = Arc::new(root);
             let mut cloud = Arc::clone(&root);
             for pose in &moves {

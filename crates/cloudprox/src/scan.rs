@@ -47,7 +47,6 @@
 use rayon::prelude::*;
 
 use crate::cloud::{validate_pose, PointCloud};
-use crate::element::ElementSettings;
 use crate::error::{Error, Result};
 use crate::filter::{
     self, CovarianceMerge, SelfFilter, ShadowSettings, SOR_DEFAULT_K, SOR_DEFAULT_STD_RATIO,
@@ -412,21 +411,7 @@ fn check_scan(scan: &CloudData) -> Result<()> {
             scan.points[i].coords.as_slice()
         )));
     }
-    let n = scan.points.len();
-    for (field, len) in [
-        ("normals", scan.normals.as_ref().map(Vec::len)),
-        ("covariances", scan.covariances.as_ref().map(Vec::len)),
-        ("grid pixels", scan.grid.as_ref().map(|g| g.pixels.len())),
-    ] {
-        if let Some(len) = len.filter(|&len| len != n) {
-            return Err(Error::Shape {
-                what: format!("scan pipeline: the scan's {field} (one per point)"),
-                expected: n,
-                got: len,
-            });
-        }
-    }
-    Ok(())
+    scan.check_aligned("scan pipeline: the scan")
 }
 
 /// Step `i` on `data` (non-empty); the sensor covariances are in
@@ -532,11 +517,7 @@ impl FilteredScan {
             None => cloud,
         };
         if let Some(rho) = rho {
-            let settings = ElementSettings {
-                noise_correlation: rho,
-                ..*cloud.element_settings()
-            };
-            cloud.set_element_settings(settings)?;
+            cloud.set_noise_correlation(rho)?;
         }
         Ok(Scan {
             cloud,

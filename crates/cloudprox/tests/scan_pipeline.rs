@@ -322,6 +322,11 @@ fn bad_input_gives_errors_naming_the_problem() {
     let mut short = data.clone();
     short.normals.as_mut().unwrap().pop();
     assert!(matches!(iso.run(&short), Err(Error::Shape { .. })));
+    let what = msg(iso.run(&short));
+    assert!(
+        what.contains("scan pipeline") && what.contains("normals"),
+        "{what}"
+    );
 
     let bare = CloudData::from_points(data.points.clone());
     assert!(msg(ScanPipeline::new(ScanNoise::Stored).run(&bare)).contains("stores no covariances"));

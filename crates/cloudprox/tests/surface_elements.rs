@@ -274,3 +274,26 @@ fn a_large_element_is_sampled_on_a_grid_where_it_was_sampled() {
     }
     assert!(gridded >= 1, "no element was more than 12 spacings across");
 }
+
+#[test]
+fn the_noise_correlation_is_set_alone_and_checked() {
+    let mut cloud = PointCloud::from_sigma(sphere(&Point3::origin(), 0.1, 500), 0.001).unwrap();
+    let custom = ElementSettings {
+        significance: 0.05,
+        min_points: 12,
+        ..ElementSettings::default()
+    };
+    cloud.set_element_settings(custom).unwrap();
+    cloud.set_noise_correlation(0.3).unwrap();
+    assert_eq!(
+        *cloud.element_settings(),
+        ElementSettings {
+            noise_correlation: 0.3,
+            ..custom
+        }
+    );
+    for bad in [-0.1, 1.5, f64::NAN] {
+        assert!(cloud.set_noise_correlation(bad).is_err(), "{bad}");
+    }
+    assert_eq!(cloud.element_settings().noise_correlation, 0.3);
+}

@@ -224,6 +224,16 @@ impl PointCloud {
         Ok(())
     }
 
+    /// Sets the correlation of the sensor noise between the points of an
+    /// element ([`ElementSettings::noise_correlation`], in `[0, 1]`), the
+    /// other element settings kept; existing elements are dropped.
+    pub fn set_noise_correlation(&mut self, rho: Real) -> Result<()> {
+        self.set_element_settings(ElementSettings {
+            noise_correlation: rho,
+            ..self.element_settings
+        })
+    }
+
     /// The settings the surface elements are built with.
     pub fn element_settings(&self) -> &ElementSettings {
         &self.element_settings

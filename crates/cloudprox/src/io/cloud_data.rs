@@ -138,8 +138,8 @@ impl CloudData {
     }
 
     /// Checks that everything per point has one entry per point, including the
-    /// grid's pixels.
-    fn check_aligned(&self, what: &str) -> crate::Result<()> {
+    /// grid's pixels (`what` names the caller in the error).
+    pub(crate) fn check_aligned(&self, what: &str) -> crate::Result<()> {
         let n = self.points.len();
         for (field, len) in [
             ("normals", self.normals.as_ref().map(Vec::len)),

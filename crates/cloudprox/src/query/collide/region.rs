@@ -304,14 +304,14 @@ fn near_points_in_blocks(
     // points are all near can change nothing (deep in an overlap, most pairs).
     // With nothing found, every point of each block (no counting pass).
     let left = |read: &Blocks<'_>, near: Option<&[bool]>| -> Vec<usize> {
-        (0..read.bounds.len())
-            .map(|k| match near {
-                Some(near) => read
-                    .block(k as u32)
+        read.bounds
+            .iter()
+            .map(|b| match near {
+                Some(near) => read.points[b.run.clone()]
                     .iter()
                     .filter(|(i, _)| !near[*i])
                     .count(),
-                None => read.bounds[k].run.len(),
+                None => b.run.len(),
             })
             .collect()
     };
