@@ -21,6 +21,14 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   single-call medians by 20-40% between runs).
 * **collide_robot_many** on 10 000 random configurations with 1 and 2 threads
   (separate processes).
+* **Short motions near the scene** (``--motions``, default 60): through each
+  of the first near-contact configurations (the agreement set below), a
+  straight joint-space motion along a random arm direction, its links
+  travelling 10 sigma either side; ``check_motion`` at its default resolution
+  (sigma) checks every state (``max_probability=1``), with the previous
+  state's classifier hint (``warm_start``, the default) and without, the two
+  alternated motion by motion; total seconds, the ratio, and the largest
+  difference of the motions' worst ``P``.
 * **Agreement with the exact scene** over ``--near`` configurations near it: from
   a random free configuration along a random joint-space direction to first
   contact (python-fcl), then back to an exact clearance uniform in [0, 10] sigma
@@ -31,7 +39,8 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   collisions deeper than 3 sigma, for both models; the collision maps' booleans
   alike.
 
-Usage: ``python3 benches/robot.py [--configurations 2000] [--near 1000] [--repeat 1] [--seed 0]``
+Usage: ``python3 benches/robot.py [--configurations 2000] [--near 1000] [--motions 60]
+[--repeat 1] [--seed 0]``
 """
 
 from __future__ import annotations
@@ -157,6 +166,68 @@ def near_configurations(
     return np.array(qs), np.array(sd)
 
 
+def motion_ends(
+    robot: cp.Robot, centres: np.ndarray, sigma: float, rng: np.random.Generator
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per centre, the ends of a straight motion through it.
+
+    Along a random direction of the arm's joints, its links travelling about 10 sigma
+    either side.
+    """
+    verts = vertices(robot)
+    ends = []
+    for q in centres:
+        direction = np.zeros(robot.dof)
+        direction[ARM] = rng.normal(size=7)
+        direction *= 0.01 / np.linalg.norm(direction)
+        scale = 10.0 * sigma / max(travel(robot, verts, q, robot.clamp(q + direction)), 1e-12)
+        ends.append((robot.clamp(q - scale * direction), robot.clamp(q + scale * direction)))
+    return ends
+
+
+def motion_rows(
+    robot: cp.Robot, cloud: cp.PointCloud, ends: list[tuple[np.ndarray, np.ndarray]]
+) -> None:
+    """Print the motion table: ``check_motion`` with and without ``warm_start``."""
+    print(
+        f"\n`check_motion` through {len(ends)} near-contact configurations, every state "
+        "checked, one thread:\n"
+    )
+    print(
+        "| model | states | cold (s) | warm-started (s) | warm / cold "
+        "| median motion cold / warm (ms) | largest worst-`P` difference |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for model in MODELS:
+        seconds: dict[bool, list[float]] = {True: [], False: []}
+        worst: dict[bool, list[float]] = {True: [], False: []}
+        states = 0
+        for i, (q0, q1) in enumerate(ends):
+            order = (True, False) if i % 2 == 0 else (False, True)
+            for warm in order:
+                t = time.perf_counter()
+                m = cp.check_motion(
+                    robot,
+                    q0,
+                    q1,
+                    cloud,
+                    self_collision=False,
+                    model=model,
+                    max_probability=1.0,
+                    warm_start=warm,
+                )
+                seconds[warm].append(time.perf_counter() - t)
+                worst[warm].append(m.probability)
+            states += m.states_checked
+        cold, warm_s = sum(seconds[False]), sum(seconds[True])
+        diff = float(np.max(np.abs(np.subtract(worst[True], worst[False]))))
+        print(
+            f"| {model} | {states} | {cold:.2f} | {warm_s:.2f} | {warm_s / cold:.2f}x | "
+            f"{np.median(seconds[False]) * 1e3:.0f} / {np.median(seconds[True]) * 1e3:.0f} | "
+            f"{diff:.1e} |"
+        )
+
+
 def fcl_call_times(checker: FclChecker, qs: np.ndarray) -> np.ndarray:
     """Seconds of python-fcl's ``collide()`` per configuration, links posed beforehand."""
     out = np.empty(len(qs))
@@ -208,6 +279,7 @@ def main() -> None:
     ap.add_argument("--configurations", type=int, default=2000)
     ap.add_argument("--near", type=int, default=1000)
     ap.add_argument("--many", type=int, default=10_000)
+    ap.add_argument("--motions", type=int, default=60, help="short motions near the scene")
     ap.add_argument(
         "--repeat", type=int, default=1, help="calls per configuration; the fastest is kept"
     )
@@ -311,6 +383,10 @@ def main() -> None:
         "\nOne `collide_robot` call's wall time, far configurations (median): "
         + ", ".join(f"{m} {us(w)}" for m, w in walls.items())
     )
+
+    if args.motions:
+        centres = near_q[: args.motions]
+        motion_rows(robot, cloud, motion_ends(robot, centres, sigma, rng))
 
     seconds = {k: many_seconds(k, args.many, args.seed) for k in (1, 2)}
     print(

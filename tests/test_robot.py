@@ -225,6 +225,28 @@ def test_check_motion_finds_a_collision_between_two_free_waypoints(arm: cp.Robot
     assert coarse.states_total < m.states_total
 
 
+def test_check_motion_warm_start_changes_the_work_not_the_answer(arm: cp.Robot) -> None:
+    # Link2 passes 3 sigma over a post: checked to the end, the worst state's P
+    # is the same with and without the previous state's hint, and equals the
+    # largest of the states queried one by one.
+    half = np.array([0.01, 0.01, 0.05])
+    top = 0.28 - 3 * SIGMA
+    pts = cp.synthetic.sample_box_surface(tuple(half), 0.004, center=(0.2, 0.0, top - half[2]))
+    post = cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
+    q0, q1 = np.array([-0.3, 0, 0, 0]), np.array([0.3, 0, 0, 0])
+    opts = {"max_probability": 1.0, "self_collision": False}
+    warm = cp.check_motion(arm, q0, q1, post, **opts)
+    cold = cp.check_motion(arm, q0, q1, post, warm_start=False, **opts)
+    assert warm.states_checked == cold.states_checked == warm.states_total
+    assert 0.2 < cold.probability < 0.9
+    assert warm.probability == pytest.approx(cold.probability, abs=1e-5)
+    s = np.linspace(0.0, 1.0, cold.states_total)
+    states = cp.collide_robot_many(arm, q0 + s[:, None] * (q1 - q0), post, self_collision=False)
+    assert cold.probability == states.probabilities.max()
+    with pytest.raises(cp.InvalidInputError, match="warm_start must be a bool"):
+        cp.check_motion(arm, q0, q1, post, warm_start="yes")
+
+
 def test_self_collision_on_a_folded_arm(arm: cp.Robot) -> None:
     folded = [0.0, np.pi / 2, 0.0, 0.0]
     assert ("base", "link2") in arm.self_collisions(folded)

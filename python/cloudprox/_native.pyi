@@ -1821,5 +1821,9 @@ def check_motion(
     its median spacing without noise); the check stops at the first unsafe state
     (probability above ``max_probability``, default ``threshold_free``, or
     self-collision). ``options``: those of :func:`collide_robot` plus
-    ``resolution`` and ``max_probability``.
+    ``resolution``, ``max_probability`` and ``warm_start`` (default ``True``: each
+    state's classifier starts from the samples that supported the previous state's
+    surfaces, which saves work and gives the same answers to the solver's
+    tolerance; ``False`` makes each state's answer exactly
+    :func:`collide_robot`'s).
     """

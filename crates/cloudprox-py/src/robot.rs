@@ -24,7 +24,7 @@ use crate::result::{PyCollisionResult, PyContactPatch};
 /// The keywords of `collide_robot` that are not request options.
 const ROBOT_KEYWORDS: [&str; 4] = ["request", "mesh_spacing", "broad_phase", "self_collision"];
 /// The keywords of `check_motion` beyond those of `collide_robot`.
-const MOTION_KEYWORDS: [&str; 2] = ["resolution", "max_probability"];
+const MOTION_KEYWORDS: [&str; 3] = ["resolution", "max_probability", "warm_start"];
 
 fn extract<'py, T: FromPyObjectOwned<'py>>(
     py: Python<'py>,
@@ -65,6 +65,7 @@ fn motion_request(
                 "max_probability" if motion => {
                     out.max_probability = Some(extract(py, &v, &key, "a float")?);
                 }
+                "warm_start" if motion => out.warm_start = extract(py, &v, &key, "a bool")?,
                 _ => collide_options.set_item(key, v)?,
             }
         }

@@ -34,5 +34,6 @@ mod working_set;
 
 pub use separator::{QuadraticForm, Separator};
 pub use settings::{ClassifySettings, SocpSolver};
+pub(crate) use solve::train_hinted;
 pub use solve::{train, Classification, SolveStatus};
 pub use surface::Surface;

@@ -62,6 +62,20 @@ pub fn train(
     labels: &[Real],
     settings: &ClassifySettings,
 ) -> Result<Classification> {
+    train_hinted(points, covs, labels, settings, &[]).map(|(c, _)| c)
+}
+
+/// [`train`], with the specialized method's first working set widened by
+/// `hint` (empty, or one flag per point: the constraints that supported a
+/// nearby problem's surface). Also returns, per point, whether its constraint
+/// supports this surface (empty when the specialized method did not solve it).
+pub(crate) fn train_hinted(
+    points: &[Point3],
+    covs: &[Matrix3],
+    labels: &[Real],
+    settings: &ClassifySettings,
+    hint: &[bool],
+) -> Result<(Classification, Vec<bool>)> {
     settings.validate()?;
     let n = points.len();
     for (what, len) in [("covariances", covs.len()), ("labels", labels.len())] {
@@ -87,15 +101,16 @@ pub fn train(
     let r = settings.robust_radius()?;
     let norm = Normalized::new(points, covs);
     if settings.solver == SocpSolver::PrimalDual {
-        if let Some(sol) = solve_reduced(
+        if let Some((sol, support)) = solve_reduced(
             &norm,
             labels,
             settings.surface,
             settings.slack_weight,
             r,
             settings.solver_tol,
+            hint,
         ) {
-            return Ok(Classification {
+            let classification = Classification {
                 separator: Separator {
                     surface: settings.surface,
                     w: sol.w,
@@ -108,7 +123,8 @@ pub fn train(
                 solver: SocpSolver::PrimalDual,
                 iterations: sol.iterations,
                 slacks: sol.xi,
-            });
+            };
+            return Ok((classification, support));
         }
     }
     let problem = assemble(&norm, labels, settings.surface, settings.slack_weight, r);
@@ -142,25 +158,31 @@ pub fn train(
         };
         if let Some(status) = status {
             if sol.x[..=d].iter().all(|v| v.is_finite()) {
-                return Ok(Classification {
-                    separator: Separator {
-                        surface: settings.surface,
-                        w: sol.x[..d].to_vec(),
-                        b: sol.x[d],
-                        center: norm.center,
-                        scale: norm.scale,
-                        frame: Pose::identity(),
+                return Ok((
+                    Classification {
+                        separator: Separator {
+                            surface: settings.surface,
+                            w: sol.x[..d].to_vec(),
+                            b: sol.x[d],
+                            center: norm.center,
+                            scale: norm.scale,
+                            frame: Pose::identity(),
+                        },
+                        status,
+                        solver: SocpSolver::Clarabel,
+                        iterations: sol.iterations,
+                        slacks: sol.x[d + 1..d + 1 + n].to_vec(),
                     },
-                    status,
-                    solver: SocpSolver::Clarabel,
-                    iterations: sol.iterations,
-                    slacks: sol.x[d + 1..d + 1 + n].to_vec(),
-                });
+                    Vec::new(),
+                ));
             }
         }
-        return Ok(fallback(&norm, labels, settings, sol.iterations));
+        return Ok((
+            fallback(&norm, labels, settings, sol.iterations),
+            Vec::new(),
+        ));
     }
-    Ok(fallback(&norm, labels, settings, 0))
+    Ok((fallback(&norm, labels, settings, 0), Vec::new()))
 }
 
 fn fallback(

@@ -27,9 +27,22 @@ const WORKING_SET_ROUNDS: usize = 4;
 /// Points of each cloud in the first working set.
 const WORKING_SET_START: usize = 24;
 
+/// A constraint whose margin at the optimum is within this of its bound
+/// (`c_i f(x_i) - 1 - r |Sigma_i^(1/2) grad f| <= SUPPORT_MARGIN`, in the
+/// normalized units where the bound is 1) is reported as supporting the
+/// surface: the constraints a nearby problem (the next state of a motion) will
+/// most likely need.
+const SUPPORT_MARGIN: Real = 0.25;
+
 /// Solves the robust SOCP of the normalized points `norm` with labels `labels`
 /// (`lambda` the slack weight, `r` the robust radius) on a working set of its
 /// constraints; `None` when the method does not converge.
+///
+/// `hint` (empty, or one flag per point) names constraints to put in the
+/// first working set besides the nearest points: those that supported a
+/// nearby problem's surface. It changes the work, not the answer. Returns the
+/// optimum and, per point, whether its constraint supports the surface
+/// (within [`SUPPORT_MARGIN`] of its bound).
 pub(crate) fn solve_reduced(
     norm: &Normalized,
     labels: &[Real],
@@ -37,14 +50,55 @@ pub(crate) fn solve_reduced(
     lambda: Real,
     r: Real,
     tol: Real,
-) -> Option<Solution> {
+    hint: &[bool],
+) -> Option<(Solution, Vec<bool>)> {
     let n = norm.u.len();
     let d = surface.dim();
     let data = cone_data(norm, labels, surface, r);
-    if n <= 4 * WORKING_SET_START {
-        return solve_primal_dual(&data, d, lambda, tol);
-    }
+    let sol = if n <= 4 * WORKING_SET_START {
+        solve_primal_dual(&data, d, lambda, tol)?
+    } else {
+        solve_working_set(&data, norm, labels, d, lambda, tol, hint)?
+    };
+    let z = unknowns(&sol);
+    let support = data
+        .iter()
+        .map(|c| constraint_margin(c, &z) <= SUPPORT_MARGIN)
+        .collect();
+    Some((sol, support))
+}
+
+/// `(w, b)`, zeros after: the cones' coefficients there are zero too.
+fn unknowns(sol: &Solution) -> [Real; MAX_UNKNOWNS] {
+    let mut z = [0.0; MAX_UNKNOWNS];
+    z[..sol.w.len()].copy_from_slice(&sol.w);
+    z[sol.w.len()] = sol.b;
+    z
+}
+
+/// A constraint's margin at `z`: `c_i f(x_i) - 1 - r |Sigma_i^(1/2) grad f|`
+/// (negative where it is violated without slack).
+fn constraint_margin(c: &ConeData, z: &[Real; MAX_UNKNOWNS]) -> Real {
+    let g = c.apply(z);
+    g[0] - 1.0 - (g[1] * g[1] + g[2] * g[2] + g[3] * g[3]).sqrt()
+}
+
+/// The working-set rounds (see the module docs), starting from the nearest
+/// points and the `hint`ed constraints.
+fn solve_working_set(
+    data: &[ConeData],
+    norm: &Normalized,
+    labels: &[Real],
+    d: usize,
+    lambda: Real,
+    tol: Real,
+    hint: &[bool],
+) -> Option<Solution> {
+    let n = data.len();
     let mut in_set = initial_working_set(norm, labels);
+    for (s, &h) in in_set.iter_mut().zip(hint) {
+        *s |= h;
+    }
     let mut iterations = 0;
     for _ in 0..WORKING_SET_ROUNDS {
         if 2 * in_set.iter().filter(|&&x| x).count() > n {
@@ -54,10 +108,7 @@ pub(crate) fn solve_reduced(
         let subset: Vec<ConeData> = idx.iter().map(|&i| data[i]).collect();
         let sol = solve_primal_dual(&subset, d, lambda, tol)?;
         iterations += sol.iterations;
-        // `(w, b)`, zeros after: the cones' coefficients there are zero too.
-        let mut z = [0.0; MAX_UNKNOWNS];
-        z[..d].copy_from_slice(&sol.w);
-        z[d] = sol.b;
+        let z = unknowns(&sol);
         let mut violated = false;
         for i in 0..n {
             if in_set[i] {
@@ -83,7 +134,7 @@ pub(crate) fn solve_reduced(
             });
         }
     }
-    let sol = solve_primal_dual(&data, d, lambda, tol)?;
+    let sol = solve_primal_dual(data, d, lambda, tol)?;
     Some(Solution {
         iterations: sol.iterations + iterations,
         ..sol
@@ -159,6 +210,7 @@ fn initial_working_set(norm: &Normalized, labels: &[Real]) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::classify::Surface;
     use crate::math::Matrix3;
     use crate::sample::{add_noise, sphere};
 
@@ -189,6 +241,67 @@ mod tests {
             assert!(nearest_opposite(&norm, &alone)
                 .iter()
                 .all(|d| d.is_infinite()));
+        }
+    }
+
+    /// Two noisy spheres 0.1 m across, B's centre `dx` from A's, as the
+    /// solver's normalized problem with labels.
+    fn two_spheres(dx: Real) -> (Normalized, Vec<Real>) {
+        let a = add_noise(&sphere(&Point3::origin(), 0.1, 400), 0.002, 1);
+        let b = add_noise(&sphere(&Point3::new(dx, 0.0, 0.0), 0.1, 400), 0.002, 2);
+        // The caps facing each other: the near region a query would classify.
+        let cap_a = a.iter().filter(|p| p.x > 0.06);
+        let cap_b = b.iter().filter(|p| p.x < dx - 0.06);
+        let labels: Vec<Real> = cap_a
+            .clone()
+            .map(|_| 1.0)
+            .chain(cap_b.clone().map(|_| -1.0))
+            .collect();
+        let points: Vec<Point3> = cap_a.chain(cap_b).copied().collect();
+        let covs = vec![Matrix3::identity() * 4e-6; points.len()];
+        (Normalized::new(&points, &covs), labels)
+    }
+
+    #[test]
+    fn a_hint_changes_the_work_not_the_answer() {
+        let solve = |dx: Real, hint: &[bool]| {
+            let (norm, labels) = two_spheres(dx);
+            assert!(labels.len() > 4 * WORKING_SET_START);
+            solve_reduced(&norm, &labels, Surface::Quadric, 100.0, 1.0, 1e-7, hint).unwrap()
+        };
+        // The first state (the spheres 15 mm, 7.5 sigma, into each other):
+        // cold. Every point with slack supports the surface.
+        let (first, support) = solve(0.185, &[]);
+        assert_eq!(support.len(), first.xi.len());
+        for (i, &xi) in first.xi.iter().enumerate() {
+            assert!(xi < 1e-6 || support[i], "point {i} has slack {xi}");
+        }
+        let supporting = support.iter().filter(|&&s| s).count();
+        assert!(supporting > 0 && supporting < support.len());
+        // The same problem again, hinted with its own support: the first
+        // round is the optimum.
+        let (again, _) = solve(0.185, &support);
+        assert!(again.iterations <= first.iterations);
+        // The next state of a motion (B 1.5 mm further in), cold and hinted
+        // with the first state's support (the caps hold the same points).
+        let (cold, _) = solve(0.1835, &[]);
+        let (warm, _) = solve(0.1835, &support);
+        assert!(
+            warm.iterations < cold.iterations,
+            "hinted {} iterations, cold {}",
+            warm.iterations,
+            cold.iterations
+        );
+        for (x, y) in warm
+            .w
+            .iter()
+            .chain([&warm.b])
+            .zip(cold.w.iter().chain([&cold.b]))
+        {
+            assert!((x - y).abs() <= 1e-5 * (1.0 + y.abs()), "{x} vs {y}");
+        }
+        for (x, y) in warm.xi.iter().zip(&cold.xi) {
+            assert!((x - y).abs() <= 1e-5, "slack {x} vs {y}");
         }
     }
 }

@@ -13,7 +13,7 @@ use crate::math::Pose;
 use crate::probability::{normal_quantile, Aggregation, CollisionState};
 use crate::query::collide::{
     collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, prepare,
-    CollisionRequest, CollisionResult, QueryModel,
+    CollisionRequest, CollisionResult, QueryModel, WarmStart,
 };
 use crate::query::exact::intersects;
 use crate::Real;
@@ -245,6 +245,22 @@ pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollisio
 pub(crate) struct RobotWorkspace {
     bvh: BvhWorkspace,
     stack: Vec<u32>,
+    /// Per link, the classifier's hint from the last query of that link
+    /// (`None`: every query starts cold; the batch queries, whose
+    /// configurations need not be near each other, and whose answers must not
+    /// depend on the order the threads take them in).
+    warm: Option<Vec<WarmStart>>,
+}
+
+impl RobotWorkspace {
+    /// A workspace whose queries carry each link's classifier hint to the next:
+    /// for consecutive states of a motion.
+    pub(crate) fn warm_started() -> Self {
+        RobotWorkspace {
+            warm: Some(Vec::new()),
+            ..RobotWorkspace::default()
+        }
+    }
 }
 
 /// [`collide_robot`] with prepared samples and a workspace; `q` checked.
@@ -319,6 +335,12 @@ pub(crate) fn collide_robot_prepared(
         }
         stats.counters.links_queried += 1;
         // The request was validated by the caller; a query error cannot occur.
+        let warm = ws.warm.as_mut().map(|w| {
+            if w.len() <= l {
+                w.resize_with(l + 1, WarmStart::default);
+            }
+            &mut w[l]
+        });
         match collide_with_workspace(
             &poses[l],
             link_cloud,
@@ -326,6 +348,7 @@ pub(crate) fn collide_robot_prepared(
             cloud,
             &request.collide,
             &mut ws.bvh,
+            warm,
         ) {
             Ok(r) => {
                 stats.counters.node_pairs_visited += r.stats.counters.node_pairs_visited;

@@ -18,6 +18,7 @@ use crate::query::collide::probabilities::{
     core_values, indexed, point_probabilities, surface_side,
 };
 use crate::query::collide::region::{cut, split_patches, Patch};
+use crate::query::collide::warm_start::WarmStart;
 use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactPatch, PointAggregates, PointProbabilities,
     QueryModel, QueryStats,
@@ -64,7 +65,7 @@ pub fn collide(
     request: &CollisionRequest,
 ) -> Result<CollisionResult> {
     let mut workspace = BvhWorkspace::default();
-    collide_with_workspace(pose_a, a, pose_b, b, request, &mut workspace)
+    collide_with_workspace(pose_a, a, pose_b, b, request, &mut workspace, None)
 }
 
 pub(crate) fn collide_with_workspace(
@@ -74,6 +75,7 @@ pub(crate) fn collide_with_workspace(
     b: &PointCloud,
     request: &CollisionRequest,
     workspace: &mut BvhWorkspace,
+    mut warm: Option<&mut WarmStart>,
 ) -> Result<CollisionResult> {
     request.validate()?;
     validate_pose(pose_a, "pose_a")?;
@@ -181,6 +183,9 @@ pub(crate) fn collide_with_workspace(
     let mut touched: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     let stop_early = request.decide_only
         && matches!(request.aggregation, Aggregation::Max | Aggregation::Surface);
+    if let Some(w) = warm.as_deref_mut() {
+        w.begin();
+    }
     'regions: for component in near.regions {
         let (pa, ca) = in_frame(&rel, sa, &component.a);
         let (pb, cb) = in_frame(&Pose::identity(), sb, &component.b);
@@ -222,6 +227,7 @@ pub(crate) fn collide_with_workspace(
             }
             let spacing = patch_median(&ia, sa.spacing(), &ib, sb.spacing());
             let sigma = patch_median(&ia, sa.sigma_max(), &ib, sb.sigma_max());
+            let hint = warm.as_deref().map_or_else(Vec::new, |w| w.hint(&ia, &ib));
             let fit = fit_patch(
                 &pts,
                 &covs,
@@ -231,7 +237,11 @@ pub(crate) fn collide_with_workspace(
                 sigma,
                 request,
                 !request.decide_only,
+                &hint,
             )?;
+            if let Some(w) = warm.as_deref_mut() {
+                w.record(&ia, &ib, &fit.support);
+            }
             // A context sample (beyond the noise's reach of the other cloud) that
             // the surface puts on the wrong side shows a surface too rigid for the
             // patch (a wrapped or saddle-shaped contact): cut it and fit the
@@ -372,6 +382,9 @@ pub(crate) fn collide_with_workspace(
                 break 'regions;
             }
         }
+    }
+    if let Some(w) = warm {
+        w.finish();
     }
     stats.counters.patches = patches.len();
     // In index order, as over every sample: a sum's order is kept, and the

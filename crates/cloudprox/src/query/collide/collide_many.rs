@@ -28,7 +28,7 @@ pub fn collide_many(
     poses_a
         .par_iter()
         .map_init(BvhWorkspace::default, |ws, pose_a| {
-            collide_with_workspace(pose_a, a, pose_b, b, request, ws)
+            collide_with_workspace(pose_a, a, pose_b, b, request, ws, None)
         })
         .collect()
 }

@@ -1,7 +1,7 @@
 //! Contact regions: a patch's trained surface, per-sample margins and
 //! probabilities, and the contact point, normal and separation estimate.
 
-use crate::classify::{train, Classification};
+use crate::classify::{train_hinted, Classification};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, PrincipalAxes, Vector3};
 use crate::probability::point_probability;
@@ -20,6 +20,9 @@ pub(crate) struct PatchFit {
     /// The separation estimate (see [`crate::query::ContactPatch::separation`]);
     /// not computed (NaN) when `contact` is false.
     pub separation: Real,
+    /// Per point, whether its constraint supports the surface (empty when the
+    /// specialized solver did not solve it).
+    pub support: Vec<bool>,
 }
 
 /// Trains the surface for `pts` (the first `na` from A) and derives the per-point
@@ -33,11 +36,12 @@ pub(crate) fn fit_patch(
     sigma: Real,
     request: &CollisionRequest,
     contact: bool,
+    hint: &[bool],
 ) -> Result<PatchFit> {
     let labels: Vec<Real> = (0..pts.len())
         .map(|i| if i < na { 1.0 } else { -1.0 })
         .collect();
-    let classification = train(pts, covs, &labels, &request.classify)?;
+    let (classification, support) = train_hinted(pts, covs, &labels, &request.classify, hint)?;
     let sep = &classification.separator;
     let mut probabilities = Vec::with_capacity(pts.len());
     let mut margins = Vec::with_capacity(pts.len());
@@ -72,6 +76,7 @@ pub(crate) fn fit_patch(
             point,
             normal,
             separation: Real::NAN,
+            support,
         });
     }
     // The separation is measured along the near region's axis (unlike the trained
@@ -116,6 +121,7 @@ pub(crate) fn fit_patch(
         point,
         normal,
         separation,
+        support,
     })
 }
 

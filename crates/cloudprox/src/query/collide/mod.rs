@@ -12,7 +12,9 @@
 //! 2. merge them into connected near regions, and split large regions into
 //!    patches along the contact (`region.rs`);
 //! 3. train a robust separating surface per patch ([`crate::classify`]), and
-//!    estimate the contact point, normal and separation (`contact.rs`);
+//!    estimate the contact point, normal and separation (`contact.rs`); along
+//!    a motion, the classifier starts from the samples that supported the
+//!    previous state's surfaces (`warm_start.rs`);
 //! 4. with surface elements, whether a patch's element surfaces can reach each
 //!    other at all (if not, it is pruned without a classifier) and the
 //!    probability that they cross (`elements.rs`);
@@ -32,6 +34,7 @@ mod probabilities;
 pub(crate) mod region;
 mod request;
 mod result;
+mod warm_start;
 
 pub use collide::collide;
 pub(crate) use collide::collide_with_workspace;
@@ -44,3 +47,4 @@ pub use request::{CollisionRequest, QueryModel};
 pub use result::{
     CollisionResult, ContactPatch, PointAggregates, PointProbabilities, QueryCounters, QueryStats,
 };
+pub(crate) use warm_start::WarmStart;
