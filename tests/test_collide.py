@@ -133,6 +133,25 @@ def test_collide_many_equals_a_loop(spheres) -> None:
     assert cp.collide_many(a, b, np.zeros((0, 4, 4))) == []
 
 
+def test_collide_along_answers_as_collide_many(spheres) -> None:
+    # A approaching B from 6 sigma apart to 3 sigma in, quarter-sigma steps: the
+    # answers of the warm-started runs are collide_many's to the solver's
+    # tolerance, with fewer solver iterations.
+    a, b = spheres
+    poses = np.stack([np.linalg.inv(sphere_gap_pose(g)) for g in np.arange(6.0, -3.01, -0.25)])
+    along = cp.collide_along(a, b, poses)
+    many = cp.collide_many(a, b, poses)
+    assert len(along) == len(many) == len(poses)
+    for r, m in zip(along, many, strict=True):
+        assert r.probability == pytest.approx(m.probability, abs=1e-4)
+        np.testing.assert_allclose(r.probabilities_b, m.probabilities_b, atol=1e-4)
+    iterations = [sum(r.stats.solver_iterations for r in rs) for rs in (along, many)]
+    assert 0 < iterations[0] < iterations[1]
+    assert cp.collide_along(a, b, np.zeros((0, 4, 4))) == []
+    with pytest.raises(cp.InvalidInputError, match="poses_a"):
+        cp.collide_along(a, b, np.zeros((3, 4)))
+
+
 def test_options_take_effect(spheres) -> None:
     a, b = spheres
     pose_b = sphere_gap_pose(4.0)

@@ -239,7 +239,7 @@ def test_check_motion_warm_start_changes_the_work_not_the_answer(arm: cp.Robot) 
     cold = cp.check_motion(arm, q0, q1, post, warm_start=False, **opts)
     assert warm.states_checked == cold.states_checked == warm.states_total
     assert 0.2 < cold.probability < 0.9
-    assert warm.probability == pytest.approx(cold.probability, abs=1e-5)
+    assert warm.probability == pytest.approx(cold.probability, abs=1e-4)
     s = np.linspace(0.0, 1.0, cold.states_total)
     states = cp.collide_robot_many(arm, q0 + s[:, None] * (q1 - q0), post, self_collision=False)
     assert cold.probability == states.probabilities.max()

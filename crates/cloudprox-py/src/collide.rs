@@ -87,3 +87,42 @@ pub fn collide_many(
         })
         .collect()
 }
+
+/// `collide` for cloud `a` at the `(m, 4, 4)` poses `poses_a` of a motion against
+/// cloud `b` at `pose_b`: runs of consecutive poses in parallel (rayon) with the
+/// GIL released, each query's classifier starting from the previous pose's
+/// support. Results are in the order of `poses_a`.
+#[pyfunction]
+#[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_spacing=None, **options))]
+pub fn collide_along(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    poses_a: &Bound<'_, PyAny>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
+    mesh_spacing: Option<f64>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<PyCollisionResult>> {
+    let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
+    let poses_a = poses_from(poses_a, "poses_a")?;
+    let pose_b = pose_from(py, pose_b, "pose_b")?;
+    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
+    let (sa, sb, poses) = (Arc::clone(&ca), Arc::clone(&cb), poses_a.clone());
+    let results = run_detached(py, move || {
+        cloudprox::query::collide_along(&poses_a, &ca, &pose_b, &cb, &request)
+    })?;
+    results
+        .into_iter()
+        .zip(poses)
+        .map(|(r, pose_a)| {
+            let sides = QueriedSides {
+                a: Arc::clone(&sa),
+                b: Arc::clone(&sb),
+                pose_a,
+                pose_b,
+            };
+            PyCollisionResult::with_sides(py, r, sides)
+        })
+        .collect()
+}

@@ -9,7 +9,7 @@
 //! | `convert.rs` | numpy <-> nalgebra conversion and shape checks |
 //! | `cloud.rs` | `PointCloud` |
 //! | `request.rs` | `CollisionRequest`: the query options |
-//! | `collide.rs` | `collide`, `collide_many` |
+//! | `collide.rs` | `collide`, `collide_many`, `collide_along` |
 //! | `result.rs` | `CollisionResult`, `ContactPatch`, `QueryStats` |
 //! | `filter.rs` | sensor-cloud filters: crop box, voxel, outliers, shadow, self |
 //! | `io.rs` | `CloudFile`, reading and writing point-cloud and mesh files |
@@ -57,6 +57,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<result::PyContactPatch>()?;
     m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
+    m.add_function(wrap_pyfunction!(collide::collide_along, m)?)?;
     m.add_class::<request::PyCollisionRequest>()?;
     m.add_class::<result::PyQueryStats>()?;
     m.add_class::<mesh::PyMesh>()?;

@@ -1,10 +1,12 @@
 #![allow(missing_docs)]
 //! `collide` on two 10K-point noisy spheres: apart, near, interpenetrating;
 //! the paper's per-point model and the surface-element model, at two noise
-//! levels.
+//! levels. And a motion of one sphere into the other, queried pose by pose
+//! (`collide_many`) and warm-started along the motion (`collide_along`).
 //!
 //! `cargo bench -p cloudprox --bench query`
-//! (`-- collide_10k_elements` for the element model alone)
+//! (`-- collide_10k_elements` for the element model alone, `-- motion_10k`
+//! for the motion)
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -88,5 +90,42 @@ fn bench_element_build(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_points, bench_elements, bench_element_build);
+/// A approaching B from 6 sigma apart to 3 sigma into it in quarter-sigma
+/// steps (37 poses, sigma 1 mm): every pose queried.
+fn bench_motion(c: &mut Criterion) {
+    let mut group = c.benchmark_group("motion_10k");
+    group.sample_size(10);
+    let (a, b) = common::spheres(10_000);
+    let poses: Vec<Pose> = (0..=36)
+        .map(|k| {
+            let gap = (6.0 - 0.25 * f64::from(k)) * common::SIGMA;
+            Pose::translation(-2.0 * common::RADIUS - gap, 0.0, 0.0)
+        })
+        .collect();
+    let id = Pose::identity();
+    for model in [QueryModel::Points, QueryModel::Elements] {
+        let req = CollisionRequest {
+            model,
+            ..CollisionRequest::default()
+        };
+        cloudprox::query::prepare(&a, &req);
+        cloudprox::query::prepare(&b, &req);
+        let name = format!("{model:?}").to_lowercase();
+        group.bench_function(format!("{name}/collide_many"), |bch| {
+            bch.iter(|| black_box(collide_many(&poses, &a, &id, &b, &req).unwrap()));
+        });
+        group.bench_function(format!("{name}/collide_along"), |bch| {
+            bch.iter(|| black_box(collide_along(&poses, &a, &id, &b, &req).unwrap()));
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_points,
+    bench_elements,
+    bench_element_build,
+    bench_motion
+);
 criterion_main!(benches);

@@ -23,7 +23,7 @@
 //! | bounding volume hierarchy with noise-inflated pruning | [`bvh`] |
 //! | robust separating surface (SOCP) | [`classify`] |
 //! | per-point and pair probability, thresholds, state | [`probability`] |
-//! | queries (`collide`, `collide_many`; exact mesh-vs-mesh ground truth) | [`query`] |
+//! | queries (`collide`, `collide_many`, `collide_along`; exact mesh-vs-mesh ground truth) | [`query`] |
 //! | triangle meshes, primitives, surface sampling | [`shape`] |
 //! | sensor filters: self, shadow, crop box, voxel, outliers | [`filter`] |
 //! | files: PLY, PCD, XYZ/CSV, NPY, LAS/LAZ, STL, OBJ, OFF, PointCloud2 | [`io`] |
@@ -82,8 +82,8 @@ pub mod prelude {
     pub use crate::probability::{Aggregation, CollisionState, Thresholds};
     pub use crate::query::exact::{exact_proximity, ExactProximity, ExactShape};
     pub use crate::query::{
-        collide, collide_many, collide_mesh_cloud, CollisionRequest, CollisionResult, ContactPatch,
-        MeshSampling, PointProbabilities, QueryModel, QueryStats,
+        collide, collide_along, collide_many, collide_mesh_cloud, CollisionRequest,
+        CollisionResult, ContactPatch, MeshSampling, PointProbabilities, QueryModel, QueryStats,
     };
     pub use crate::shape::Mesh;
     pub use crate::uncertainty::{

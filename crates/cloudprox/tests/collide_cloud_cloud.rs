@@ -5,6 +5,7 @@ use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::probability::normal_cdf;
+use cloudprox::query::collide::ALONG_RUN;
 use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 
 /// The paper's per-point model (this file's subject; the surface elements
@@ -262,6 +263,66 @@ fn collide_many_equals_a_loop_of_collide() {
         let one = collide(p, &a, &Pose::identity(), &b, &req).unwrap();
         assert_eq!(one.probability, m.probability);
         assert_eq!(one.probabilities_b, m.probabilities_b);
+    }
+}
+
+/// A approaching B from 6 sigma apart to 3 sigma into it, in steps of a
+/// quarter sigma: `collide_along` answers as `collide_many` (each query's
+/// classifier starting from the last one's support changes the work, not the
+/// optimum: `P` and the per-point probabilities move by the solver's
+/// tolerance, 1.4e-5 and 4e-5 at most here) with fewer solver iterations
+/// (567 against 801 for the points, 450 against 638 for the elements), for
+/// both models; and its answers do not depend on the number of threads.
+#[test]
+fn collide_along_answers_as_collide_many_with_fewer_iterations() {
+    let (a, b) = spheres(2000);
+    let poses: Vec<Pose> = (0..=36)
+        .map(|k| {
+            let gap = (6.0 - 0.25 * f64::from(k)) * SIGMA;
+            Pose::translation(-2.0 * common::RADIUS - gap, 0.0, 0.0)
+        })
+        .collect();
+    assert!(poses.len() > 2 * ALONG_RUN);
+    for model in [QueryModel::Points, QueryModel::Elements] {
+        let req = CollisionRequest {
+            model,
+            ..CollisionRequest::default()
+        };
+        let id = Pose::identity();
+        let along = collide_along(&poses, &a, &id, &b, &req).unwrap();
+        let many = collide_many(&poses, &a, &id, &b, &req).unwrap();
+        let iterations = |rs: &[CollisionResult]| -> u64 {
+            rs.iter().map(|r| r.stats.counters.solver_iterations).sum()
+        };
+        for (k, (x, y)) in along.iter().zip(&many).enumerate() {
+            assert!(
+                (x.probability - y.probability).abs() <= 1e-4,
+                "{model:?} pose {k}: along {} many {}",
+                x.probability,
+                y.probability
+            );
+            let (px, py) = (x.probabilities_b.to_dense(), y.probabilities_b.to_dense());
+            for (p, q) in px.iter().zip(&py) {
+                assert!((p - q).abs() <= 1e-4, "{model:?} pose {k}: {p} vs {q}");
+            }
+        }
+        let classified = many.iter().filter(|r| r.stats.counters.patches > 0).count();
+        assert!(classified >= 20, "{model:?}: {classified} poses classified");
+        assert!(
+            iterations(&along) < iterations(&many),
+            "{model:?}: {} iterations along, {} one by one",
+            iterations(&along),
+            iterations(&many)
+        );
+        let one_thread = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| collide_along(&poses, &a, &id, &b, &req).unwrap());
+        for (x, y) in along.iter().zip(&one_thread) {
+            assert_eq!(x.probability, y.probability);
+            assert_eq!(x.probabilities_b, y.probabilities_b);
+        }
     }
 }
 

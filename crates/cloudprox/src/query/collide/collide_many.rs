@@ -1,4 +1,5 @@
-//! Many poses of one cloud against another, in parallel.
+//! Many poses of one cloud against another, in parallel: any poses
+//! ([`collide_many`]), or the poses of a motion ([`collide_along`]).
 
 use rayon::prelude::*;
 
@@ -7,7 +8,7 @@ use crate::cloud::PointCloud;
 use crate::error::Result;
 use crate::math::Pose;
 use crate::query::collide::collide::collide_with_workspace;
-use crate::query::collide::{CollisionRequest, CollisionResult, QueryModel};
+use crate::query::collide::{CollisionRequest, CollisionResult, QueryModel, WarmStart};
 
 /// [`crate::query::collide()`] for cloud `a` at each of `poses_a` against cloud `b`
 /// at `pose_b`, on rayon's thread pool. What a query of both clouds builds on
@@ -31,6 +32,54 @@ pub fn collide_many(
             collide_with_workspace(pose_a, a, pose_b, b, request, ws, None)
         })
         .collect()
+}
+
+/// Poses of a motion that [`collide_along`] queries in a row, each from the
+/// last one's classifier support; each run of this many starts cold.
+pub const ALONG_RUN: usize = 16;
+
+/// [`crate::query::collide()`] for cloud `a` at the poses `poses_a` of a
+/// motion (consecutive poses near each other) against cloud `b` at `pose_b`.
+///
+/// The poses are taken in runs of [`ALONG_RUN`], the runs in parallel on
+/// rayon's thread pool. Within a run, each query's classifier starts from the
+/// samples that supported the previous pose's separating surfaces (as
+/// `check_motion` does per link): each round of its working set still adds
+/// every violated constraint, so the answers are [`collide_many`]'s to the
+/// solver's tolerance, with fewer solver iterations where consecutive poses
+/// see the same contact. The runs are fixed by the poses' order alone, so the
+/// answers do not depend on the number of threads. Results are in the order
+/// of `poses_a`.
+///
+/// # Errors
+/// As [`collide_many`].
+pub fn collide_along(
+    poses_a: &[Pose],
+    a: &PointCloud,
+    pose_b: &Pose,
+    b: &PointCloud,
+    request: &CollisionRequest,
+) -> Result<Vec<CollisionResult>> {
+    request.validate()?;
+    prepare(a, request);
+    prepare(b, request);
+    let runs: Vec<Result<Vec<CollisionResult>>> = poses_a
+        .par_chunks(ALONG_RUN)
+        .map(|run| {
+            let mut ws = BvhWorkspace::default();
+            let mut warm = WarmStart::default();
+            run.iter()
+                .map(|pose_a| {
+                    collide_with_workspace(pose_a, a, pose_b, b, request, &mut ws, Some(&mut warm))
+                })
+                .collect()
+        })
+        .collect();
+    let mut out = Vec::with_capacity(poses_a.len());
+    for run in runs {
+        out.extend(run?);
+    }
+    Ok(out)
 }
 
 /// Builds every part of `cloud` that is built on first use and that a query
