@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import re
+from typing import Any
 
 import numpy as np
 import pytest
@@ -137,16 +138,21 @@ def test_bad_query_input(small: cp.PointCloud, kwargs: dict, pattern: str) -> No
         cp.collide(small, small, **kwargs)
 
 
-def test_bad_collide_many_input(small: cp.PointCloud) -> None:
+@pytest.mark.parametrize("many", [cp.collide_many, cp.collide_along])
+def test_bad_collide_many_input(small: cp.PointCloud, many: Any) -> None:
     with pytest.raises(
         InvalidInputError, match=r"poses_a must have shape \(m, 4, 4\), got shape \(4, 4\)"
     ):
-        cp.collide_many(small, small, np.eye(4))
+        many(small, small, np.eye(4))
     poses = np.stack([np.eye(4), scaled()])
     with pytest.raises(InvalidInputError, match=re.escape("poses_a[1]: pose's upper-left")):
-        cp.collide_many(small, small, poses)
+        many(small, small, poses)
     with pytest.raises(InvalidInputError, match="unknown surface"):
-        cp.collide_many(small, small, np.eye(4)[None], surface="plane")
+        many(small, small, np.eye(4)[None], surface="plane")
+    with pytest.raises(InvalidInputError, match="unknown option"):
+        many(small, small, np.eye(4)[None], no_such_option=1)
+    with pytest.raises(InvalidInputError, match=r"pose_b must have shape \(4, 4\)"):
+        many(small, small, np.eye(4)[None], np.eye(4)[None])
 
 
 def test_wrong_types_raise_type_error(small: cp.PointCloud) -> None:

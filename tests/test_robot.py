@@ -225,10 +225,10 @@ def test_check_motion_finds_a_collision_between_two_free_waypoints(arm: cp.Robot
     assert coarse.states_total < m.states_total
 
 
-def test_check_motion_warm_start_changes_the_work_not_the_answer(arm: cp.Robot) -> None:
-    # Link2 passes 3 sigma over a post: checked to the end, the worst state's P
-    # is the same with and without the previous state's hint, and equals the
-    # largest of the states queried one by one.
+def test_check_motion_warm_start_saves_iterations_not_answers(arm: cp.Robot) -> None:
+    # Link2 passes 3 sigma over a post, every state checked: with the previous
+    # state's hint (the default) the classifiers take fewer iterations for the
+    # same worst P; without it, each state is exactly collide_robot's.
     half = np.array([0.01, 0.01, 0.05])
     top = 0.28 - 3 * SIGMA
     pts = cp.synthetic.sample_box_surface(tuple(half), 0.004, center=(0.2, 0.0, top - half[2]))
@@ -240,11 +240,16 @@ def test_check_motion_warm_start_changes_the_work_not_the_answer(arm: cp.Robot) 
     assert warm.states_checked == cold.states_checked == warm.states_total
     assert 0.2 < cold.probability < 0.9
     assert warm.probability == pytest.approx(cold.probability, abs=1e-4)
-    s = np.linspace(0.0, 1.0, cold.states_total)
-    states = cp.collide_robot_many(arm, q0 + s[:, None] * (q1 - q0), post, self_collision=False)
-    assert cold.probability == states.probabilities.max()
+    assert 0 < warm.solver_iterations < cold.solver_iterations
+    n = cold.states_total - 1
+    s = np.arange(n + 1) / n  # the states' t = i / n
+    states = [cp.collide_robot(arm, q0 + t * (q1 - q0), post, self_collision=False) for t in s]
+    assert cold.probability == max(r.probability for r in states)
+    assert cold.solver_iterations == sum(r.stats.solver_iterations for r in states)
     with pytest.raises(cp.InvalidInputError, match="warm_start must be a bool"):
         cp.check_motion(arm, q0, q1, post, warm_start="yes")
+    with pytest.raises(cp.InvalidInputError, match="unknown option 'warm_start'"):
+        cp.collide_robot(arm, q0, post, warm_start=True)
 
 
 def test_self_collision_on_a_folded_arm(arm: cp.Robot) -> None:

@@ -936,13 +936,14 @@ def collide_along(
 ) -> list[CollisionResult]:
     """Run :func:`collide` for the poses of a motion of ``a`` (consecutive poses near each other).
 
-    The poses are taken in runs of 16, the runs in parallel. Within a run each
-    query's classifier starts from the samples that supported the previous pose's
-    separating surfaces: the same optimum (the working set still adds every violated
-    constraint), so the answers are :func:`collide_many`'s to the solver's tolerance
-    (``P`` within about 1e-5), with fewer solver iterations where consecutive poses
-    see the same contact. The runs depend on the poses' order alone, not on the
-    number of threads.
+    The poses are taken in runs of 16 (``ceil(m / 16)`` parallel tasks), the runs in
+    parallel; each run's first pose is queried cold, each later one's classifier
+    starts from the samples that supported the previous pose's separating surfaces.
+    The working set still adds every violated constraint, so the surfaces are
+    :func:`collide_many`'s to the solver's tolerance (``P`` within about 1e-5: a
+    state can differ only where ``P`` lies that close to a threshold), with fewer
+    solver iterations where consecutive poses see the same contact. The runs depend
+    on the poses' order alone, not on the number of threads.
 
     Parameters
     ----------
@@ -1741,6 +1742,9 @@ class RobotStats:
     def node_pairs_visited(self) -> int:
         """Node pairs visited by the per-link queries, summed."""
     @property
+    def solver_iterations(self) -> int:
+        """Interior-point iterations of the per-link queries' classifiers, summed."""
+    @property
     def time_seconds(self) -> float:
         """Wall time of the query (seconds)."""
     def to_dict(self) -> dict[str, int | float]:
@@ -1798,6 +1802,9 @@ class MotionResult:
     @property
     def resolution(self) -> float:
         """The largest displacement (metres) of a link point between two states."""
+    @property
+    def solver_iterations(self) -> int:
+        """Interior-point iterations of the classifiers of every state checked, summed."""
 
 def collide_robot(
     robot: Robot,
@@ -1860,7 +1867,8 @@ def check_motion(
     self-collision). ``options``: those of :func:`collide_robot` plus
     ``resolution``, ``max_probability`` and ``warm_start`` (default ``True``: each
     state's classifier starts from the samples that supported the previous state's
-    surfaces, which saves work and gives the same answers to the solver's
-    tolerance; ``False`` makes each state's answer exactly
-    :func:`collide_robot`'s).
+    surfaces, which saves solver iterations (``solver_iterations``) and finds the
+    same surfaces to the solver's tolerance, ``P`` within about 1e-5, so only a
+    state that close to ``max_probability`` can be judged otherwise; ``False``
+    makes each state's answer exactly :func:`collide_robot`'s).
     """

@@ -1,4 +1,4 @@
-//! The `collide` and `collide_many` functions.
+//! The `collide`, `collide_many` and `collide_along` functions.
 
 use std::sync::Arc;
 
@@ -10,8 +10,12 @@ use crate::error::run_detached;
 use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, QueriedSides};
 use crate::side::resolve_pair;
+use cloudprox::cloud::PointCloud;
+use cloudprox::math::Pose;
+use cloudprox::query::{CollisionRequest, CollisionResult};
 
-/// The keywords of `collide` and `collide_many` that are not request options.
+/// The keywords of `collide`, `collide_many` and `collide_along` that are not
+/// request options.
 const QUERY_KEYWORDS: [&str; 2] = ["request", "mesh_spacing"];
 
 /// The probabilistic collision query between cloud `a` at `pose_a` and cloud `b`
@@ -50,6 +54,53 @@ pub fn collide(
     PyCollisionResult::with_sides(py, result, sides)
 }
 
+/// The core's answer for many poses of one cloud ([`cloudprox::query::collide_many`],
+/// [`cloudprox::query::collide_along`]).
+type ManyPoses = fn(
+    &[Pose],
+    &PointCloud,
+    &Pose,
+    &PointCloud,
+    &CollisionRequest,
+) -> cloudprox::Result<Vec<CollisionResult>>;
+
+/// A query of many poses of `a`: the arguments read and checked, `run` with the
+/// GIL released, each result with the sides it was queried on.
+#[allow(clippy::too_many_arguments)]
+fn query_poses(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    poses_a: &Bound<'_, PyAny>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+    request: Option<&Bound<'_, PyCollisionRequest>>,
+    mesh_spacing: Option<f64>,
+    options: Option<&Bound<'_, PyDict>>,
+    run: ManyPoses,
+) -> PyResult<Vec<PyCollisionResult>> {
+    let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
+    let poses_a = poses_from(poses_a, "poses_a")?;
+    let pose_b = pose_from(py, pose_b, "pose_b")?;
+    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
+    let (sa, sb) = (Arc::clone(&ca), Arc::clone(&cb));
+    let (results, poses_a) = run_detached(py, move || {
+        run(&poses_a, &ca, &pose_b, &cb, &request).map(|r| (r, poses_a))
+    })?;
+    results
+        .into_iter()
+        .zip(poses_a)
+        .map(|(r, pose_a)| {
+            let sides = QueriedSides {
+                a: Arc::clone(&sa),
+                b: Arc::clone(&sb),
+                pose_a,
+                pose_b,
+            };
+            PyCollisionResult::with_sides(py, r, sides)
+        })
+        .collect()
+}
+
 /// `collide` for cloud `a` at each of the `(m, 4, 4)` poses `poses_a` against cloud
 /// `b` at `pose_b`, in parallel (rayon) with the GIL released. Results are in the
 /// order of `poses_a`.
@@ -65,33 +116,24 @@ pub fn collide_many(
     mesh_spacing: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<PyCollisionResult>> {
-    let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
-    let poses_a = poses_from(poses_a, "poses_a")?;
-    let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
-    let (sa, sb, poses) = (Arc::clone(&ca), Arc::clone(&cb), poses_a.clone());
-    let results = run_detached(py, move || {
-        cloudprox::query::collide_many(&poses_a, &ca, &pose_b, &cb, &request)
-    })?;
-    results
-        .into_iter()
-        .zip(poses)
-        .map(|(r, pose_a)| {
-            let sides = QueriedSides {
-                a: Arc::clone(&sa),
-                b: Arc::clone(&sb),
-                pose_a,
-                pose_b,
-            };
-            PyCollisionResult::with_sides(py, r, sides)
-        })
-        .collect()
+    let run: ManyPoses = cloudprox::query::collide_many;
+    query_poses(
+        py,
+        a,
+        b,
+        poses_a,
+        pose_b,
+        request,
+        mesh_spacing,
+        options,
+        run,
+    )
 }
 
 /// `collide` for cloud `a` at the `(m, 4, 4)` poses `poses_a` of a motion against
-/// cloud `b` at `pose_b`: runs of consecutive poses in parallel (rayon) with the
-/// GIL released, each query's classifier starting from the previous pose's
-/// support. Results are in the order of `poses_a`.
+/// cloud `b` at `pose_b`: runs of 16 consecutive poses in parallel (rayon) with
+/// the GIL released, within a run each query's classifier starting from the
+/// previous pose's support. Results are in the order of `poses_a`.
 #[pyfunction]
 #[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_spacing=None, **options))]
 pub fn collide_along(
@@ -104,25 +146,16 @@ pub fn collide_along(
     mesh_spacing: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<PyCollisionResult>> {
-    let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
-    let poses_a = poses_from(poses_a, "poses_a")?;
-    let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
-    let (sa, sb, poses) = (Arc::clone(&ca), Arc::clone(&cb), poses_a.clone());
-    let results = run_detached(py, move || {
-        cloudprox::query::collide_along(&poses_a, &ca, &pose_b, &cb, &request)
-    })?;
-    results
-        .into_iter()
-        .zip(poses)
-        .map(|(r, pose_a)| {
-            let sides = QueriedSides {
-                a: Arc::clone(&sa),
-                b: Arc::clone(&sb),
-                pose_a,
-                pose_b,
-            };
-            PyCollisionResult::with_sides(py, r, sides)
-        })
-        .collect()
+    let run: ManyPoses = cloudprox::query::collide_along;
+    query_poses(
+        py,
+        a,
+        b,
+        poses_a,
+        pose_b,
+        request,
+        mesh_spacing,
+        options,
+        run,
+    )
 }

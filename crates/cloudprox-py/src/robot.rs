@@ -435,6 +435,8 @@ stats_class! {
         self_pairs_checked: usize,
         /// Node pairs visited by the per-link queries, summed.
         node_pairs_visited: usize,
+        /// Interior-point iterations of the per-link queries' classifiers, summed.
+        solver_iterations: u64,
     }
 }
 
@@ -777,6 +779,12 @@ impl PyMotionResult {
     #[getter]
     fn resolution(&self) -> f64 {
         self.inner.resolution
+    }
+
+    /// Interior-point iterations of the classifiers of every state checked, summed.
+    #[getter]
+    fn solver_iterations(&self) -> u64 {
+        self.inner.solver_iterations
     }
 
     fn __repr__(&self) -> String {

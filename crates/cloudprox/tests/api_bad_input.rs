@@ -78,17 +78,25 @@ fn bad_requests() {
     req.thresholds.free = 0.7;
     let a = PointCloud::from_sigma(pts(5), 0.01).unwrap();
     assert!(msg(collide(&Pose::identity(), &a, &Pose::identity(), &a, &req)).contains("threshold"));
-    assert!(msg(collide_many(
-        &[Pose::identity()],
+    let id = Pose::identity();
+    for many in [collide_many, collide_along] {
+        assert!(msg(many(&[id], &a, &id, &a, &req)).contains("threshold"));
+    }
+    // A motion's pose that is not finite is named by its index, before any
+    // query runs.
+    let mut far = Pose::translation(1.0, 0.0, 0.0);
+    far.translation.vector.x = f64::NAN;
+    let motion = [Pose::identity(), Pose::identity(), far];
+    let e = msg(collide_along(
+        &motion,
         &a,
-        &Pose::identity(),
+        &id,
         &a,
-        &req
-    ))
-    .contains("threshold"));
+        &CollisionRequest::default(),
+    ));
+    assert!(e.contains("poses_a[2]") && e.contains("not finite"), "{e}");
     // So is every other entry point that takes a request or settings.
     let cube = Mesh::cuboid(0.1, 0.1, 0.1).unwrap();
-    let id = Pose::identity();
     let sampling = MeshSampling::default();
     let e = msg(collide_mesh_cloud(&id, &cube, &id, &a, &req, &sampling));
     assert!(e.contains("threshold"), "{e}");

@@ -5,7 +5,7 @@ use crate::common;
 
 use cloudprox::prelude::*;
 use cloudprox::probability::normal_cdf;
-use cloudprox::query::collide::ALONG_RUN;
+use cloudprox::query::ALONG_RUN;
 use common::{plate_pose, plates, sphere_pose, spheres, SIGMA};
 
 /// The paper's per-point model (this file's subject; the surface elements
@@ -305,6 +305,15 @@ fn collide_along_answers_as_collide_many_with_fewer_iterations() {
             for (p, q) in px.iter().zip(&py) {
                 assert!((p - q).abs() <= 1e-4, "{model:?} pose {k}: {p} vs {q}");
             }
+        }
+        // Each run's first pose is queried cold: exactly collide_many's.
+        for k in (0..poses.len()).step_by(ALONG_RUN) {
+            assert_eq!(along[k].probability, many[k].probability, "pose {k}");
+            assert_eq!(along[k].probabilities_b, many[k].probabilities_b);
+            assert_eq!(
+                along[k].stats.counters.solver_iterations,
+                many[k].stats.counters.solver_iterations
+            );
         }
         let classified = many.iter().filter(|r| r.stats.counters.patches > 0).count();
         assert!(classified >= 20, "{model:?}: {classified} poses classified");

@@ -62,19 +62,21 @@ pub fn train(
     labels: &[Real],
     settings: &ClassifySettings,
 ) -> Result<Classification> {
-    train_hinted(points, covs, labels, settings, &[]).map(|(c, _)| c)
+    train_hinted(points, covs, labels, settings, None).map(|(c, _)| c)
 }
 
-/// [`train`], with the specialized method's first working set widened by
-/// `hint` (empty, or one flag per point: the constraints that supported a
-/// nearby problem's surface). Also returns, per point, whether its constraint
-/// supports this surface (empty when the specialized method did not solve it).
+/// [`train`] for one of a sequence of nearby problems when `warm` is given:
+/// the specialized method's first working set is widened by it (empty, or
+/// one flag per point: the constraints that supported the previous problem's
+/// surface), and the result comes with, per point, whether its constraint
+/// supports this surface (empty when `warm` is `None` or the specialized
+/// method did not solve it).
 pub(crate) fn train_hinted(
     points: &[Point3],
     covs: &[Matrix3],
     labels: &[Real],
     settings: &ClassifySettings,
-    hint: &[bool],
+    warm: Option<&[bool]>,
 ) -> Result<(Classification, Vec<bool>)> {
     settings.validate()?;
     let n = points.len();
@@ -108,7 +110,7 @@ pub(crate) fn train_hinted(
             settings.slack_weight,
             r,
             settings.solver_tol,
-            hint,
+            warm,
         ) {
             let classification = Classification {
                 separator: Separator {

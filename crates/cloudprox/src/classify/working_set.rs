@@ -38,11 +38,15 @@ const SUPPORT_MARGIN: Real = 0.25;
 /// (`lambda` the slack weight, `r` the robust radius) on a working set of its
 /// constraints; `None` when the method does not converge.
 ///
-/// `hint` (empty, or one flag per point) names constraints to put in the
-/// first working set besides the nearest points: those that supported a
-/// nearby problem's surface. It changes the work, not the answer. Returns the
-/// optimum and, per point, whether its constraint supports the surface
-/// (within [`SUPPORT_MARGIN`] of its bound).
+/// `warm`: `None` for a query on its own; for one of a sequence of nearby
+/// problems (the states of a motion), the constraints that supported the
+/// previous problem's surface (empty, or one flag per point), put in the first
+/// working set besides the nearest points. Either way the working set adds
+/// every violated constraint before it stops, so the optimum is the same to
+/// the solver's tolerance; should a hinted round not converge, the problem is
+/// solved again without the hint. With `warm` given, also returns per point
+/// whether its constraint supports the surface (within [`SUPPORT_MARGIN`] of
+/// its bound), for the next problem; otherwise an empty vector.
 pub(crate) fn solve_reduced(
     norm: &Normalized,
     labels: &[Real],
@@ -50,21 +54,35 @@ pub(crate) fn solve_reduced(
     lambda: Real,
     r: Real,
     tol: Real,
-    hint: &[bool],
+    warm: Option<&[bool]>,
 ) -> Option<(Solution, Vec<bool>)> {
     let n = norm.u.len();
     let d = surface.dim();
     let data = cone_data(norm, labels, surface, r);
+    let hint = warm.unwrap_or_default();
+    debug_assert!(
+        hint.is_empty() || hint.len() == n,
+        "one hint flag per point"
+    );
     let sol = if n <= 4 * WORKING_SET_START {
         solve_primal_dual(&data, d, lambda, tol)?
     } else {
-        solve_working_set(&data, norm, labels, d, lambda, tol, hint)?
+        let hinted = solve_working_set(&data, norm, labels, d, lambda, tol, hint);
+        match hinted {
+            None if hint.contains(&true) => {
+                solve_working_set(&data, norm, labels, d, lambda, tol, &[])?
+            }
+            other => other?,
+        }
     };
-    let z = unknowns(&sol);
-    let support = data
-        .iter()
-        .map(|c| constraint_margin(c, &z) <= SUPPORT_MARGIN)
-        .collect();
+    let support = if warm.is_some() {
+        let z = unknowns(&sol);
+        data.iter()
+            .map(|c| constraint_margin(c, &z) <= SUPPORT_MARGIN)
+            .collect()
+    } else {
+        Vec::new()
+    };
     Some((sol, support))
 }
 
@@ -267,7 +285,16 @@ mod tests {
         let solve = |dx: Real, hint: &[bool]| {
             let (norm, labels) = two_spheres(dx);
             assert!(labels.len() > 4 * WORKING_SET_START);
-            solve_reduced(&norm, &labels, Surface::Quadric, 100.0, 1.0, 1e-7, hint).unwrap()
+            solve_reduced(
+                &norm,
+                &labels,
+                Surface::Quadric,
+                100.0,
+                1.0,
+                1e-7,
+                Some(hint),
+            )
+            .unwrap()
         };
         // The first state (the spheres 15 mm, 7.5 sigma, into each other):
         // cold. Every point with slack supports the surface.

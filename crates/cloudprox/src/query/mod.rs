@@ -11,5 +11,5 @@ pub mod exact;
 pub use collide::{
     collide, collide_along, collide_many, collide_mesh_cloud, prepare, CollisionRequest,
     CollisionResult, ContactPatch, MeshSampling, PointAggregates, PointProbabilities,
-    QueryCounters, QueryModel, QueryStats,
+    QueryCounters, QueryModel, QueryStats, ALONG_RUN,
 };

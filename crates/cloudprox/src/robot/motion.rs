@@ -33,10 +33,12 @@ pub struct MotionRequest {
     /// Whether each state's classifier starts from the samples that supported
     /// the previous state's separating surfaces, link by link (default
     /// `true`). Consecutive states lie within the resolution of each other, so
-    /// the working set's first round is more often already the optimum. The
-    /// answers are the same as without it (each state's classifier still
-    /// adds every violated constraint), to the solver's tolerance; `false`
-    /// makes every state's answer bit-for-bit that of [`collide_robot`](super::collide_robot).
+    /// the working set's first round is more often already the optimum. Each
+    /// state's classifier still adds every violated constraint, so its
+    /// surface is the cold query's to the solver's tolerance and `P` moves by
+    /// about 1e-5 at most (a state whose `P` lies that close to
+    /// `max_probability` can be judged otherwise); `false` makes every
+    /// state's answer bit for bit that of [`collide_robot`](super::collide_robot).
     pub warm_start: bool,
 }
 
@@ -95,6 +97,9 @@ pub struct MotionResult {
     pub states_total: usize,
     /// The largest displacement (metres) of a link point between two states.
     pub resolution: Real,
+    /// Interior-point iterations of the classifiers of every state checked,
+    /// summed (what [`MotionRequest::warm_start`] saves).
+    pub solver_iterations: u64,
 }
 
 /// The default [`MotionRequest::resolution`] for `cloud`.
@@ -171,12 +176,14 @@ pub fn check_motion(
     let mut q = vec![0.0; q0.len()];
     let mut worst = 0.0;
     let mut worst_state = CollisionState::Free;
+    let mut solver_iterations = 0;
     for i in 0..=steps {
         let t = i as Real / steps as Real;
         for (k, v) in q.iter_mut().enumerate() {
             *v = q0[k] + t * dq[k];
         }
         let r = collide_robot_prepared(robot, &samples, &q, base, cloud, &request.robot, &mut ws);
+        solver_iterations += r.stats.counters.solver_iterations;
         if r.probability >= worst {
             worst = r.probability;
             worst_state = r.state;
@@ -190,6 +197,7 @@ pub fn check_motion(
                 states_checked: i + 1,
                 states_total: steps + 1,
                 resolution,
+                solver_iterations,
             });
         }
     }
@@ -201,5 +209,6 @@ pub fn check_motion(
         states_checked: steps + 1,
         states_total: steps + 1,
         resolution,
+        solver_iterations,
     })
 }

@@ -111,6 +111,8 @@ pub struct RobotCounters {
     pub self_pairs_checked: usize,
     /// Node pairs visited by the per-link queries, summed.
     pub node_pairs_visited: usize,
+    /// Interior-point iterations of the per-link queries' classifiers, summed.
+    pub solver_iterations: u64,
 }
 
 /// Counters and timings of one robot query. Equality compares the counters,
@@ -352,6 +354,7 @@ pub(crate) fn collide_robot_prepared(
         ) {
             Ok(r) => {
                 stats.counters.node_pairs_visited += r.stats.counters.node_pairs_visited;
+                stats.counters.solver_iterations += r.stats.counters.solver_iterations;
                 decided = request.collide.decide_only
                     && r.probability >= request.collide.thresholds.collision;
                 links.push(LinkCollision {

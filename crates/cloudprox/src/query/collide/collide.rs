@@ -56,7 +56,8 @@ use crate::Real;
 /// ```
 ///
 /// # See Also
-/// [`crate::query::collide_many`] for many poses of one cloud in parallel.
+/// [`crate::query::collide_many`] for many poses of one cloud in parallel;
+/// [`crate::query::collide_along`] for the poses of a motion.
 pub fn collide(
     pose_a: &Pose,
     a: &PointCloud,
@@ -184,7 +185,7 @@ pub(crate) fn collide_with_workspace(
     let stop_early = request.decide_only
         && matches!(request.aggregation, Aggregation::Max | Aggregation::Surface);
     if let Some(w) = warm.as_deref_mut() {
-        w.begin();
+        w.begin(sa.len(), sb.len());
     }
     'regions: for component in near.regions {
         let (pa, ca) = in_frame(&rel, sa, &component.a);
@@ -227,7 +228,7 @@ pub(crate) fn collide_with_workspace(
             }
             let spacing = patch_median(&ia, sa.spacing(), &ib, sb.spacing());
             let sigma = patch_median(&ia, sa.sigma_max(), &ib, sb.sigma_max());
-            let hint = warm.as_deref().map_or_else(Vec::new, |w| w.hint(&ia, &ib));
+            let hint = warm.as_deref().map(|w| w.hint(&ia, &ib));
             let fit = fit_patch(
                 &pts,
                 &covs,
@@ -237,11 +238,8 @@ pub(crate) fn collide_with_workspace(
                 sigma,
                 request,
                 !request.decide_only,
-                &hint,
+                hint.as_deref(),
             )?;
-            if let Some(w) = warm.as_deref_mut() {
-                w.record(&ia, &ib, &fit.support);
-            }
             // A context sample (beyond the noise's reach of the other cloud) that
             // the surface puts on the wrong side shows a surface too rigid for the
             // patch (a wrapped or saddle-shaped contact): cut it and fit the
@@ -279,6 +277,10 @@ pub(crate) fn collide_with_workspace(
             });
             if cut_misfit(crossings.as_ref().is_some_and(|c| c.2), &mut stats) {
                 continue;
+            }
+            // The surface is kept (a cut one's halves record their own).
+            if let Some(w) = warm.as_deref_mut() {
+                w.record(&ia, &ib, &fit.support);
             }
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);

@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use crate::bvh::BvhWorkspace;
-use crate::cloud::PointCloud;
+use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::Pose;
 use crate::query::collide::collide::collide_with_workspace;
@@ -23,15 +23,22 @@ pub fn collide_many(
     b: &PointCloud,
     request: &CollisionRequest,
 ) -> Result<Vec<CollisionResult>> {
-    request.validate()?;
-    prepare(a, request);
-    prepare(b, request);
+    ready(a, b, request)?;
     poses_a
         .par_iter()
         .map_init(BvhWorkspace::default, |ws, pose_a| {
             collide_with_workspace(pose_a, a, pose_b, b, request, ws, None)
         })
         .collect()
+}
+
+/// Checks `request` and builds what a query of `a` and `b` under it builds on
+/// first use ([`prepare`]), before a parallel part.
+fn ready(a: &PointCloud, b: &PointCloud, request: &CollisionRequest) -> Result<()> {
+    request.validate()?;
+    prepare(a, request);
+    prepare(b, request);
+    Ok(())
 }
 
 /// Poses of a motion that [`collide_along`] queries in a row, each from the
@@ -42,17 +49,21 @@ pub const ALONG_RUN: usize = 16;
 /// motion (consecutive poses near each other) against cloud `b` at `pose_b`.
 ///
 /// The poses are taken in runs of [`ALONG_RUN`], the runs in parallel on
-/// rayon's thread pool. Within a run, each query's classifier starts from the
-/// samples that supported the previous pose's separating surfaces (as
-/// `check_motion` does per link): each round of its working set still adds
-/// every violated constraint, so the answers are [`collide_many`]'s to the
-/// solver's tolerance, with fewer solver iterations where consecutive poses
-/// see the same contact. The runs are fixed by the poses' order alone, so the
-/// answers do not depend on the number of threads. Results are in the order
-/// of `poses_a`.
+/// rayon's thread pool (so `ceil(m / ALONG_RUN)` parallel tasks for `m`
+/// poses). A run's first pose is queried cold; each later pose's classifier
+/// starts from the samples that supported the previous pose's separating
+/// surfaces (as `check_motion` does per link). Each round of its working set
+/// still adds every violated constraint, so the surfaces are
+/// [`collide_many`]'s to the solver's tolerance and `P` moves by about 1e-5
+/// at most (a state can differ only where `P` lies that close to a
+/// threshold), with fewer solver iterations where consecutive poses see the
+/// same contact. The runs are fixed by the poses' order alone, so the answers
+/// do not depend on the number of threads. Results are in the order of
+/// `poses_a`.
 ///
 /// # Errors
-/// As [`collide_many`].
+/// An invalid request; a pose of `poses_a` that is not finite (the first, by
+/// its index), found before any query runs.
 pub fn collide_along(
     poses_a: &[Pose],
     a: &PointCloud,
@@ -60,9 +71,10 @@ pub fn collide_along(
     b: &PointCloud,
     request: &CollisionRequest,
 ) -> Result<Vec<CollisionResult>> {
-    request.validate()?;
-    prepare(a, request);
-    prepare(b, request);
+    ready(a, b, request)?;
+    for (i, pose) in poses_a.iter().enumerate() {
+        validate_pose(pose, &format!("poses_a[{i}]"))?;
+    }
     let runs: Vec<Result<Vec<CollisionResult>>> = poses_a
         .par_chunks(ALONG_RUN)
         .map(|run| {
@@ -93,7 +105,7 @@ pub fn collide_along(
 /// these parts are built with rayon inside a `OnceLock`, and a rayon thread
 /// building one, while it waits for its helpers, may take up another query of
 /// the same loop that needs the same part and wait for itself. It also keeps
-/// the build out of the first query's time. [`collide_many`] and the robot's
+/// the build out of the first query's time. [`collide_many`], [`collide_along`] and the robot's
 /// batch queries call it themselves.
 pub fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
     let _ = (cloud.bvh(), cloud.spacing());

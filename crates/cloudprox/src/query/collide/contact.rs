@@ -20,8 +20,8 @@ pub(crate) struct PatchFit {
     /// The separation estimate (see [`crate::query::ContactPatch::separation`]);
     /// not computed (NaN) when `contact` is false.
     pub separation: Real,
-    /// Per point, whether its constraint supports the surface (empty when the
-    /// specialized solver did not solve it).
+    /// Per point, whether its constraint supports the surface (empty unless
+    /// warm-started, or when the specialized solver did not solve it).
     pub support: Vec<bool>,
 }
 
@@ -36,12 +36,12 @@ pub(crate) fn fit_patch(
     sigma: Real,
     request: &CollisionRequest,
     contact: bool,
-    hint: &[bool],
+    warm: Option<&[bool]>,
 ) -> Result<PatchFit> {
     let labels: Vec<Real> = (0..pts.len())
         .map(|i| if i < na { 1.0 } else { -1.0 })
         .collect();
-    let (classification, support) = train_hinted(pts, covs, &labels, &request.classify, hint)?;
+    let (classification, support) = train_hinted(pts, covs, &labels, &request.classify, warm)?;
     let sep = &classification.separator;
     let mut probabilities = Vec::with_capacity(pts.len());
     let mut margins = Vec::with_capacity(pts.len());

@@ -4,16 +4,22 @@
 //! (about a sensor sigma), so the samples whose constraints shaped one state's
 //! separating surfaces are, mostly, those that shape the next state's. The
 //! working set ([`crate::classify`]) starts from the samples nearest the other
-//! cloud; given these too, its first round is most often already the optimum,
+//! cloud; given these too, its first round is more often already the optimum,
 //! where it would otherwise need a second round or the whole problem. The hint
-//! changes the work, never the answer: the working set still adds every
-//! violated constraint before it stops.
+//! changes the work, not the optimum: the working set still adds every
+//! violated constraint before it stops, so the surface is the cold query's to
+//! the solver's tolerance. What is read off it moves by as much (`P` by up to
+//! about 1e-5 in the tests), so a decision taken at a threshold (a state, a
+//! misfit cut) can come out otherwise where a value lies that close to it.
 
 /// The samples (indices into each cloud's query samples: its points, or its
 /// surface elements' samples) whose constraints supported the last query's
 /// surfaces.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct WarmStart {
+    /// The number of query samples of A and of B the hint was gathered on: a
+    /// query on others (another cloud or model) starts without it.
+    samples: (usize, usize),
     /// Sorted sample indices of cloud A and of cloud B.
     support: [Vec<u32>; 2],
     /// The current query's, gathered patch by patch.
@@ -23,12 +29,20 @@ pub(crate) struct WarmStart {
 }
 
 impl WarmStart {
-    /// Starts a query: forgets what an unfinished one gathered.
-    pub(crate) fn begin(&mut self) {
+    /// Starts a query of clouds with `na` and `nb` query samples: forgets what
+    /// an unfinished one gathered, and the hint if it was gathered on clouds of
+    /// other sizes.
+    pub(crate) fn begin(&mut self, na: usize, nb: usize) {
         for v in &mut self.next {
             v.clear();
         }
         self.recorded = false;
+        if self.samples != (na, nb) {
+            self.samples = (na, nb);
+            for v in &mut self.support {
+                v.clear();
+            }
+        }
     }
 
     /// The working set's hint for a patch of A's samples `ia` and B's `ib`:
@@ -84,7 +98,7 @@ mod tests {
     #[test]
     fn a_patch_s_support_is_hinted_to_the_next_query_by_sample_index() {
         let mut w = WarmStart::default();
-        w.begin();
+        w.begin(10, 10);
         // Two patches: A's 7 and 3 with B's 2 and 9; then A's 5 with B's 9.
         w.record(&[7, 3], &[2, 9], &[true, false, false, true]);
         w.record(&[5], &[9], &[true, true]);
@@ -102,26 +116,32 @@ mod tests {
     #[test]
     fn a_query_that_classifies_nothing_keeps_the_hint_and_an_unfinished_one_leaves_nothing() {
         let mut w = WarmStart::default();
-        w.begin();
+        w.begin(10, 10);
         w.record(&[4], &[6], &[true, true]);
         w.finish();
         // Decided by bounds: nothing recorded.
-        w.begin();
+        w.begin(10, 10);
         w.finish();
         assert_eq!(w.support(), (&[4][..], &[6][..]));
         // A query that failed midway (recorded, never finished) is forgotten
         // by the next one's begin.
-        w.begin();
+        w.begin(10, 10);
         w.record(&[8], &[1], &[true, true]);
-        w.begin();
+        w.begin(10, 10);
         w.record(&[2], &[3], &[false, true]);
         w.finish();
         assert_eq!(w.support(), (&[][..], &[3][..]));
         // The solver reported no support (Clarabel's fallback): the next
         // query starts without a hint.
-        w.begin();
+        w.begin(10, 10);
         w.record(&[2], &[3], &[]);
         w.finish();
         assert_eq!(w.support(), (&[][..], &[][..]));
+        // A query of clouds of other sizes starts without the hint.
+        w.begin(10, 10);
+        w.record(&[4], &[6], &[true, true]);
+        w.finish();
+        w.begin(10, 11);
+        assert!(w.hint(&[4], &[6]).iter().all(|&h| !h));
     }
 }
