@@ -271,7 +271,7 @@ fn collide_many_equals_a_loop_of_collide() {
 /// classifier starting from the last one's support changes the work, not the
 /// optimum: `P` and the per-point probabilities move by the solver's
 /// tolerance, 1.4e-5 and 4e-5 at most here) with fewer solver iterations
-/// (567 against 801 for the points, 450 against 638 for the elements), for
+/// (573 against 801 for the points, 468 against 638 for the elements), for
 /// both models; and its answers do not depend on the number of threads.
 #[test]
 fn collide_along_answers_as_collide_many_with_fewer_iterations() {

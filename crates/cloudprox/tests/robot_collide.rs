@@ -626,7 +626,7 @@ fn check_motion_answers_as_its_states_queried_one_by_one() {
             warm.probability
         );
         // The points model's regions are larger than the working set's
-        // first round (2568 against 4242 iterations at 2 sigma); the
+        // first round (2567 against 4242 iterations at 2 sigma); the
         // elements' are often small enough to be solved whole, where a hint
         // changes nothing (1975 against 2201 at 3 sigma, equal at 4).
         let fewer = if model == QueryModel::Points {

@@ -101,8 +101,9 @@ fn constraint_margin(c: &ConeData, z: &[Real; MAX_UNKNOWNS]) -> Real {
     g[0] - 1.0 - (g[1] * g[1] + g[2] * g[2] + g[3] * g[3]).sqrt()
 }
 
-/// The working-set rounds (see the module docs), starting from the nearest
-/// points and the `hint`ed constraints.
+/// The working-set rounds (see the module docs), starting from the `hint`ed
+/// constraints, with the nearest points unless the hint holds enough of both
+/// clouds.
 fn solve_working_set(
     data: &[ConeData],
     norm: &Normalized,
@@ -113,10 +114,26 @@ fn solve_working_set(
     hint: &[bool],
 ) -> Option<Solution> {
     let n = data.len();
-    let mut in_set = initial_working_set(norm, labels);
-    for (s, &h) in in_set.iter_mut().zip(hint) {
-        *s |= h;
-    }
+    // A hint that holds, of each cloud, at least as many points as the
+    // surface has unknowns is the first set on its own: it supported a
+    // nearby surface, which the nearest points need not (and finding them
+    // costs a search over the region). Otherwise the nearest points start,
+    // with the hint's.
+    let hinted = |label: Real| {
+        hint.iter()
+            .zip(labels)
+            .filter(|&(&h, &c)| h && c == label)
+            .count()
+    };
+    let mut in_set = if hinted(1.0) > d && hinted(-1.0) > d {
+        hint.to_vec()
+    } else {
+        let mut nearest = initial_working_set(norm, labels);
+        for (s, &h) in nearest.iter_mut().zip(hint) {
+            *s |= h;
+        }
+        nearest
+    };
     let mut iterations = 0;
     for _ in 0..WORKING_SET_ROUNDS {
         if 2 * in_set.iter().filter(|&&x| x).count() > n {
