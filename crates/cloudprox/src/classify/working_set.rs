@@ -2,7 +2,9 @@
 //!
 //! Points far on their own side satisfy their constraint with zero slack and do
 //! not shape the optimum. The problem is solved first on a working set (the
-//! points of each cloud nearest the other cloud), every other point's
+//! points of each cloud nearest the other cloud; along a motion, the points
+//! that supported the previous state's surface, see
+//! `query/collide/warm_start.rs`), every other point's
 //! constraint is checked at that solution
 //! (`c_i f(x_i) - 1 >= r |Sigma_i^(1/2) grad f|`), and every violated one is
 //! added until none is. Solving on a subset is a relaxation of the full

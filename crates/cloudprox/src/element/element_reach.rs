@@ -57,6 +57,18 @@ pub(crate) struct Hull {
 }
 
 impl Hull {
+    /// The corners moved by `pose`. A plain loop: an array `map`'s closure
+    /// is left out of line by some builds (a 15-20% slower hull descent in
+    /// criterion's microsecond cases when it was, with no change to this code).
+    #[inline]
+    pub(crate) fn corners_moved(&self, pose: &Pose) -> [Point3; 4] {
+        let mut out = self.corners;
+        for c in &mut out {
+            *c = pose * *c;
+        }
+        out
+    }
+
     fn new(e: &SurfaceElement, sample_sigma: Real, sample_spacing: Real) -> Self {
         let across = across_normal(e);
         let mut corners = [e.mean; 4];
@@ -271,7 +283,7 @@ impl PosedHull {
         Self {
             mean: rel * h.mean,
             normal: rel.rotation * h.normal,
-            corners: h.corners.map(|c| rel * c),
+            corners: h.corners_moved(rel),
         }
     }
 }

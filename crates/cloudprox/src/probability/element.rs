@@ -45,7 +45,7 @@ impl<'a> Posed<'a> {
             tangents: [r * e.tangents[0], r * e.tangents[1]],
             normal: r * e.normal,
             across: r * across_normal(e) * r.transpose(),
-            corners: hull.corners.map(|c| pose * c),
+            corners: hull.corners_moved(pose),
         }
     }
 
