@@ -66,9 +66,9 @@ pub fn train(
 }
 
 /// [`train`] for one of a sequence of nearby problems when `warm` is given:
-/// the specialized method's first working set is widened by it (empty, or
+/// the specialized method's first working set starts from it (empty, or
 /// one flag per point: the constraints that supported the previous problem's
-/// surface), and the result comes with, per point, whether its constraint
+/// surface; alone when it is large enough, else with the nearest points), and the result comes with, per point, whether its constraint
 /// supports this surface (empty when `warm` is `None` or the specialized
 /// method did not solve it).
 pub(crate) fn train_hinted(

@@ -42,8 +42,10 @@ const SUPPORT_MARGIN: Real = 0.25;
 ///
 /// `warm`: `None` for a query on its own; for one of a sequence of nearby
 /// problems (the states of a motion), the constraints that supported the
-/// previous problem's surface (empty, or one flag per point), put in the first
-/// working set besides the nearest points. Either way the working set adds
+/// previous problem's surface (empty, or one flag per point): the first
+/// working set, alone when it holds more points of each cloud than the
+/// surface has coefficients (as many as its unknowns), else with the nearest
+/// points. Either way the working set adds
 /// every violated constraint before it stops, so the optimum is the same to
 /// the solver's tolerance; should a hinted round not converge, the problem is
 /// solved again without the hint. With `warm` given, also returns per point
@@ -127,7 +129,7 @@ fn solve_working_set(
             .filter(|&(&h, &c)| h && c == label)
             .count()
     };
-    let mut in_set = if hinted(1.0) > d && hinted(-1.0) > d {
+    let mut in_set = if hint.len() == n && hinted(1.0) > d && hinted(-1.0) > d {
         hint.to_vec()
     } else {
         let mut nearest = initial_working_set(norm, labels);

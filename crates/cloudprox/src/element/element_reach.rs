@@ -58,8 +58,8 @@ pub(crate) struct Hull {
 
 impl Hull {
     /// The corners moved by `pose`. A plain loop: an array `map`'s closure
-    /// is left out of line by some builds (a 15-20% slower hull descent in
-    /// criterion's microsecond cases when it was, with no change to this code).
+    /// is left out of line by some builds (four of criterion's microsecond
+    /// cases 12-23% slower when it was, with no change to this code).
     #[inline]
     pub(crate) fn corners_moved(&self, pose: &Pose) -> [Point3; 4] {
         let mut out = self.corners;

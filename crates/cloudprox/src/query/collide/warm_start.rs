@@ -4,7 +4,9 @@
 //! (about a sensor sigma), so the samples whose constraints shaped one state's
 //! separating surfaces are, mostly, those that shape the next state's. The
 //! working set ([`crate::classify`]) starts from the samples nearest the other
-//! cloud; given these too, its first round is more often already the optimum,
+//! cloud; given these (alone when they hold more samples of each cloud than
+//! the surface has coefficients, else with the nearest), its first round is
+//! more often already the optimum,
 //! where it would otherwise need a second round or the whole problem. The hint
 //! changes the work, not the optimum: the working set still adds every
 //! violated constraint before it stops, so the surface is the cold query's to
