@@ -53,6 +53,7 @@ __all__ = [
     "add_noise",
     "check_motion",
     "collide",
+    "collide_along",
     "collide_many",
     "collide_robot",
     "collide_robot_many",
