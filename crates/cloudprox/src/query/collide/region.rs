@@ -4,7 +4,7 @@ use std::collections::HashMap;
 
 use crate::bvh::{Aabb, Bvh};
 use crate::cloud::PointCloud;
-use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::math::{Matrix3, Point3, Pose, PrincipalAxes, Vector3};
 use crate::probability::normal_quantile;
 use crate::Real;
 
@@ -560,27 +560,24 @@ fn halves(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
     if p.a.is_empty() || p.b.is_empty() {
         return None;
     }
-    let xa = p.a.iter().map(|&i| pa[i as usize].coords);
-    let xb = p.b.iter().map(|&i| pb[i as usize].coords);
-    let mean_a = xa.clone().sum::<Vector3>() / p.a.len() as Real;
-    let mean_b = xb.clone().sum::<Vector3>() / p.b.len() as Real;
-    let all: Vec<Vector3> = xa.chain(xb).collect();
-    let mean = all.iter().sum::<Vector3>() / all.len() as Real;
-    let mut scatter = Matrix3::zeros();
-    for x in &all {
-        let d = x - mean;
-        scatter += d * d.transpose();
-    }
-    let mut normal = mean_b - mean_a;
-    if normal.norm() <= 1e-12 * scatter.trace().sqrt().max(Real::MIN_POSITIVE) {
-        let eig = scatter.symmetric_eigen();
-        normal = eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned();
+    let all: Vec<Point3> = (p.a.iter().map(|&i| pa[i as usize]))
+        .chain(p.b.iter().map(|&i| pb[i as usize]))
+        .collect();
+    let (all_a, all_b) = all.split_at(p.a.len());
+    let mean = |x: &[Point3]| x.iter().map(|q| q.coords).sum::<Vector3>() / x.len() as Real;
+    let whole = PrincipalAxes::of(all.iter().copied());
+    // Across the contact: from A's points to B's, or the least spread where
+    // their means coincide.
+    let mut normal = mean(all_b) - mean(all_a);
+    let spread = (whole.variances.sum() * all.len() as Real).sqrt();
+    if normal.norm() <= 1e-12 * spread.max(Real::MIN_POSITIVE) {
+        normal = whole.least();
     }
     let normal = normal.normalize();
-    let proj = Matrix3::identity() - normal * normal.transpose();
-    let eig = (proj * scatter * proj).symmetric_eigen();
-    let axis = eig.eigenvectors.column(eig.eigenvalues.imax()).into_owned();
-    let mut keys: Vec<Real> = all.iter().map(|x| x.dot(&axis)).collect();
+    // Along the contact: the largest spread of the points projected onto the
+    // plane normal to it.
+    let axis = PrincipalAxes::of(all.iter().map(|x| x - normal * normal.dot(&x.coords))).largest();
+    let mut keys: Vec<Real> = all.iter().map(|x| x.coords.dot(&axis)).collect();
     let mid = keys.len() / 2;
     let (_, median, _) = keys.select_nth_unstable_by(mid, Real::total_cmp);
     let median = *median;
