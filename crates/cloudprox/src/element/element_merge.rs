@@ -4,7 +4,7 @@
 //! The top-down split halves a group at its median wherever the group fails,
 //! which cuts a flat face into pieces wherever an edge or a second face was in
 //! the same group higher up. Merging neighbours whose union is still one
-//! element (the same residual and curvature tests) gives the face back its
+//! element (the same residual test and curvature rule) gives the face back its
 //! size, and lets the single points left at an edge join the face they lie on.
 
 use std::collections::HashSet;

@@ -13,9 +13,10 @@ use crate::Real;
 /// How a cloud's points are grouped into surface elements.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ElementSettings {
-    /// Significance level of the residual and curvature tests (default 0.01): the
-    /// probability of splitting a group that does sample one flat surface with
-    /// the stated noise.
+    /// Significance level of the residual tests (default 0.01): the
+    /// probability of splitting a group that does sample one smooth surface
+    /// with the stated noise. (Curvature splits by Mallows' Cp, without a
+    /// level: see the [module docs](crate::element).)
     pub significance: Real,
     /// The fewest points of an element (default 10; at least 7, the quadric fit
     /// needs 6 and its residual test a degree of freedom); smaller groups that
@@ -70,9 +71,10 @@ impl ElementSettings {
 /// The surface is a plane over the points' principal plane: a point at
 /// tangential coordinates `(u, v)` from the mean lies at height
 /// `h(u, v) = height . (1, u, v)` along the normal, fitted by weighted least
-/// squares (elements are accepted only where curvature is not significant);
-/// the variance of the fitted height there is `x^T height_cov x + common_var`
-/// with `x = (1, u, v)`.
+/// squares (elements are accepted only where a curvature would not describe
+/// the points better, see the [module docs](crate::element)); the variance
+/// of the fitted height there is `x^T height_cov x + common_var` with
+/// `x = (1, u, v)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceElement {
     /// Index of the element's first point in [`SurfaceElements::indices`].

@@ -8,8 +8,9 @@
 //! a top-down split (at the median along the largest principal axis, or between
 //! two surfaces where the points along the normal fall into two groups further
 //! apart than the noise, as the two faces of a thin plate do); a group is an
-//! element as soon as three statistical tests at the significance level
-//! [`ElementSettings::significance`] and a coverage test accept it:
+//! element as soon as a residual test at the significance level
+//! [`ElementSettings::significance`], a curvature rule and a coverage test
+//! accept it:
 //!
 //! 1. **Residual test.** A quadric height field `h(u, v)` over the group's
 //!    principal plane is fitted by weighted least squares, each point weighted by
@@ -20,19 +21,28 @@
 //!    the largest of `m` standard normals (a Bonferroni bound): one point far
 //!    off a surface the others fit adds less to the sum than the sum's own
 //!    spread over hundreds of points.
-//! 2. **Curvature test.** The quadric's three curvature coefficients, against
-//!    their covariance from the fit (a Wald statistic, chi-square with 3 degrees
-//!    of freedom): where curvature is significant the group is larger than the
-//!    surface's curvature scale at this noise, and is split. So elements are
-//!    large where the surface is flat or the noise is high, and shrink with
-//!    curvature and with falling noise; no threshold is tuned to a scene.
+//! 2. **Curvature rule.** The element's surface is a plane, so the group is
+//!    split unless the plane describes its points' surface as well as the
+//!    quadric is expected to: the quadric's three curvature coefficients,
+//!    against their covariance from the fit (a Wald statistic `W`), must keep
+//!    `W <= 6` (Mallows' Cp: the two fits' expected squared errors differ by
+//!    `W - 2 x 3`). A group too small for its halves to be elements (fewer
+//!    than twice [`ElementSettings::min_points`]) would fall apart into
+//!    single points with their full noise: it splits only on a significant
+//!    curvature (`W` above the chi-square quantile at the significance
+//!    level). A group larger than the surface's curvature scale at this
+//!    noise is split. So elements are large where the surface is flat or the
+//!    noise is high, and shrink with curvature and with falling noise; no
+//!    threshold is tuned to a scene. (A significance test here, `W` against
+//!    11.3 at 1%, kept planes whose sag was several times their stated
+//!    uncertainty.)
 //!
 //! 3. **Coverage test.** The points cover the rectangle the element claims
 //!    (its tangents along the sides of the smallest rectangle holding them, its
 //!    extent their sampled edges with the noise taken out, see
 //!    [`SurfaceElement::extent`]): at least half of its cells of twice the
 //!    sampling spacing hold a point, and no strip of empty cells runs across
-//!    it. Two coplanar patches apart pass the first two tests together, but the
+//!    it. Two coplanar patches apart pass the first two together, but the
 //!    plane between them was never sampled.
 //!
 //! An accepted element keeps its mean, normal and tangents, its extent, and the
@@ -48,10 +58,11 @@
 //!
 //! The median splits cut flat faces apart wherever an edge or a second face
 //! shared a group higher up; a bottom-up pass then merges neighbouring elements
-//! (and single points) whose union still passes both tests.
+//! (and single points) whose union still passes the residual test and the
+//! curvature rule.
 //!
 //! An element keeps its fitted plane (weighted least squares over its
-//! principal plane: curvature was not significant) and the covariance of the
+//! principal plane: curvature did not pay for itself) and the covariance of the
 //! fit, so any point of its surface comes with the variance of its height, the
 //! slopes' uncertainty included
 //! ([`SurfaceElement::surface_point`]). In a query it is represented by five
