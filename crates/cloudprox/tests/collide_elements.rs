@@ -110,12 +110,12 @@ fn parallel_plates_probability_is_calibrated() {
         decided_wrong <= draws / 10,
         "{decided_wrong} of {draws} decided wrongly"
     );
-    // The faces are located far better than one point's noise: at +-12
-    // standard errors of the gap (1.4 sigma) the states are decided. (The
-    // curvature rule splits a flat face's group one time in nine, and a split
-    // face's pieces are located less precisely than the whole face: over 40
-    // noise draws, 13 were undecided at +8 standard errors, 4 at +12; with the
-    // 1% curvature test that the rule replaced, 4 at +8.)
+    // At +-12 standard errors of the gap (1.4 sigma) these draws' states are
+    // decided. (The curvature rule splits a flat face's group about one time
+    // in nine, and a split face's pieces are located less precisely than the
+    // whole face: over 40 pairs of noise draws, 13 were undecided at +8
+    // standard errors, 4 at +12; with the 1% curvature test that the rule
+    // replaced, 4 at +8. The -8 side was decided in all 40 either way.)
     let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1);
     let b = slab(k, h, (0.0, 0.0), 0.02, sigma, 2);
     for (gap, state) in [
@@ -129,9 +129,11 @@ fn parallel_plates_probability_is_calibrated() {
 
 #[test]
 fn spheres_are_decided_within_a_sigma_of_contact() {
-    // Five pairs of noise draws; the claims hold for the median pair at each
-    // gap (`P` a sigma apart ranges from 0.10 to 0.69 over these draws: where
-    // element boundaries fall decides how close the fitted surfaces come).
+    // Five pairs of noise draws (seeds 100-104 and 200-204); the claims hold
+    // for the median pair at each gap. `P` a sigma apart is 0.10, 0.67, 0.21,
+    // 0.69 and 0.59 over these draws: where element boundaries fall decides
+    // how close the fitted surfaces come (the shared fixture's draws, seeds
+    // 11 and 12, read 0.92, a collision a sigma apart).
     let req = elements();
     let gaps = [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 6.0];
     let per_draw: Vec<Vec<f64>> = (0..5u64)
@@ -163,8 +165,11 @@ fn spheres_are_decided_within_a_sigma_of_contact() {
     // sigma: one sigma either side of contact is decided (or nearly).
     assert!(ps[0] > 0.999 && ps[1] > 0.99 && ps[2] > 0.9, "{ps:?}");
     assert!(ps[5] < 0.1 && ps[6] < 0.01 && ps[7] < 1e-6, "{ps:?}");
-    // Touching counts as a collision; a sigma apart is not one.
+    // Touching counts as a collision; a sigma apart is not one, at most in
+    // one draw of five.
     assert!(ps[3] > 0.5 && ps[4] < 0.9, "{ps:?} of {per_draw:?}");
+    let collisions = per_draw.iter().filter(|p| p[4] >= 0.9).count();
+    assert!(collisions <= 1, "{per_draw:?}");
 }
 
 #[test]
@@ -276,6 +281,9 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
             &elements(),
         );
         assert_eq!(q.state, full.unwrap().state, "gap {gap}");
+        if gap >= 3.0 {
+            assert_ne!(q.state, CollisionState::Collision, "gap {gap}");
+        }
     }
     // The full query reads the crossings only where its patches found no
     // collision: here they did.

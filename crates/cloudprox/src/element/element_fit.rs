@@ -1,4 +1,5 @@
-//! The two tests that make a group of points a surface element.
+//! The tests and the curvature rule that make a group of points a surface
+//! element.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -69,11 +70,12 @@ fn quadric_row(u: Real, v: Real) -> Vec6 {
 /// quadric's three curvature coefficients.
 ///
 /// With the noise known, the weighted residual sum of the plane exceeds the
-/// quadric's by the curvature's Wald statistic `W`, and the expected squared
-/// error of each fit over the points is its residual sum plus twice its
-/// coefficient count, less the point count (Mallows' Cp, AIC with known
-/// variance). So the plane describes the surface at least as well as the
-/// quadric while `W <= 6`. A test of significance (`W` against the
+/// quadric's by the curvature's Wald statistic `W` (the fits are nested), and
+/// each fit's standardized expected squared error over the points is
+/// estimated without bias by its residual sum plus twice its coefficient
+/// count, less the point count (Mallows' Cp, AIC with known variance): the
+/// two estimates differ by `W - 6`. So the plane is estimated to describe the
+/// surface at least as well as the quadric while `W <= 6`. A test of significance (`W` against the
 /// chi-square quantile, 11.3 at 1%) keeps the plane until curvature is
 /// *certain*: it let through sags several times the plane's own stated
 /// standard deviation, which the element's uncertainty leaves out, and where
@@ -82,9 +84,9 @@ fn quadric_row(u: Real, v: Real) -> Vec6 {
 /// `benches/realmesh.py --poses 400` this rule halved the hard flips between
 /// noise draws (0.5% noise: 0.50% -> 0.17%; 2%: 1.00% -> 0.50%) and raised
 /// the decided accuracy (0.971 -> 0.981, 0.983 -> 0.984). Its price: a flat
-/// face's `W` follows the chi-square law with 3 degrees of freedom, above 6
-/// one time in nine, so flat faces are split more often than at 1% (see
-/// `docs/architecture.md`).
+/// face's `W` approximately follows the chi-square law with 3 degrees of
+/// freedom, above 6 one time in nine, so flat faces are split more often
+/// than at 1% (see `docs/architecture.md`).
 pub(crate) const CURVATURE_SPLIT: Real = 6.0;
 
 type Vec6 = SVector<Real, 6>;
@@ -173,9 +175,9 @@ pub(crate) fn fit_element(
         Some(c) => curvature.dot(&c.solve(&curvature)),
         None => Real::INFINITY,
     };
-    // A group too small for its halves to be elements would fall apart into
-    // single points, each with its full noise: there only a significant
-    // curvature splits it.
+    // A group too small for both halves to be elements would leave at least
+    // one half as single points, each with its full noise: there only a
+    // significant curvature splits it.
     let split_at = if m >= 2 * settings.min_points {
         CURVATURE_SPLIT
     } else {

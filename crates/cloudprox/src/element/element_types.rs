@@ -16,7 +16,8 @@ pub struct ElementSettings {
     /// Significance level of the residual tests (default 0.01): the
     /// probability of splitting a group that does sample one smooth surface
     /// with the stated noise. (Curvature splits by Mallows' Cp, without a
-    /// level: see the [module docs](crate::element).)
+    /// level, except in groups of fewer than twice `min_points`, which use
+    /// this level: see the [module docs](crate::element).)
     pub significance: Real,
     /// The fewest points of an element (default 10; at least 7, the quadric fit
     /// needs 6 and its residual test a degree of freedom); smaller groups that

@@ -25,10 +25,11 @@
 //!    split unless the plane describes its points' surface as well as the
 //!    quadric is expected to: the quadric's three curvature coefficients,
 //!    against their covariance from the fit (a Wald statistic `W`), must keep
-//!    `W <= 6` (Mallows' Cp: the two fits' expected squared errors differ by
-//!    `W - 2 x 3`). A group too small for its halves to be elements (fewer
-//!    than twice [`ElementSettings::min_points`]) would fall apart into
-//!    single points with their full noise: it splits only on a significant
+//!    `W <= 6` (Mallows' Cp: the two fits' estimates of their expected
+//!    squared errors differ by `W - 2 x 3`). A group too small for both
+//!    halves to be elements (fewer than twice
+//!    [`ElementSettings::min_points`]) would leave single points with their
+//!    full noise: it splits only on a significant
 //!    curvature (`W` above the chi-square quantile at the significance
 //!    level). A group larger than the surface's curvature scale at this
 //!    noise is split. So elements are large where the surface is flat or the

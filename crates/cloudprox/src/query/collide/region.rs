@@ -565,18 +565,26 @@ fn halves(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
         .collect();
     let (all_a, all_b) = all.split_at(p.a.len());
     let mean = |x: &[Point3]| x.iter().map(|q| q.coords).sum::<Vector3>() / x.len() as Real;
-    let whole = PrincipalAxes::of(all.iter().copied());
+    let centre = mean(&all);
     // Across the contact: from A's points to B's, or the least spread where
     // their means coincide.
     let mut normal = mean(all_b) - mean(all_a);
-    let spread = (whole.variances.sum() * all.len() as Real).sqrt();
+    let spread = all
+        .iter()
+        .map(|x| (x.coords - centre).norm_squared())
+        .sum::<Real>()
+        .sqrt();
     if normal.norm() <= 1e-12 * spread.max(Real::MIN_POSITIVE) {
-        normal = whole.least();
+        normal = PrincipalAxes::of(all.iter().copied()).least();
     }
     let normal = normal.normalize();
     // Along the contact: the largest spread of the points projected onto the
     // plane normal to it.
-    let axis = PrincipalAxes::of(all.iter().map(|x| x - normal * normal.dot(&x.coords))).largest();
+    let axis = PrincipalAxes::of(all.iter().map(|x| {
+        let d = x.coords - centre;
+        Point3::from(d - normal * normal.dot(&d))
+    }))
+    .largest();
     let mut keys: Vec<Real> = all.iter().map(|x| x.coords.dot(&axis)).collect();
     let mid = keys.len() / 2;
     let (_, median, _) = keys.select_nth_unstable_by(mid, Real::total_cmp);
