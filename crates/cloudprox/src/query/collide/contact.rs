@@ -136,6 +136,7 @@ pub(crate) fn least_spread_axis(pts: &[Point3], towards: &Vector3) -> Vector3 {
     }
 }
 
+/// The mean of the points' coordinates.
 pub(crate) fn mean(p: &[Point3]) -> Vector3 {
     p.iter().map(|x| x.coords).sum::<Vector3>() / p.len() as Real
 }

@@ -6,6 +6,7 @@ use crate::bvh::{Aabb, Bvh};
 use crate::cloud::PointCloud;
 use crate::math::{Matrix3, Point3, Pose, PrincipalAxes, Vector3};
 use crate::probability::normal_quantile;
+use crate::query::collide::contact::mean;
 use crate::Real;
 
 /// A set of points of both clouds classified together.
@@ -564,7 +565,6 @@ fn halves(p: &Patch, pa: &[Point3], pb: &[Point3]) -> Option<(Patch, Patch)> {
         .chain(p.b.iter().map(|&i| pb[i as usize]))
         .collect();
     let (all_a, all_b) = all.split_at(p.a.len());
-    let mean = |x: &[Point3]| x.iter().map(|q| q.coords).sum::<Vector3>() / x.len() as Real;
     let centre = mean(&all);
     // Across the contact: from A's points to B's, or the least spread where
     // their means coincide.
