@@ -317,6 +317,24 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     )
     .unwrap();
     assert!(q.probability >= 1.0 - 1e-9);
+    // The brute-force path (every pair, no hierarchies) reads the same
+    // crossings: from the pairs within reach at the reach, and from every
+    // pair beyond it (the strict threshold).
+    for (request, gap) in [(&quick, -3.0), (&quick, -6.0), (&strict, -6.0)] {
+        let brute = CollisionRequest {
+            use_hierarchy: false,
+            ..*request
+        };
+        let pose = sphere_pose(gap * SIGMA);
+        let h = collide(&Pose::identity(), &a, &pose, &b, request).unwrap();
+        let bf = collide(&Pose::identity(), &a, &pose, &b, &brute).unwrap();
+        assert_eq!(bf.stats.counters.surface_crossings, 1, "gap {gap}");
+        assert_eq!(
+            (bf.state, bf.probability),
+            (h.state, h.probability),
+            "gap {gap}"
+        );
+    }
 }
 
 /// A leg (a cylinder of 5 cm radius, 60 cm long, tilted by 0.2 rad) pushed

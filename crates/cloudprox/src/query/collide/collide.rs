@@ -123,13 +123,14 @@ pub(crate) fn collide_with_workspace(
     // probability, when they cross (the bound's confidence, at least the
     // collision threshold).
     let crossing = |stats: &mut QueryStats, workspace: &mut BvhWorkspace| -> Option<Real> {
-        let (ea, eb) = elements.filter(|_| request.use_hierarchy && !beyond_reach)?;
+        let (ea, eb) = elements.filter(|_| !beyond_reach)?;
         // The pairs within reach found above hold every pair that can cross
         // when `z` is the reach (the usual case): no second descent (and
         // deciding only, the descent has tested them already).
         let known = within_reach.as_ref().and_then(|p| p.cross(z));
         let crossed = known.unwrap_or_else(|| {
-            let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
+            let (crossed, visited) =
+                element_surfaces_cross(ea, &rel, eb, z, request.use_hierarchy, workspace);
             stats.counters.node_pairs_visited += visited;
             crossed
         });

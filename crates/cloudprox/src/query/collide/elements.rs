@@ -274,8 +274,9 @@ fn element_sample_range(elements: &SurfaceElements, e: u32) -> std::ops::Range<u
 /// Whether the fitted surfaces of some element of `ea` (at `rel` in `eb`'s
 /// frame) and some element of `eb` cross, each beyond `z_sds` standard
 /// deviations on both sides of the other ([`element_pair_crosses`]), found by
-/// the hierarchies over both clouds' element hulls. Returns the answer and
-/// the number of node pairs tested.
+/// the hierarchies over both clouds' element hulls, or (`use_hierarchy =
+/// false`) over every pair. Returns the answer and the number of node pairs
+/// tested.
 ///
 /// Two sampled surfaces of different objects cross only where the objects
 /// overlap, whichever side of each is inside: a crossing decides a collision
@@ -285,12 +286,25 @@ pub(crate) fn element_surfaces_cross(
     rel: &Pose,
     eb: &SurfaceElements,
     z_sds: Real,
+    use_hierarchy: bool,
     workspace: &mut BvhWorkspace,
 ) -> (bool, usize) {
     if !z_sds.is_finite() {
         return (false, 0);
     }
     let crosses = |a: ElementRef<'_>, b: ElementRef<'_>| element_pair_crosses(a, rel, b, z_sds);
+    if !use_hierarchy {
+        let (ha, hb) = (ea.hulls(), eb.hulls());
+        let crossed = (0..ea.elements().len() as u32).any(|i| {
+            (0..eb.elements().len() as u32).any(|j| {
+                crosses(
+                    (&ea.elements()[i as usize], ha.hull(i)),
+                    (&eb.elements()[j as usize], hb.hull(j)),
+                )
+            })
+        });
+        return (crossed, 0);
+    }
     // Single points never cross anything: the descent reads surfaces alone.
     first_hull_pair(ea, rel, eb, z_sds, workspace, true, crosses)
 }

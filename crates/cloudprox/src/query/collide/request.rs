@@ -87,7 +87,9 @@ pub struct CollisionRequest {
     pub region_max_points: usize,
     /// `false` skips the hierarchy: the near points are found by testing every
     /// point pair (`O(n_a n_b)`) and all go into one region (still split into
-    /// patches). The brute-force reference. Default `true`.
+    /// patches); with the elements model, the element pairs within reach and
+    /// the crossings of element surfaces are found by testing every element
+    /// pair. The brute-force reference. Default `true`.
     pub use_hierarchy: bool,
     /// Return as soon as the state is decided (default `false`): no per-point
     /// probabilities, no separation estimates, and with the `max` aggregation the
