@@ -94,18 +94,30 @@ def main() -> None:
         f"none at {(~shown).sum()}: {deep[~shown].tolist()} "
         f"({time.perf_counter() - t0:.0f} s)"
     )
-    head = ["model", "draw", "missed, frame shows it", "missed, reference only", "states there"]
+    head = [
+        "model",
+        "draw",
+        "missed, frame shows it",
+        "missed, reference only",
+        "states there",
+        "missed poses (index: depth in sigma, P)",
+    ]
     print("| " + " | ".join(head) + " |")
-    print("|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|")
     for model in ("elements", "points"):
         for k, d in enumerate(draws):
             gripper, scan = d.clouds()
             res = cp.collide_many(gripper, scan, q.poses[deep], model=model)
             st = np.array([r.state for r in res])
             only = {s: int((st[~shown] == s).sum()) for s in ("free", "contact", "collision")}
+            missed = ", ".join(
+                f"{deep[i]}{'' if shown[i] else ' (hole)'}: {unit[deep[i]]:.1f}, "
+                f"{res[i].probability:.2g}"
+                for i in np.flatnonzero(st == "free")
+            )
             print(
                 f"| {model} | {k} | {(st[shown] == 'free').sum()} / {shown.sum()} | "
-                f"{(st[~shown] == 'free').sum()} / {(~shown).sum()} | {only} |"
+                f"{(st[~shown] == 'free').sum()} / {(~shown).sum()} | {only} | {missed} |"
             )
 
 
