@@ -110,8 +110,8 @@ def main() -> None:
             res = cp.collide_many(gripper, scan, q.poses[deep], model=model)
             st = np.array([r.state for r in res])
             only = {s: int((st[~shown] == s).sum()) for s in ("free", "contact", "collision")}
-            missed = ", ".join(
-                f"{deep[i]}{'' if shown[i] else ' (hole)'}: {unit[deep[i]]:.1f}, "
+            missed = "; ".join(
+                f"{deep[i]}{'' if shown[i] else ' (hole)'}: {-unit[deep[i]]:.1f}, "
                 f"{res[i].probability:.2g}"
                 for i in np.flatnonzero(st == "free")
             )

@@ -318,9 +318,9 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     .unwrap();
     assert!(q.probability >= 1.0 - 1e-9);
     // The brute-force path (every pair, no hierarchies) reads the same
-    // crossings: from the pairs within reach at the reach, and from every
-    // pair beyond it (the strict threshold).
-    for (request, gap) in [(&quick, -3.0), (&quick, -6.0), (&strict, -6.0)] {
+    // crossings: at the reach, beyond it (the strict threshold), and none
+    // where the surfaces are apart.
+    for (request, gap, crossings) in [(&quick, -3.0, 1), (&strict, -6.0, 1), (&quick, 3.0, 0)] {
         let brute = CollisionRequest {
             use_hierarchy: false,
             ..*request
@@ -328,12 +328,17 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
         let pose = sphere_pose(gap * SIGMA);
         let h = collide(&Pose::identity(), &a, &pose, &b, request).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose, &b, &brute).unwrap();
-        assert_eq!(bf.stats.counters.surface_crossings, 1, "gap {gap}");
-        assert_eq!(
-            (bf.state, bf.probability),
-            (h.state, h.probability),
-            "gap {gap}"
-        );
+        assert_eq!(bf.stats.counters.node_pairs_visited, 0, "gap {gap}");
+        for r in [&h, &bf] {
+            assert_eq!(r.stats.counters.surface_crossings, crossings, "gap {gap}");
+        }
+        if crossings > 0 {
+            assert_eq!(
+                (bf.state, bf.probability),
+                (h.state, h.probability),
+                "gap {gap}"
+            );
+        }
     }
 }
 
@@ -439,6 +444,16 @@ fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
     let q = collide_at_height(&a, &tilted_back, 0.0, &quick);
     assert_eq!(q.stats.counters.surface_crossings, 1);
     assert_eq!(q.state, CollisionState::Collision);
+    // The full query, with the hierarchies and without: the same state.
+    for use_hierarchy in [true, false] {
+        let full = CollisionRequest {
+            model: QueryModel::Elements,
+            use_hierarchy,
+            ..CollisionRequest::default()
+        };
+        let r = collide_at_height(&a, &tilted_back, 0.0, &full);
+        assert_eq!(r.state, CollisionState::Collision, "{use_hierarchy}");
+    }
     let flat = slab(30, 0.004, (0.0, 0.0), -0.05, sigma, 3);
     for z in [-2.0 * sigma, 0.0, 2.0 * sigma] {
         let q = collide_at_height(&flat, &tilted_back, z, &quick);

@@ -102,7 +102,7 @@ pub(crate) fn collide_with_workspace(
     // Deciding only, the descent also looks for crossing surfaces (below) and
     // stops at the first.
     let z = crossing_sds(reach, request.thresholds.collision);
-    let stop_at_crossing = (request.decide_only && request.use_hierarchy).then_some(z);
+    let stop_at_crossing = request.decide_only.then_some(z);
     let within_reach = elements.map(|(ea, eb)| {
         let pairs = element_pairs_within_reach(
             ea,
@@ -123,14 +123,16 @@ pub(crate) fn collide_with_workspace(
     // probability, when they cross (the bound's confidence, at least the
     // collision threshold).
     let crossing = |stats: &mut QueryStats, workspace: &mut BvhWorkspace| -> Option<Real> {
-        let (ea, eb) = elements.filter(|_| !beyond_reach)?;
+        // Surfaces that cross are within reach of each other: none crosses
+        // where no pair is within reach (with or without the hierarchy).
+        let (ea, eb) = elements.filter(|_| within_reach.as_ref().is_some_and(|p| p.any))?;
         // The pairs within reach found above hold every pair that can cross
-        // when `z` is the reach (the usual case): no second descent (and
-        // deciding only, the descent has tested them already).
+        // when `z` is the reach (the usual case), and without the hierarchy
+        // every pair at any `z`: no second descent (and deciding only, the
+        // descent has tested them already).
         let known = within_reach.as_ref().and_then(|p| p.cross(z));
         let crossed = known.unwrap_or_else(|| {
-            let (crossed, visited) =
-                element_surfaces_cross(ea, &rel, eb, z, request.use_hierarchy, workspace);
+            let (crossed, visited) = element_surfaces_cross(ea, &rel, eb, z, workspace);
             stats.counters.node_pairs_visited += visited;
             crossed
         });

@@ -104,6 +104,9 @@ pub(crate) struct PairsWithinReach<'a> {
     /// noise from their sparse sampling), which as links made regions of
     /// points 8 sigma from the other cloud (a Kinect frame).
     candidates: Vec<(u32, u32)>,
+    /// Whether the candidates are every pair of surface elements (found
+    /// without the hierarchy, so not limited to the reach).
+    all_pairs: bool,
     /// The `z` at which every candidate met so far was tested for a crossing
     /// during the descent (deciding only), and whether one crossed (the
     /// descent then stopped there).
@@ -153,7 +156,8 @@ impl PairsWithinReach<'_> {
     /// ([`element_pair_crosses`]), as [`element_surfaces_cross`] finds it;
     /// `None` when `z_sds` is beyond the reach the candidates were found at
     /// (the hull test passes more pairs at more standard deviations, so the
-    /// candidates hold every pair that can cross only up to their own).
+    /// candidates hold every pair that can cross only up to their own),
+    /// unless they are every pair.
     pub(crate) fn cross(&self, z_sds: Real) -> Option<bool> {
         if !z_sds.is_finite() {
             return Some(false);
@@ -163,7 +167,7 @@ impl PairsWithinReach<'_> {
                 return Some(crossed);
             }
         }
-        if z_sds > self.reach_sds {
+        if z_sds > self.reach_sds && !self.all_pairs {
             return None;
         }
         let (ea, eb) = (self.ea, self.eb);
@@ -204,6 +208,7 @@ pub(crate) fn element_pairs_within_reach<'a>(
         reach_sds,
         any: !reach_sds.is_finite(),
         candidates: Vec::new(),
+        all_pairs: !use_hierarchy,
         crossing: None,
         visited: 0,
     };
@@ -274,9 +279,8 @@ fn element_sample_range(elements: &SurfaceElements, e: u32) -> std::ops::Range<u
 /// Whether the fitted surfaces of some element of `ea` (at `rel` in `eb`'s
 /// frame) and some element of `eb` cross, each beyond `z_sds` standard
 /// deviations on both sides of the other ([`element_pair_crosses`]), found by
-/// the hierarchies over both clouds' element hulls, or (`use_hierarchy =
-/// false`) over every pair. Returns the answer and the number of node pairs
-/// tested.
+/// the hierarchies over both clouds' element hulls. Returns the answer and
+/// the number of node pairs tested.
 ///
 /// Two sampled surfaces of different objects cross only where the objects
 /// overlap, whichever side of each is inside: a crossing decides a collision
@@ -286,25 +290,12 @@ pub(crate) fn element_surfaces_cross(
     rel: &Pose,
     eb: &SurfaceElements,
     z_sds: Real,
-    use_hierarchy: bool,
     workspace: &mut BvhWorkspace,
 ) -> (bool, usize) {
     if !z_sds.is_finite() {
         return (false, 0);
     }
     let crosses = |a: ElementRef<'_>, b: ElementRef<'_>| element_pair_crosses(a, rel, b, z_sds);
-    if !use_hierarchy {
-        let (ha, hb) = (ea.hulls(), eb.hulls());
-        let crossed = (0..ea.elements().len() as u32).any(|i| {
-            (0..eb.elements().len() as u32).any(|j| {
-                crosses(
-                    (&ea.elements()[i as usize], ha.hull(i)),
-                    (&eb.elements()[j as usize], hb.hull(j)),
-                )
-            })
-        });
-        return (crossed, 0);
-    }
     // Single points never cross anything: the descent reads surfaces alone.
     first_hull_pair(ea, rel, eb, z_sds, workspace, true, crosses)
 }
