@@ -17,9 +17,13 @@ python-fcl (``pip install python-fcl``), when installed, answers the same
 poses on the exact meshes in the same run: its ``distance()`` and ``collide()``
 median times are the anchor of the speed column.
 
-Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02] [--save F.npz]``
+Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02] [--seed 0]
+[--methods elements,points,nn-gap,collision-map] [--noise-scale 1] [--save F.npz]``
 (``--save``: every method's scores, states, seconds and the exact signed
-distances per level, for a closer look at where the methods err or flip).
+distances per level, for a closer look at where the methods err or flip;
+``--noise-scale F``: the noise drawn at ``F`` times the level's sigma, while
+the poses and the metrics stay in the level's sigma, to see what the noise
+costs against what the sampling does).
 """
 
 from __future__ import annotations
@@ -134,6 +138,26 @@ def poses(
     return np.array(out), np.array(dist)
 
 
+#: The methods compared (``--methods`` names) and their names in the table.
+METHODS = {
+    "elements": "elements",
+    "points": "points (default)",
+    "nn-gap": "nn-gap",
+    "collision-map": "collision map",
+}
+
+
+def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
+    """One method's answers (a key of :data:`METHODS`) for one noise draw at the poses ``q``."""
+    if method == "elements":
+        return m.cloudprox_answer(draw, q, "quadric", "max", "elements")
+    if method == "points":
+        return m.cloudprox_answer(draw, q, "quadric", "max")
+    if method == "nn-gap":
+        return m.nn_gap_answer(draw, q)
+    return m.collision_map_answer(draw, q, m.sampling_spacing(draw.room_points))
+
+
 def main() -> None:
     """Run every pair at every level and print one table."""
     ap = argparse.ArgumentParser(description=__doc__)
@@ -141,7 +165,26 @@ def main() -> None:
     ap.add_argument("--levels", default="0.005,0.02")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--save", type=Path, default=None, help="write the per-pose arrays (.npz)")
+    ap.add_argument(
+        "--methods",
+        default=",".join(METHODS),
+        help=f"comma-separated, among {', '.join(METHODS)} (default: all)",
+    )
+    ap.add_argument(
+        "--noise-scale",
+        type=float,
+        default=1.0,
+        help="draw the noise at this multiple of the level's sigma (default 1)",
+    )
     args = ap.parse_args()
+    methods = [x.strip() for x in args.methods.split(",") if x.strip()]
+    unknown = [x for x in methods if x not in METHODS]
+    if unknown or not methods:
+        ap.error(f"unknown method(s) {unknown}; known: {', '.join(METHODS)}")
+    if not (np.isfinite(args.noise_scale) and args.noise_scale > 0.0):
+        ap.error(f"--noise-scale must be finite and > 0, got {args.noise_scale}")
+    if args.poses < 1:
+        ap.error(f"--poses must be >= 1, got {args.poses}")
     rng = np.random.default_rng(args.seed)
     rows: dict[tuple[float, str], list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = {}
     fcl_rows: dict[float, list[tuple[float, float]]] = {}
@@ -155,24 +198,18 @@ def main() -> None:
             q, dist = poses(cp.ExactShape([ma]), cp.ExactShape([mb]), args.poses, pair_sigma, rng)
             pa, _, _ = ma.sample(POINTS, seed=1)
             pb, _, _ = mb.sample(POINTS, seed=2)
-            cov = np.broadcast_to(sigma**2 * np.eye(3), (POINTS, 3, 3)).copy()
+            drawn = args.noise_scale * sigma
+            cov = np.broadcast_to(drawn**2 * np.eye(3), (POINTS, 3, 3)).copy()
             draws = [
                 m.Draw(
-                    np.asarray(pa) + rng.normal(scale=sigma, size=(POINTS, 3)),
+                    np.asarray(pa) + rng.normal(scale=drawn, size=(POINTS, 3)),
                     cov,
-                    np.asarray(pb) + rng.normal(scale=sigma, size=(POINTS, 3)),
+                    np.asarray(pb) + rng.normal(scale=drawn, size=(POINTS, 3)),
                     cov,
                 )
                 for _ in range(2)
             ]
-            answers = {
-                "elements": [m.cloudprox_answer(d, q, "quadric", "max", "elements") for d in draws],
-                "points (default)": [m.cloudprox_answer(d, q, "quadric", "max") for d in draws],
-                "nn-gap": [m.nn_gap_answer(d, q) for d in draws],
-                "collision map": [
-                    m.collision_map_answer(d, q, m.sampling_spacing(d.room_points)) for d in draws
-                ],
-            }
+            answers = {METHODS[k]: [method_answer(k, d, q) for d in draws] for k in methods}
             for name, ans in answers.items():
                 rows.setdefault((level, name), []).append(
                     (
