@@ -18,12 +18,17 @@ poses on the exact meshes in the same run: its ``distance()`` and ``collide()``
 median times are the anchor of the speed column.
 
 Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02] [--seed 0]
-[--methods elements,points,nn-gap,collision-map] [--noise-scale 1] [--save F.npz]``
-(``--save``: every method's scores, states, seconds and the exact signed
-distances per level, for a closer look at where the methods err or flip;
-``--noise-scale F``: the noise drawn at ``F`` times the level's sigma, while
-the poses and the metrics stay in the level's sigma, to see what the noise
-costs against what the sampling does).
+[--methods elements,points,nn-gap,collision-map] [--noise-scale 1] [--bounds]
+[--save F.npz]`` (``--save``: every method's scores, states, seconds and the
+exact signed distances per level, for a closer look at where the methods err
+or flip; ``--noise-scale F``: the noise drawn, and its stated covariances
+set, at ``F`` times the level's sigma, while the poses and the metrics stay
+in the level's sigma, to see what the noise costs against what the sampling
+does; ``--bounds``: per row, the near-contact AUC the same scores reach with
+every pose beyond 1 and beyond 0.5 pair sigma of contact ranked perfectly).
+``--methods`` draws no random numbers, so a subset reads the same as the
+full run for the methods it keeps. Each pair's sampling spacing (in pair
+sigma) is printed with its progress line.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benches.near_limits import near_auc, ranked_beyond
 from tests.realfiles import real_file
 
 import cloudprox as cp
@@ -148,14 +154,16 @@ METHODS = {
 
 
 def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
-    """One method's answers (a key of :data:`METHODS`) for one noise draw at the poses ``q``."""
+    """Return ``method``'s answers (a key of :data:`METHODS`) for one draw at the poses ``q``."""
     if method == "elements":
         return m.cloudprox_answer(draw, q, "quadric", "max", "elements")
     if method == "points":
         return m.cloudprox_answer(draw, q, "quadric", "max")
     if method == "nn-gap":
         return m.nn_gap_answer(draw, q)
-    return m.collision_map_answer(draw, q, m.sampling_spacing(draw.room_points))
+    if method == "collision-map":
+        return m.collision_map_answer(draw, q, m.sampling_spacing(draw.room_points))
+    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 
 def main() -> None:
@@ -171,15 +179,23 @@ def main() -> None:
         help=f"comma-separated, among {', '.join(METHODS)} (default: all)",
     )
     ap.add_argument(
+        "--bounds",
+        action="store_true",
+        help="also print each row's AUC near with every pose beyond 1 (0.5) pair sigma "
+        "of contact ranked perfectly",
+    )
+    ap.add_argument(
         "--noise-scale",
         type=float,
         default=1.0,
         help="draw the noise at this multiple of the level's sigma (default 1)",
     )
     args = ap.parse_args()
-    methods = [x.strip() for x in args.methods.split(",") if x.strip()]
+    methods = list(dict.fromkeys(x.strip() for x in args.methods.split(",") if x.strip()))
+    if not methods:
+        ap.error("--methods is empty")
     unknown = [x for x in methods if x not in METHODS]
-    if unknown or not methods:
+    if unknown:
         ap.error(f"unknown method(s) {unknown}; known: {', '.join(METHODS)}")
     if not (np.isfinite(args.noise_scale) and args.noise_scale > 0.0):
         ap.error(f"--noise-scale must be finite and > 0, got {args.noise_scale}")
@@ -222,12 +238,24 @@ def main() -> None:
             times = fcl_times(ma, mb, q)
             if times is not None:
                 fcl_rows.setdefault(level, []).append(times)
-            print(f"{level:.1%} {na} vs {nb}: {len(q)} poses", file=sys.stderr, flush=True)
+            spacing = m.sampling_spacing(np.concatenate([np.asarray(pa), np.asarray(pb)]))
+            print(
+                f"{level:.1%} {na} vs {nb}: {len(q)} poses, sampling spacing "
+                f"{spacing / pair_sigma:.2f} pair sigma",
+                file=sys.stderr,
+                flush=True,
+            )
+    if args.noise_scale != 1.0:
+        print(
+            f"noise drawn at {args.noise_scale:g} x the level's sigma; "
+            "poses and metrics in the level's pair sigma\n"
+        )
     print(
         "| level | method | AUC near | decided acc. | undecided | hard flips "
         "| FP > 3σ | FN < -3σ | ms |\n|---|---|---|---|---|---|---|---|---|"
     )
     saved: dict[str, np.ndarray] = {}
+    bounds: list[str] = []
     for (level, name), parts in rows.items():
         sc = np.concatenate([p[0] for p in parts], axis=1)
         st = np.concatenate([p[1] for p in parts], axis=1)
@@ -241,6 +269,7 @@ def main() -> None:
                 f"{key}/seconds": se,
                 f"{key}/distance": d,
                 f"{key}/sigma": np.array(np.sqrt(2.0) * sigmas[level]),
+                f"{key}/noise_scale": np.array(args.noise_scale),
             }
         )
         mt = compute_metrics(sc, st, se, d, np.sqrt(2.0) * sigmas[level])
@@ -249,12 +278,22 @@ def main() -> None:
             f"{mt.undecided:.1%} | {mt.hard_flip:.1%} | {mt.false_positive_3s:.1%} | "
             f"{mt.false_negative_3s:.1%} | {mt.median_ms:.2f} |"
         )
+        if args.bounds:
+            ps = np.sqrt(2.0) * sigmas[level]
+            b1, b05 = (near_auc(ranked_beyond(sc, d, ps, w), d, ps) for w in (1.0, 0.5))
+            bounds.append(
+                f"{level:.1%} {name}: AUC near {mt.auc_near:.3f}; poses beyond 1 pair sigma "
+                f"ranked perfectly {b1:.3f}, beyond 0.5 {b05:.3f}"
+            )
     for level, times in fcl_rows.items():
         d, c = np.median([t[0] for t in times]), np.median([t[1] for t in times])
         print(
             f"| {level:.1%} | python-fcl on the exact meshes: distance() {1e3 * d:.3f} ms, "
             f"collide() {1e3 * c:.3f} ms (medians of the pairs' medians) | | | | | | | |"
         )
+    if bounds:
+        print()
+        print("\n".join(bounds))
     if args.save is not None:
         np.savez_compressed(args.save, **saved)
         print(f"per-pose arrays: {args.save}", file=sys.stderr)
