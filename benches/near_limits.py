@@ -31,7 +31,7 @@ import dataclasses
 import numpy as np
 
 from cloudprox.reproduce import methods as m
-from cloudprox.reproduce.metrics import NEAR_SIGMA, auc, compute_metrics
+from cloudprox.reproduce.metrics import NEAR_SIGMA, auc_near, compute_metrics
 from cloudprox.reproduce.noise import NoiseModel
 from cloudprox.reproduce.poses import sample_poses
 from cloudprox.reproduce.run import Config, config_levels, level_name, sample_scene
@@ -61,13 +61,6 @@ def ranked_beyond(
     out[:, unit < -w] = 2.0
     out[:, unit > w] = -1.0
     return out
-
-
-def near_auc(score: np.ndarray, signed_distance: np.ndarray, sigma: float) -> float:
-    """Return the near-contact AUC as :func:`compute_metrics` reads it (both draws pooled)."""
-    d = np.broadcast_to(signed_distance, score.shape).ravel()
-    near = np.abs(d) <= NEAR_SIGMA * sigma
-    return auc(score.ravel()[near], (d <= 0.0)[near])
 
 
 def main() -> None:
@@ -129,7 +122,7 @@ def main() -> None:
         blind = []
         for w in (0.5, 1.0, 0.5 * scene.spacing / sigma):
             s = ranked_beyond(np.full((1, len(d)), 0.5), d, sigma, w)
-            blind.append(f"{near_auc(s, d, sigma):.3f} at w = {w:.2f}")
+            blind.append(f"{auc_near(s, d, sigma):.3f} at w = {w:.2f}")
         print(f"  perfect beyond w sigma, blind within: {', '.join(blind)}", flush=True)
         start = rng.bit_generator.state
         for factor in factors:
@@ -150,7 +143,7 @@ def main() -> None:
                 state = np.stack([x.state for x in answers])
                 seconds = np.stack([x.seconds for x in answers])
                 mt = compute_metrics(score, state, seconds, d, sigma)
-                bound = near_auc(ranked_beyond(score, d, sigma, 1.0), d, sigma)
+                bound = auc_near(ranked_beyond(score, d, sigma, 1.0), d, sigma)
                 print(
                     f"  noise x{factor:g}, {m.variant_name(*variant)}: AUC near {mt.auc_near:.3f} "
                     f"(beyond 1 sigma perfect: {bound:.3f}), decided {mt.decided_accuracy:.3f}, "

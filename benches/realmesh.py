@@ -42,12 +42,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benches.near_limits import near_auc, ranked_beyond
+from benches.near_limits import ranked_beyond
 from tests.realfiles import real_file
 
 import cloudprox as cp
 from cloudprox.reproduce import methods as m
-from cloudprox.reproduce.metrics import compute_metrics
+from cloudprox.reproduce.metrics import auc_near, compute_metrics
 
 PAIRS = (
     ("stl_panda_hand", "stl_binary_bunny"),
@@ -280,7 +280,7 @@ def main() -> None:
         )
         if args.bounds:
             ps = np.sqrt(2.0) * sigmas[level]
-            b1, b05 = (near_auc(ranked_beyond(sc, d, ps, w), d, ps) for w in (1.0, 0.5))
+            b1, b05 = (auc_near(ranked_beyond(sc, d, ps, w), d, ps) for w in (1.0, 0.5))
             bounds.append(
                 f"{level:.1%} {name}: AUC near {mt.auc_near:.3f}; poses beyond 1 pair sigma "
                 f"ranked perfectly {b1:.3f}, beyond 0.5 {b05:.3f}"

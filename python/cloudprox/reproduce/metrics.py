@@ -8,7 +8,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.stats import rankdata, spearmanr
 
-__all__ = ["Metrics", "auc", "compute_metrics", "roc_curve"]
+__all__ = ["Metrics", "auc", "auc_near", "compute_metrics", "roc_curve"]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -25,6 +25,17 @@ def auc(score: FloatArray, label: npt.NDArray[np.bool_]) -> float:
         return float("nan")
     ranks = rankdata(score)
     return float((ranks[label].sum() - pos * (pos + 1) / 2.0) / (pos * neg))
+
+
+def auc_near(score: FloatArray, signed_distance: FloatArray, sigma: float) -> float:
+    """ROC AUC over the near queries (``|signed_distance| <= NEAR_SIGMA * sigma``).
+
+    ``score`` is ``(draws, poses)`` (the draws pooled) or ``(poses,)``; the
+    label is ``signed_distance <= 0``, as in :func:`compute_metrics`.
+    """
+    d = np.broadcast_to(signed_distance, np.shape(score)).ravel()
+    near = np.abs(d) <= NEAR_SIGMA * sigma
+    return auc(np.ravel(score)[near], (d <= 0.0)[near])
 
 
 def roc_curve(score: FloatArray, label: npt.NDArray[np.bool_]) -> tuple[FloatArray, FloatArray]:
@@ -100,7 +111,6 @@ def compute_metrics(
     d = np.broadcast_to(signed_distance, score.shape).ravel()
     s, st = score.ravel(), state.ravel()
     label = d <= 0.0
-    near = np.abs(d) <= NEAR_SIGMA * sigma
     decided = st != "contact"
     correct = (st == "collision") == label
     rho = spearmanr(s, -d).statistic if np.ptp(s) > 0 else float("nan")
@@ -114,7 +124,7 @@ def compute_metrics(
     )
     return Metrics(
         auc_all=auc(s, label),
-        auc_near=auc(s[near], label[near]),
+        auc_near=auc_near(score, signed_distance, sigma),
         spearman=float(rho),
         decided_accuracy=_share(correct, decided),
         undecided=float(np.mean(~decided)),
