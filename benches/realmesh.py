@@ -147,23 +147,38 @@ def poses(
 #: The methods compared (``--methods`` names) and their names in the table.
 METHODS = {
     "elements": "elements",
+    "elements-x3": "elements, 3 segmentations",
     "points": "points (default)",
     "nn-gap": "nn-gap",
     "collision-map": "collision map",
 }
 
 
+def method_name(method: str) -> str | None:
+    """Return the table's name of ``method``, None if unknown.
+
+    ``method`` is a key of :data:`METHODS` or ``elements-xK``: the elements averaged
+    over ``K`` segmentations.
+    """
+    if method in METHODS:
+        return METHODS[method]
+    k = method.removeprefix("elements-x")
+    if method.startswith("elements-x") and k.isdigit():
+        return f"elements, {int(k)} segmentations"
+    return None
+
+
 def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
     """Return ``method``'s answers (a key of :data:`METHODS`) for one draw at the poses ``q``."""
-    if method == "elements":
-        return m.cloudprox_answer(draw, q, "quadric", "max", "elements")
+    if method.startswith("elements"):
+        return m.cloudprox_answer(draw, q, "quadric", "max", method)
     if method == "points":
         return m.cloudprox_answer(draw, q, "quadric", "max")
     if method == "nn-gap":
         return m.nn_gap_answer(draw, q)
     if method == "collision-map":
         return m.collision_map_answer(draw, q, m.sampling_spacing(draw.room_points))
-    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}, elements-xK")
 
 
 def main() -> None:
@@ -176,7 +191,8 @@ def main() -> None:
     ap.add_argument(
         "--methods",
         default=",".join(METHODS),
-        help=f"comma-separated, among {', '.join(METHODS)} (default: all)",
+        help=f"comma-separated, among {', '.join(METHODS)} or elements-xK (the elements "
+        "averaged over K segmentations) (default: all listed)",
     )
     ap.add_argument(
         "--bounds",
@@ -194,7 +210,7 @@ def main() -> None:
     methods = list(dict.fromkeys(x.strip() for x in args.methods.split(",") if x.strip()))
     if not methods:
         ap.error("--methods is empty")
-    unknown = [x for x in methods if x not in METHODS]
+    unknown = [x for x in methods if method_name(x) is None]
     if unknown:
         ap.error(f"unknown method(s) {unknown}; known: {', '.join(METHODS)}")
     if not (np.isfinite(args.noise_scale) and args.noise_scale > 0.0):
@@ -225,7 +241,7 @@ def main() -> None:
                 )
                 for _ in range(2)
             ]
-            answers = {METHODS[k]: [method_answer(k, d, q) for d in draws] for k in methods}
+            answers = {method_name(k): [method_answer(k, d, q) for d in draws] for k in methods}
             for name, ans in answers.items():
                 rows.setdefault((level, name), []).append(
                     (

@@ -29,8 +29,9 @@ CHANGED: dict[str, Any] = {
     "robust_model": "chebyshev",
     "solver": "clarabel",
     "use_hierarchy": False,
-    "model": "points",
+    "model": "elements",
     "decide_only": True,
+    "segmentations": 2,
 }
 
 
@@ -91,7 +92,7 @@ def test_equality_hash_repr() -> None:
     assert a != "CollisionRequest"
     text = repr(a)
     assert text.startswith("CollisionRequest(surface='linear', aggregation='max', ")
-    assert "slack_weight=100.0" in text and text.endswith("decide_only=False)")
+    assert "slack_weight=100.0" in text and text.endswith("decide_only=False, segmentations=1)")
 
 
 def test_pickle_copy_and_json() -> None:
@@ -185,6 +186,26 @@ def test_collide_with_a_request_equals_the_keywords(spheres) -> None:
     )
     many = cp.collide_many(a, b, np.stack([np.eye(4), pose]), request=request)
     _same(many[1], cp.collide(a, b, pose_a=pose, **options))
+
+
+def test_segmentations_average_the_elements_model(spheres) -> None:
+    # The mean of one query per segmentation: the clouds' own segmentation s
+    # is the first of a query's (the Rust tests check every field; here the
+    # option's way through the binding).
+    a, b = spheres
+    pose = sphere_gap_pose(0.5)
+    mean = cp.collide(a, b, pose_b=pose, model="elements", segmentations=3)
+    one = [cp.collide(a, b, pose_b=pose, model="elements", segmentations=1)]
+    assert mean.stats.patches == len(mean.patches)
+    assert mean.stats.patches >= len(one[0].patches)
+    q = cp.collide(a, b, pose_b=pose, model="elements", segmentations=3, decide_only=True)
+    assert q.state == mean.state and q.probability == pytest.approx(mean.probability, abs=1e-12)
+    with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got 0"):
+        cp.CollisionRequest(model="elements", segmentations=0)
+    with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got -1"):
+        cp.CollisionRequest(model="elements", segmentations=-1)
+    with pytest.raises(cp.InvalidInputError, match=r"needs model 'elements'"):
+        cp.CollisionRequest(segmentations=2)
 
 
 def test_collide_rejects_bad_requests_and_options(spheres) -> None:

@@ -482,6 +482,9 @@ struct RequestInput {
     clarabel: bool,
     solver_max_iter: Opt<u8>,
     solver_tol: Opt<Num>,
+    /// Plus one, modulo 18: 1 (the default) when the input runs out; 0 and
+    /// 17 are out of range.
+    segmentations: u8,
 }
 
 impl RequestInput {
@@ -501,6 +504,7 @@ impl RequestInput {
             ][usize::from(self.aggregation) % 4],
             use_hierarchy: self.use_hierarchy,
             decide_only: self.decide_only,
+            segmentations: (u32::from(self.segmentations) + 1) % 18,
             ..CollisionRequest::default()
         };
         let num = |o: Opt<Num>, field: &mut f64| {

@@ -61,6 +61,7 @@ impl PyCollisionRequest {
         d.set_item("use_hierarchy", r.use_hierarchy)?;
         d.set_item("model", r.model.name())?;
         d.set_item("decide_only", r.decide_only)?;
+        d.set_item("segmentations", r.segmentations)?;
         Ok(d)
     }
 }
@@ -72,7 +73,7 @@ impl PyCollisionRequest {
         *, surface=None, aggregation=None, threshold_collision=None, threshold_free=None,
         prune_epsilon=None, region_max_points=None, near_context=None, slack_weight=None,
         robust_eta=None, robust_model=None, solver=None, use_hierarchy=None, model=None,
-        decide_only=None
+        decide_only=None, segmentations=None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -91,6 +92,7 @@ impl PyCollisionRequest {
         use_hierarchy: Option<bool>,
         model: Option<&str>,
         decide_only: Option<bool>,
+        segmentations: Option<i64>,
     ) -> PyResult<Self> {
         let mut r = CollisionRequest::default();
         if let Some(s) = surface {
@@ -139,6 +141,11 @@ impl PyCollisionRequest {
         }
         if let Some(v) = decide_only {
             r.decide_only = v;
+        }
+        if let Some(v) = segmentations {
+            r.segmentations = u32::try_from(v).map_err(|_| {
+                invalid_input(py, format!("segmentations must be in 1..=16, got {v}"))
+            })?;
         }
         r.validate().or_py(py)?;
         Ok(Self { inner: r })
@@ -237,6 +244,13 @@ impl PyCollisionRequest {
     #[getter]
     fn decide_only(&self) -> bool {
         self.inner.decide_only
+    }
+
+    /// With ``model="elements"``: how many segmentations of the clouds the
+    /// query averages ``P`` and the per-point probabilities over (1 to 16).
+    #[getter]
+    fn segmentations(&self) -> u32 {
+        self.inner.segmentations
     }
 
     /// A copy with the given options changed (``None`` leaves an option as

@@ -2,7 +2,9 @@
 //! `collide` on two 10K-point noisy spheres: apart, near, interpenetrating;
 //! the paper's per-point model and the surface-element model, at two noise
 //! levels. And a motion of one sphere into the other, queried pose by pose
-//! (`collide_many`) and warm-started along the motion (`collide_along`).
+//! (`collide_many`) and warm-started along the motion (`collide_along`). The
+//! element model averaged over three segmentations near contact
+//! (`/segmentations_3`).
 //!
 //! `cargo bench -p cloudprox --bench query`
 //! (`-- collide_10k_elements` for the element model alone, `-- motion_10k`
@@ -69,6 +71,26 @@ fn bench_elements(c: &mut Criterion) {
                     });
                 });
             }
+        }
+        // The mean over three segmentations, near contact (each segmentation's
+        // elements built once, not part of a query).
+        let req = CollisionRequest {
+            model: QueryModel::Elements,
+            segmentations: 3,
+            ..CollisionRequest::default()
+        };
+        cloudprox::query::prepare(&a, &req);
+        cloudprox::query::prepare(&b, &req);
+        for (name, gap) in [GAPS[2], GAPS[3]] {
+            let pose = common::pose_at_noise(gap, sigma);
+            group.bench_function(
+                format!("sigma_{}mm/{name}/segmentations_3", sigma * 1e3),
+                |bch| {
+                    bch.iter(|| {
+                        black_box(collide(&Pose::identity(), &a, &pose, &b, &req).unwrap())
+                    });
+                },
+            );
         }
     }
     group.finish();

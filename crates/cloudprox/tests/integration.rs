@@ -16,6 +16,7 @@ mod collide_cloud_cloud;
 mod collide_elements;
 mod collide_hierarchy_brute_force;
 mod collide_mesh_cloud;
+mod collide_segmentations;
 mod determinism;
 mod exact_time_of_impact;
 mod filter_bad_input;

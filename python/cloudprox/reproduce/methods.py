@@ -350,7 +350,10 @@ def cloudprox_answers(
             f"not {rest} with model {model!r}"
         )
     piano, room = draw.clouds()
-    request = CollisionRequest(surface=surface, aggregation=first, model=model)
+    base, segmentations = model_segmentations(model)
+    request = CollisionRequest(
+        surface=surface, aggregation=first, model=base, segmentations=segmentations
+    )
     results = (many or collide_many)(piano, room, poses, request=request)
     seconds = np.array([r.stats.time_seconds for r in results])
     out = {
@@ -442,14 +445,32 @@ def variant_answers(
     return {variant_name(*v): answers[variant_name(*v)] for v in variants}
 
 
+def model_segmentations(model: str) -> tuple[str, int]:
+    """Split a variant's model name into the query's model and its segmentations.
+
+    ``"points"`` and ``"elements"`` query one segmentation; ``"elements-xK"`` the
+    elements model averaged over ``K`` segmentations
+    (``CollisionRequest(segmentations=K)``).
+    """
+    if model.startswith("elements-x"):
+        k = model.removeprefix("elements-x")
+        if not k.isdigit():
+            raise ValueError(f"model {model!r}: expected elements-xK with an integer K")
+        return "elements", int(k)
+    return model, 1
+
+
 def variant_name(model: str, surface: str, aggregation: str) -> str:
     """Return the row name of a cloudprox variant.
 
     ``"cloudprox quadric max"`` for the points model (the paper's, with its
-    aggregation), ``"cloudprox elements quadric"`` for the surface elements.
+    aggregation), ``"cloudprox elements quadric"`` for the surface elements
+    (``"cloudprox elements quadric x3"`` averaged over 3 segmentations).
     """
-    if model == "elements":
-        return f"cloudprox elements {surface}"
+    base, segmentations = model_segmentations(model)
+    if base == "elements":
+        suffix = f" x{segmentations}" if segmentations > 1 else ""
+        return f"cloudprox elements {surface}{suffix}"
     return f"cloudprox {surface} {aggregation}"
 
 

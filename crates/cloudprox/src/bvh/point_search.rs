@@ -77,6 +77,50 @@ impl<'a> PointSearch<'a> {
         }
     }
 
+    /// The candidates that can be among the `k` nearest points of any `x`
+    /// within `r` of `centre` (those within `d_k + 2 r` of `centre`, `d_k`
+    /// the distance of its `k`-th nearest: every point nearer `x` than its
+    /// `k`-th nearest lies there, by the triangle inequality), into `out` in
+    /// index order; [`PointSearch::nearest_among`] then finds them as
+    /// [`PointSearch::nearest`] would, with one search for many nearby `x`.
+    pub(crate) fn candidates_near(
+        &self,
+        centre: &Point3,
+        r: Real,
+        k: usize,
+        scratch: &mut Vec<(Real, u32)>,
+        out: &mut Vec<u32>,
+    ) {
+        self.nearest(centre, k, scratch);
+        let Some(&(d2, _)) = scratch.last() else {
+            out.clear();
+            return;
+        };
+        // A relative margin over the rounding of the distances.
+        let reach = (d2.sqrt() + 2.0 * r) * (1.0 + 1e-9);
+        self.within(centre, reach, out);
+    }
+
+    /// The `k` nearest points of `x` among `candidates` (from
+    /// [`PointSearch::candidates_near`] for a centre within its `r` of `x`):
+    /// the same as [`PointSearch::nearest`], ties by index.
+    pub(crate) fn nearest_among(
+        &self,
+        x: &Point3,
+        k: usize,
+        candidates: &[u32],
+        out: &mut Vec<(Real, u32)>,
+    ) {
+        out.clear();
+        let k = k.min(candidates.len());
+        if k == 0 {
+            return;
+        }
+        for &j in candidates {
+            offer_nearest(out, k, (self.points[j as usize] - x).norm_squared(), j);
+        }
+    }
+
     /// The points with `(p - x).norm() <= r`, into `out`, in index order.
     pub(crate) fn within(&self, x: &Point3, r: Real, out: &mut Vec<u32>) {
         if let Some((tree, workspace)) = &self.tree {

@@ -5,7 +5,7 @@ mod from_mesh;
 mod point_cloud;
 mod pose;
 
-pub use point_cloud::{PointCloud, MAX_COORDINATE};
+pub use point_cloud::{PointCloud, MAX_COORDINATE, MAX_SEGMENTATIONS};
 pub(crate) use pose::validate_pose;
 pub use pose::{
     pose_from_matrix, pose_from_quaternion, pose_from_rotation_vector, pose_from_rpy,

@@ -38,8 +38,17 @@ pub struct PointCloud {
     bvh: OnceLock<Bvh>,
     spacing: OnceLock<Spacing>,
     element_settings: ElementSettings,
-    elements: OnceLock<Box<SurfaceElements>>,
+    elements: ElementSets,
 }
+
+/// The most segmentations a query may average over
+/// ([`crate::query::CollisionRequest::segmentations`]).
+pub const MAX_SEGMENTATIONS: u32 = 16;
+
+/// A cloud's surface elements, one set per segmentation, each built on first
+/// use.
+#[derive(Debug, Clone, Default)]
+struct ElementSets([OnceLock<Box<SurfaceElements>>; MAX_SEGMENTATIONS as usize]);
 
 /// Sampling spacing per point and its maximum per hierarchy node.
 #[derive(Debug, Clone)]
@@ -65,10 +74,7 @@ impl Clone for PointCloud {
         if let Some(sp) = self.spacing.get() {
             let _ = spacing.set(sp.clone());
         }
-        let elements = OnceLock::new();
-        if let Some(e) = self.elements.get() {
-            let _ = elements.set(e.clone());
-        }
+        let elements = self.elements.clone();
         Self {
             points: self.points.clone(),
             covariances: self.covariances.clone(),
@@ -186,7 +192,7 @@ impl PointCloud {
             bvh: OnceLock::new(),
             spacing: OnceLock::new(),
             element_settings: ElementSettings::default(),
-            elements: OnceLock::new(),
+            elements: ElementSets::default(),
         }
     }
 
@@ -204,12 +210,33 @@ impl PointCloud {
     }
 
     /// The cloud's surface elements (see [`crate::element`]), built on first
-    /// call in the cloud's own frame and kept until the points move.
-    #[allow(clippy::expect_used)] // settings validated when set, cloud non-empty and finite
+    /// call in the cloud's own frame and kept until the points move (the
+    /// settings' segmentation, see [`PointCloud::segmentation`]).
     pub fn elements(&self) -> &SurfaceElements {
-        self.elements.get_or_init(|| {
+        self.segmentation(self.element_settings.segmentation)
+    }
+
+    /// The element set `offset` segmentations past the settings' own: the
+    /// `offset`-th of the sets a query averages over
+    /// ([`crate::query::CollisionRequest::segmentations`]).
+    pub(crate) fn segmentation_after(&self, offset: u32) -> &SurfaceElements {
+        self.segmentation(self.element_settings.segmentation.wrapping_add(offset))
+    }
+
+    /// The cloud's surface elements of segmentation `k`
+    /// ([`ElementSettings::segmentation`], the other settings the cloud's),
+    /// built on first call and kept until the points move; `k = 0` is
+    /// [`PointCloud::elements`]. `k` is taken modulo [`MAX_SEGMENTATIONS`].
+    #[allow(clippy::expect_used)] // settings validated when set, cloud non-empty and finite
+    pub fn segmentation(&self, k: u32) -> &SurfaceElements {
+        let k = k % MAX_SEGMENTATIONS;
+        self.elements.0[k as usize].get_or_init(|| {
+            let settings = ElementSettings {
+                segmentation: k,
+                ..self.element_settings
+            };
             Box::new(
-                SurfaceElements::build(self, &self.element_settings)
+                SurfaceElements::build(self, &settings)
                     .expect("element settings are validated when set"),
             )
         })
@@ -220,7 +247,7 @@ impl PointCloud {
     pub fn set_element_settings(&mut self, settings: ElementSettings) -> Result<()> {
         settings.validate()?;
         self.element_settings = settings;
-        self.elements = OnceLock::new();
+        self.elements = ElementSets::default();
         Ok(())
     }
 
@@ -255,7 +282,7 @@ impl PointCloud {
             *c += d;
         }
         self.sigma_max = self.covariances.par_iter().map(max_std).collect();
-        self.elements = OnceLock::new();
+        self.elements = ElementSets::default();
         Ok(self)
     }
 
@@ -280,7 +307,7 @@ impl PointCloud {
             *c += d;
         }
         self.sigma_max = self.covariances.par_iter().map(max_std).collect();
-        self.elements = OnceLock::new();
+        self.elements = ElementSets::default();
         Ok(self)
     }
 
@@ -418,7 +445,7 @@ impl PointCloud {
             bvh.refit(&self.points, &self.sensor_sigma_max)?;
         }
         self.spacing = OnceLock::new();
-        self.elements = OnceLock::new();
+        self.elements = ElementSets::default();
         Ok(())
     }
 
@@ -449,7 +476,7 @@ impl PointCloud {
         }
         self.bvh = OnceLock::new();
         self.spacing = OnceLock::new();
-        self.elements = OnceLock::new();
+        self.elements = ElementSets::default();
         Ok(())
     }
 

@@ -105,7 +105,7 @@ fn split_run(
                         SplitRule::TwoSurfaces { mean, frame, .. } => (mean, frame[0]),
                     };
                     let key = |i: u32| (points[i as usize] - mean).dot(&axis);
-                    k = count / 2;
+                    k = split_index(count, first, settings.segmentation);
                     run.select_nth_unstable_by(k, |&a, &b| key(a).total_cmp(&key(b)));
                 }
                 let (lo, hi) = run.split_at_mut(k);
@@ -149,6 +149,27 @@ fn split_run(
             (vec![i as u32], e)
         })
         .collect()
+}
+
+/// Where a group of `count` points (at least 2), starting at `first` in the
+/// index order, is halved along its axis: at the median for segmentation 0,
+/// else at a quantile in `[0.4, 0.6]` drawn from the segmentation and the
+/// group (a hash of the three: the same segmentation always splits the same
+/// group at the same place, on any number of threads).
+fn split_index(count: usize, first: usize, segmentation: u32) -> usize {
+    if segmentation == 0 {
+        return count / 2;
+    }
+    // SplitMix64's finalizer over the three inputs.
+    let mut h = u64::from(segmentation).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (first as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9)
+        ^ (count as u64).wrapping_mul(0x94D0_49BB_1331_11EB);
+    h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    h ^= h >> 31;
+    let unit = (h >> 11) as f64 / (1u64 << 53) as f64;
+    let at = (count as f64 * (0.4 + 0.2 * unit)).round() as usize;
+    at.clamp(1, count - 1)
 }
 
 /// Moves the entries for which `pred` holds to the front; returns their count.

@@ -29,6 +29,16 @@ pub struct ElementSettings {
     /// `rho = 1` averaging gains nothing (a depth camera's calibration error moves
     /// a whole patch together).
     pub noise_correlation: Real,
+    /// Which segmentation of the points (default 0): 0 halves every group
+    /// that fails the element tests at the median along its widest axis;
+    /// `k > 0` at a quantile between 40% and 60% drawn from `k` and the
+    /// group (deterministic), so that each `k` groups the same points into
+    /// differently placed elements. Where a contact falls relative to the
+    /// element boundaries changes which planes read it; averaging a query
+    /// over several segmentations
+    /// ([`CollisionRequest::segmentations`](crate::query::CollisionRequest::segmentations))
+    /// averages that out.
+    pub segmentation: u32,
 }
 
 impl Default for ElementSettings {
@@ -37,6 +47,7 @@ impl Default for ElementSettings {
             significance: 0.01,
             min_points: 10,
             noise_correlation: 0.0,
+            segmentation: 0,
         }
     }
 }

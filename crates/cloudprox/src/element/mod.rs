@@ -5,7 +5,9 @@
 //! standard deviation `sigma / sqrt(n)`, not `sigma`. A cloud's points are
 //! therefore grouped, once per cloud and in its own frame, into *surface
 //! elements*: groups that fit a plane within their own noise. The groups come from
-//! a top-down split (at the median along the largest principal axis, or between
+//! a top-down split (at the median along the largest principal axis, or, for
+//! segmentation `k > 0` ([`ElementSettings::segmentation`]), at a quantile
+//! between 40% and 60% drawn from `k` and the group; or between
 //! two surfaces where the points along the normal fall into two groups further
 //! apart than the noise, as the two faces of a thin plate do); a group is an
 //! element as soon as a residual test at the significance level

@@ -120,6 +120,28 @@ impl<'a> Posed<'a> {
         })
     }
 
+    /// A cheap necessary condition for `self` to give `x` a facing point
+    /// (see [`for_each_facing`]): its surface point across from `x` (clamped
+    /// to the extent) lies within `allowed` of `x` across its normal, and,
+    /// when the best so far lies over its element (`over_found`), `x` lies
+    /// over `self` too. Read on the tangential coordinates alone, before the
+    /// surface point and its variance are evaluated; `false` rules the
+    /// element out (the lateral offset `Posed::across` measures is the
+    /// clamped coordinates' offset, compared here with a margin over the
+    /// rounding). Always true for a single point.
+    fn could_face(&self, x: &Point3, allowed: Real, over_found: bool) -> bool {
+        if self.e.is_point() {
+            return true;
+        }
+        let (u, v) = self.coordinates(x);
+        if over_found && !self.is_over(u, v) {
+            return false;
+        }
+        let [[u0, u1], [v0, v1]] = self.e.extent;
+        let (du, dv) = (u.clamp(u0, u1) - u, v.clamp(v0, v1) - v);
+        du * du + dv * dv <= allowed * allowed * (1.0 + 1e-6)
+    }
+
     /// Tangential coordinates of `x`.
     fn coordinates(&self, x: &Point3) -> (Real, Real) {
         let d = x - self.mean;
@@ -229,17 +251,35 @@ fn for_each_facing(
     // hundreds of elements, each with 25 probes).
     let candidates = PointSearch::new(other.iter().map(|o| o.mean).collect::<Vec<_>>());
     let mut nearest: Vec<(Real, u32)> = Vec::with_capacity(FACING_CANDIDATES);
+    let mut probes: Vec<(Point3, Real)> = Vec::new();
+    let mut near_element: Vec<u32> = Vec::new();
     for (k, p) in own.iter().enumerate() {
         if !active[k] {
             continue;
         }
-        for &[u, v] in &p.e.probes {
-            let (x, var_x) = p.probe(u, v);
-            candidates.nearest(&x, FACING_CANDIDATES, &mut nearest);
+        // One search per element for the candidates of all its probes.
+        probes.clear();
+        probes.extend(p.e.probes.iter().map(|&[u, v]| p.probe(u, v)));
+        let r = probes
+            .iter()
+            .fold(0.0, |r: Real, (x, _)| r.max((x - p.mean).norm()));
+        candidates.candidates_near(
+            &p.mean,
+            r,
+            FACING_CANDIDATES,
+            &mut nearest,
+            &mut near_element,
+        );
+        for &(x, var_x) in &probes {
+            candidates.nearest_among(&x, FACING_CANDIDATES, &near_element, &mut nearest);
             let mut best: Option<Facing> = None;
             for &(_, j) in &nearest {
                 let j = j as usize;
                 let o = &other[j];
+                let allowed = HALF_SPACING * p.e.spacing.max(o.e.spacing);
+                if !o.could_face(&x, allowed, best.as_ref().is_some_and(|b| !b.key.0)) {
+                    continue;
+                }
                 let Across {
                     u: ou,
                     v: ov,
@@ -248,7 +288,6 @@ fn for_each_facing(
                     lateral,
                 } = o.across(&x, p);
                 let d = y - x;
-                let allowed = HALF_SPACING * p.e.spacing.max(o.e.spacing);
                 // An element that `x` lies over (within its extent, so `y`
                 // is straight across) beats one it lies beside (`y` clamped
                 // to the extent's edge, offset sideways): the gap of a pair

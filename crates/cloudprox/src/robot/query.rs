@@ -298,17 +298,18 @@ pub(crate) fn collide_robot_prepared(
             || match request.collide.model {
                 // The elements model's own first test: the hierarchies over both
                 // clouds' element hulls (the query reads P = 0 when it fails).
-                QueryModel::Elements => {
+                // With several segmentations, any of them that may reach.
+                QueryModel::Elements => (0..request.collide.segmentations).any(|s| {
                     let (may, visited) = element_surfaces_may_reach(
-                        link_cloud.elements(),
+                        link_cloud.segmentation_after(s),
                         &poses[l],
-                        cloud.elements(),
+                        cloud.segmentation_after(s),
                         k,
                         &mut ws.bvh,
                     );
                     stats.counters.broad_phase_nodes += visited;
                     may
-                }
+                }),
                 QueryModel::Points => {
                     let local = robot.links[l]
                         .geometry

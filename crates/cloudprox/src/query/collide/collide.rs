@@ -21,7 +21,7 @@ use crate::query::collide::region::{cut, split_patches, Patch};
 use crate::query::collide::warm_start::WarmStart;
 use crate::query::collide::{
     CollisionRequest, CollisionResult, ContactPatch, PointAggregates, PointProbabilities,
-    QueryModel, QueryStats,
+    QueryCounters, QueryModel, QueryStats,
 };
 use crate::Real;
 
@@ -79,6 +79,67 @@ pub(crate) fn collide_with_workspace(
     mut warm: Option<&mut WarmStart>,
 ) -> Result<CollisionResult> {
     request.validate()?;
+    let k = request.segmentations;
+    if request.model != QueryModel::Elements || k <= 1 {
+        return collide_segmentation(pose_a, a, pose_b, b, request, workspace, warm, 0);
+    }
+    // The mean over segmentations (see `CollisionRequest::segmentations`):
+    // each run's whole `P`, so deciding only, no early stop.
+    let start = Instant::now();
+    let each = CollisionRequest {
+        decide_only: false,
+        ..*request
+    };
+    let mut runs = Vec::with_capacity(k as usize);
+    for s in 0..k {
+        // A motion's warm start follows the first segmentation's samples.
+        let w = if s == 0 { warm.as_deref_mut() } else { None };
+        runs.push(collide_segmentation(
+            pose_a, a, pose_b, b, &each, workspace, w, s,
+        )?);
+    }
+    let probability = runs.iter().map(|r| r.probability).sum::<Real>() / Real::from(k);
+    let (probabilities_a, probabilities_b) = if request.decide_only {
+        (
+            PointProbabilities::zeros(a.len()),
+            PointProbabilities::zeros(b.len()),
+        )
+    } else {
+        (
+            PointProbabilities::mean(&runs.iter().map(|r| &r.probabilities_a).collect::<Vec<_>>()),
+            PointProbabilities::mean(&runs.iter().map(|r| &r.probabilities_b).collect::<Vec<_>>()),
+        )
+    };
+    let counters =
+        QueryCounters::combined(&runs.iter().map(|r| &r.stats.counters).collect::<Vec<_>>());
+    Ok(CollisionResult {
+        probability,
+        state: request.thresholds.state(probability),
+        probabilities_a,
+        probabilities_b,
+        patches: runs.into_iter().flat_map(|r| r.patches).collect(),
+        point_aggregates: None,
+        stats: QueryStats {
+            counters,
+            time_seconds: start.elapsed().as_secs_f64(),
+        },
+    })
+}
+
+/// One run of the query: with the elements model, on the clouds' element
+/// sets of segmentation `offset` past each cloud's own
+/// ([`ElementSettings::segmentation`](crate::element::ElementSettings::segmentation)).
+#[allow(clippy::too_many_arguments)]
+fn collide_segmentation(
+    pose_a: &Pose,
+    a: &PointCloud,
+    pose_b: &Pose,
+    b: &PointCloud,
+    request: &CollisionRequest,
+    workspace: &mut BvhWorkspace,
+    mut warm: Option<&mut WarmStart>,
+    offset: u32,
+) -> Result<CollisionResult> {
     validate_pose(pose_a, "pose_a")?;
     validate_pose(pose_b, "pose_b")?;
     let start = Instant::now();
@@ -88,7 +149,7 @@ pub(crate) fn collide_with_workspace(
     // The samples: the points, or the samples of the surface elements.
     let elements = match request.model {
         QueryModel::Points => None,
-        QueryModel::Elements => Some((a.elements(), b.elements())),
+        QueryModel::Elements => Some((a.segmentation_after(offset), b.segmentation_after(offset))),
     };
     let (sa, sb) = match elements {
         None => (a, b),

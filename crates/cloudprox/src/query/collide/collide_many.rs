@@ -98,7 +98,8 @@ pub fn collide_along(
 /// under `request` reads: its hierarchy and sampling spacing (the spacing is
 /// computed on the hierarchy, so both are built whatever `use_hierarchy`
 /// says) and, for the elements model, its surface elements with their hulls
-/// and their samples' hierarchy and spacing. Calling it again costs nothing.
+/// and their samples' hierarchy and spacing (of every segmentation the
+/// request averages over). Calling it again costs nothing.
 ///
 /// Call it on a new cloud before querying it from several threads of a rayon
 /// pool (your own `par_iter` over [`collide`](crate::query::collide())):
@@ -110,8 +111,10 @@ pub fn collide_along(
 pub fn prepare(cloud: &PointCloud, request: &CollisionRequest) {
     let _ = (cloud.bvh(), cloud.spacing());
     if request.model == QueryModel::Elements {
-        let elements = cloud.elements();
-        let samples = elements.samples();
-        let _ = (elements.hulls(), samples.bvh(), samples.spacing());
+        for k in 0..request.segmentations {
+            let elements = cloud.segmentation_after(k);
+            let samples = elements.samples();
+            let _ = (elements.hulls(), samples.bvh(), samples.spacing());
+        }
     }
 }

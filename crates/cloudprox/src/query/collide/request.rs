@@ -97,6 +97,22 @@ pub struct CollisionRequest {
     /// threshold. The state (and, when no patch is skipped, `P`) is that of the
     /// full query.
     pub decide_only: bool,
+    /// With the elements model, how many segmentations of the two clouds the
+    /// query averages over (default 1, at most
+    /// [`MAX_SEGMENTATIONS`](crate::cloud::MAX_SEGMENTATIONS)): the query runs
+    /// once on each pair of element sets `k = 0..segmentations`
+    /// ([`PointCloud::segmentation`](crate::cloud::PointCloud::segmentation):
+    /// the same points grouped into differently placed elements), and `P`
+    /// and the per-point probabilities are their means; the state is `P`'s,
+    /// the patches are the first segmentation's, the counters and the time
+    /// are the sums. Which element planes read a contact depends on where
+    /// the element boundaries fall, and from one noise draw to the next
+    /// that changes more than the noise of the planes themselves: the mean
+    /// over a few segmentations ranks poses near contact better, for as many
+    /// times the work. Deciding only, each segmentation's query still
+    /// computes its whole `P` (a mean of early stops would not be the full
+    /// query's). Must be 1 with the points model.
+    pub segmentations: u32,
 }
 
 impl Default for CollisionRequest {
@@ -111,6 +127,7 @@ impl Default for CollisionRequest {
             region_max_points: 2000,
             use_hierarchy: true,
             decide_only: false,
+            segmentations: 1,
         }
     }
 }
@@ -122,8 +139,9 @@ impl CollisionRequest {
     /// [`Error::InvalidInput`] naming the first field out of its domain: as
     /// [`ClassifySettings::validate`] and [`Thresholds::validate`]; a
     /// `prune_epsilon` outside `[0, 1)`, a `near_context` below 0.5 or not
-    /// finite, `region_max_points` below 8, or the `surface` aggregation with
-    /// the elements model.
+    /// finite, `region_max_points` below 8, the `surface` aggregation with
+    /// the elements model, or `segmentations` outside `1..=MAX_SEGMENTATIONS`
+    /// or above 1 with the points model.
     pub fn validate(&self) -> Result<()> {
         self.classify.validate()?;
         self.thresholds.validate()?;
@@ -143,6 +161,19 @@ impl CollisionRequest {
             return Err(Error::invalid(
                 "aggregation 'surface' belongs to model 'points' (the elements model aggregates surface crossings already)",
             ));
+        }
+        if !(1..=crate::cloud::MAX_SEGMENTATIONS).contains(&self.segmentations) {
+            return Err(Error::invalid(format!(
+                "segmentations must be in 1..={}, got {}",
+                crate::cloud::MAX_SEGMENTATIONS,
+                self.segmentations
+            )));
+        }
+        if self.model == QueryModel::Points && self.segmentations > 1 {
+            return Err(Error::invalid(format!(
+                "segmentations = {} needs model 'elements' (the points model has no segmentation)",
+                self.segmentations
+            )));
         }
         if self.region_max_points < 8 {
             return Err(Error::invalid(format!(

@@ -153,6 +153,23 @@ impl PointProbabilities {
             .zip(self.values.iter().copied())
     }
 
+    /// The mean of several runs' probabilities of the same `len` points (0
+    /// where a run stores none), stored where any run stores one.
+    pub(crate) fn mean(runs: &[&PointProbabilities]) -> Self {
+        let len = runs.first().map_or(0, |r| r.len);
+        let mut all: Vec<(u32, Real)> = runs.iter().flat_map(|r| r.iter()).collect();
+        all.sort_unstable_by_key(|&(i, _)| i);
+        let k = runs.len().max(1) as Real;
+        let mut summed: Vec<(u32, Real)> = Vec::with_capacity(all.len());
+        for (i, p) in all {
+            match summed.last_mut() {
+                Some(last) if last.0 == i => last.1 += p,
+                _ => summed.push((i, p)),
+            }
+        }
+        Self::nonzero(len, summed.into_iter().map(|(i, p)| (i, (p / k).min(1.0))))
+    }
+
     /// Every point's probability, `len` values.
     pub fn to_dense(&self) -> Vec<Real> {
         let mut out = vec![0.0; self.len];
@@ -206,6 +223,32 @@ pub struct QueryCounters {
     /// of a plane separating its node from the other cloud's (see
     /// [`crate::bvh::prune_bound`]); pruned points get `p_i = 0`.
     pub pruned_bound: Real,
+}
+
+impl QueryCounters {
+    /// The counters of several runs of one query (its segmentations, see
+    /// [`crate::query::CollisionRequest::segmentations`]): sums, but the
+    /// pruned bound, whose mean bounds what pruning changes of a mean of the
+    /// runs' probabilities.
+    pub(crate) fn combined(runs: &[&QueryCounters]) -> Self {
+        let mut out = QueryCounters::default();
+        for c in runs {
+            out.node_pairs_visited += c.node_pairs_visited;
+            out.leaf_pairs += c.leaf_pairs;
+            out.near_regions += c.near_regions;
+            out.patches += c.patches;
+            out.misfit_cuts += c.misfit_cuts;
+            out.patches_beyond_reach += c.patches_beyond_reach;
+            out.surface_crossings += c.surface_crossings;
+            out.surface_links += c.surface_links;
+            out.points_classified += c.points_classified;
+            out.solver_iterations += c.solver_iterations;
+            out.clarabel_fallbacks += c.clarabel_fallbacks;
+            out.solver_fallbacks += c.solver_fallbacks;
+            out.pruned_bound += c.pruned_bound / runs.len() as Real;
+        }
+        out
+    }
 }
 
 /// Counters and timings of one query. Equality compares the counters, not
