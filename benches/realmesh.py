@@ -158,14 +158,17 @@ def method_name(method: str) -> str | None:
     """Return the table's name of ``method``, None if unknown.
 
     ``method`` is a key of :data:`METHODS` or ``elements-xK``: the elements averaged
-    over ``K`` segmentations.
+    over ``K`` segmentations (1 to 16).
     """
     if method in METHODS:
         return METHODS[method]
-    k = method.removeprefix("elements-x")
-    if method.startswith("elements-x") and k.isdigit():
-        return f"elements, {int(k)} segmentations"
-    return None
+    try:
+        base, k = m.model_segmentations(method)
+    except ValueError:
+        return None
+    if base != "elements" or not 1 <= k <= 16:
+        return None
+    return f"elements, {k} segmentations"
 
 
 def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:

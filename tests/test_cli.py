@@ -89,6 +89,22 @@ def test_collide_with_pose_and_options(capsys, npy_files) -> None:
     assert "state: free" in out and "P = " in out and "stats:" in out
 
 
+def test_collide_with_segmentations(capsys, npy_files) -> None:
+    args = ("collide", npy_files["a"], npy_files["b_deep"], "--sigma", "0.002", "--json")
+    code, out, err = run(capsys, *args, "--model", "elements", "--segmentations", "3")
+    assert code == 0, err
+    doc = json.loads(out)
+    code, out, err = run(capsys, *args, "--model", "elements")
+    assert code == 0, err
+    one = json.loads(out)
+    assert doc["state"] == "collision"
+    assert doc["stats"]["patches"] >= len(one["patches"]) and len(doc["patches"]) > len(
+        one["patches"]
+    )
+    code, _, err = run(capsys, *args, "--segmentations", "3")
+    assert code != 0 and "needs model 'elements'" in err
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

@@ -195,11 +195,18 @@ def test_segmentations_average_the_elements_model(spheres) -> None:
     a, b = spheres
     pose = sphere_gap_pose(0.5)
     mean = cp.collide(a, b, pose_b=pose, model="elements", segmentations=3)
-    one = [cp.collide(a, b, pose_b=pose, model="elements", segmentations=1)]
-    assert mean.stats.patches == len(mean.patches)
-    assert mean.stats.patches >= len(one[0].patches)
+    one = cp.collide(a, b, pose_b=pose, model="elements")
+    assert mean.stats.patches == len(mean.patches) >= 3 * min(1, len(one.patches))
+    assert mean.stats.points_classified > one.stats.points_classified
+    # The first run is the cloud's own segmentation: its patches come first.
+    first = mean.patches[: len(one.patches)]
+    assert [p.probability for p in first] == [p.probability for p in one.patches]
     q = cp.collide(a, b, pose_b=pose, model="elements", segmentations=3, decide_only=True)
     assert q.state == mean.state and q.probability == pytest.approx(mean.probability, abs=1e-12)
+    with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got 17"):
+        cp.CollisionRequest(model="elements", segmentations=17)
+    with pytest.raises(cp.InvalidInputError, match=r"needs model 'elements'"):
+        cp.CollisionRequest(model="elements", segmentations=3).replace(model="points")
     with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got 0"):
         cp.CollisionRequest(model="elements", segmentations=0)
     with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got -1"):

@@ -230,7 +230,8 @@ class PointCloud:
         """Build now, without the GIL, what a query under ``request`` builds on first use.
 
         The hierarchy and sampling spacing and, for ``model="elements"``, the
-        surface elements (``options`` override the request's fields, as in
+        surface elements (every one of the ``segmentations`` sets, each about as
+        large as the cloud's points; ``options`` override the request's fields, as in
         :func:`collide`). Later queries then do not pay for it, the first
         query's ``time_seconds`` included; calling it again costs nothing.
         :func:`collide_many` and the robot queries do it themselves.
@@ -409,7 +410,7 @@ class QueryStats:
         """Patches of the elements model pruned because no element faces the other side within the noise's reach."""
     @property
     def surface_crossings(self) -> int:
-        """Element surface pairs found crossing, 0 or 1 (elements model: before any patch with ``decide_only``, after the patches found no collision in the full query)."""
+        """Element surface pairs found crossing, 0 or 1 per segmentation (elements model: before any patch with ``decide_only``, after the patches found no collision in the full query)."""
     @property
     def surface_links(self) -> int:
         """Element pairs whose surfaces face within the noise's reach although no sample of one of them was near the other (a metre-wide element a thin part passes through): each brought both elements into the near set."""

@@ -286,7 +286,8 @@ impl PyPointCloud {
     /// Build now, without the GIL, every part of this cloud that a query under
     /// `request` (with the keyword `options` on top, as in ``collide``) builds on
     /// its first use: the hierarchy and sampling spacing and, for
-    /// ``model="elements"``, the surface elements. Later queries then do not
+    /// ``model="elements"``, the surface elements (every set of the
+    /// ``segmentations`` the request averages over). Later queries then do not
     /// pay for it (the first query's ``time_seconds`` included); calling it
     /// again costs nothing. ``collide_many`` and the robot queries do it
     /// themselves.

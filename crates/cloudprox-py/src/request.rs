@@ -144,7 +144,13 @@ impl PyCollisionRequest {
         }
         if let Some(v) = segmentations {
             r.segmentations = u32::try_from(v).map_err(|_| {
-                invalid_input(py, format!("segmentations must be in 1..=16, got {v}"))
+                invalid_input(
+                    py,
+                    format!(
+                        "segmentations must be in 1..={}, got {v}",
+                        cloudprox::cloud::MAX_SEGMENTATIONS
+                    ),
+                )
             })?;
         }
         r.validate().or_py(py)?;

@@ -236,7 +236,7 @@ stats_class! {
         /// Patches of the elements model pruned without a classifier (no element
         /// faces the other side within the noise's reach).
         patches_beyond_reach: usize,
-        /// Element surface pairs found crossing (0 or 1): with the elements
+        /// Element surface pairs found crossing (0 or 1 per segmentation): with the elements
         /// model, ``decide_only`` looks for one before any patch (a collision
         /// decided without a classifier), the full query where its patches
         /// found no collision.

@@ -53,6 +53,16 @@ pub fn box_surface(center: &Point3, half: &Vector3, spacing: Real) -> Vec<Point3
 
 /// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator
 /// seeded by `seed` (Knuth's MMIX constants): the tests' fixed streams.
+/// SplitMix64's output function: a bijection of `u64` that spreads every input
+/// bit over the output (Steele, Lea and Flood, *Fast splittable pseudorandom
+/// number generators*, 2014). [`NormalRng`] applies it to its counter; the
+/// element split to a hash of a group.
+pub(crate) fn splitmix64_mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
 #[cfg(test)]
 pub(crate) fn lcg_uniform(seed: u64) -> impl FnMut() -> Real {
     let mut state = seed;
@@ -83,10 +93,7 @@ impl NormalRng {
     /// A uniform number in `(0, 1)`.
     pub fn uniform(&mut self) -> Real {
         self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
+        let z = splitmix64_mix(self.state);
         ((z >> 11) as Real + 0.5) / (1u64 << 53) as Real
     }
 

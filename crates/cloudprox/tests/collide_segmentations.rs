@@ -160,3 +160,62 @@ fn bad_segmentation_counts_are_named() {
         assert!(err.to_string().contains(needle), "{err}");
     }
 }
+
+#[test]
+fn many_poses_and_a_motion_average_as_single_queries_do() {
+    let (a, b) = spheres(2000);
+    let req = averaged(2);
+    let poses: Vec<Pose> = [3.0, 1.5, 0.5, -0.5, -1.5]
+        .iter()
+        .map(|g| sphere_pose(g * SIGMA))
+        .collect();
+    let id = Pose::identity();
+    let many = collide_many(&poses, &a, &id, &b, &req).unwrap();
+    let along = collide_along(&poses, &a, &id, &b, &req).unwrap();
+    for (k, pose) in poses.iter().enumerate() {
+        let one = collide(pose, &a, &id, &b, &req).unwrap();
+        assert_eq!(many[k].probability, one.probability, "pose {k}");
+        assert_eq!(many[k].probabilities_a, one.probabilities_a, "pose {k}");
+        // The warm start changes the first segmentation's work, not its
+        // optimum (to the solver's tolerance).
+        assert!(
+            (along[k].probability - one.probability).abs() < 1e-6,
+            "pose {k}: along {} vs {}",
+            along[k].probability,
+            one.probability
+        );
+        assert_eq!(along[k].state, one.state, "pose {k}");
+    }
+}
+
+#[test]
+fn a_clouds_own_segmentation_is_its_elements_and_moves_with_its_points() {
+    let (a, _) = spheres(1500);
+    let mut own = a.clone();
+    own.set_element_settings(ElementSettings {
+        segmentation: 5,
+        ..ElementSettings::default()
+    })
+    .unwrap();
+    assert_eq!(own.elements().elements(), a.segmentation(5).elements());
+    assert_eq!(own.segmentation(0).elements(), a.elements().elements());
+    let t = Pose::new(Vector3::new(0.1, 0.2, 0.3), Vector3::new(0.3, -0.2, 0.1));
+    let mut moved = a.clone();
+    let _ = moved.segmentation(3).elements().len();
+    moved.transform(&t).unwrap();
+    let fresh = a.transformed(&t).unwrap();
+    assert_eq!(
+        moved.segmentation(3).elements(),
+        fresh.segmentation(3).elements()
+    );
+    let bad = ElementSettings {
+        segmentation: cloudprox::cloud::MAX_SEGMENTATIONS,
+        ..ElementSettings::default()
+    };
+    let err = own.set_element_settings(bad).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("element segmentation must be below 16, got 16"),
+        "{err}"
+    );
+}

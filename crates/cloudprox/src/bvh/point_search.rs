@@ -178,6 +178,7 @@ impl Neighbourhoods {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Vector3;
 
     fn check(pts: &[Point3], radii: &[Real]) {
         let (tree, scan) = (PointSearch::new(pts), PointSearch::scan(pts));
@@ -220,6 +221,39 @@ mod tests {
             .map(|i| Point3::new((i % 30) as Real * 0.01, (i / 30) as Real * 0.01, 0.0))
             .collect();
         check(&lattice, &[0.01, 0.02 * std::f64::consts::SQRT_2, 0.03]);
+    }
+
+    #[test]
+    fn the_nearest_among_an_elements_candidates_are_the_nearest_of_all() {
+        // A lattice (ties at most k-th distances) and a noisy sheet; centres
+        // on and off the points, probes scattered within `r` of each.
+        let mut uniform = crate::sample::lcg_uniform(11);
+        let lattice: Vec<Point3> = (0..400)
+            .map(|i| Point3::new((i % 20) as Real, (i / 20) as Real, 0.0))
+            .collect();
+        let sheet: Vec<Point3> = (0..300)
+            .map(|_| Point3::new(20.0 * uniform(), 20.0 * uniform(), 0.3 * uniform()))
+            .collect();
+        for pts in [lattice, sheet] {
+            let search = PointSearch::new(&pts[..]);
+            let (mut scratch, mut cand, mut got, mut want) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for c in 0..25 {
+                let centre = Point3::new(0.8 * c as Real, 0.7 * c as Real, 0.0);
+                for (k, r) in [(1, 0.0), (6, 1.5), (6, 4.0), (12, 2.5)] {
+                    search.candidates_near(&centre, r, k, &mut scratch, &mut cand);
+                    assert!(cand.len() < pts.len() || r >= 4.0, "centre {c}: no pruning");
+                    for p in 0..20 {
+                        let a = 6.283 * p as Real / 20.0;
+                        let x = centre
+                            + Vector3::new(a.cos(), a.sin(), 0.0) * r * (p % 3) as Real / 2.0;
+                        search.nearest_among(&x, k, &cand, &mut got);
+                        search.nearest(&x, k, &mut want);
+                        assert_eq!(got, want, "centre {c}, k {k}, r {r}, probe {p}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -225,8 +225,10 @@ impl PointCloud {
 
     /// The cloud's surface elements of segmentation `k`
     /// ([`ElementSettings::segmentation`], the other settings the cloud's),
-    /// built on first call and kept until the points move; `k = 0` is
-    /// [`PointCloud::elements`]. `k` is taken modulo [`MAX_SEGMENTATIONS`].
+    /// built on first call and kept until the points move (each set about as
+    /// large as the cloud's points; a query over `K` segmentations keeps `K`).
+    /// [`PointCloud::elements`] is the settings' own segmentation. `k` is
+    /// taken modulo [`MAX_SEGMENTATIONS`].
     #[allow(clippy::expect_used)] // settings validated when set, cloud non-empty and finite
     pub fn segmentation(&self, k: u32) -> &SurfaceElements {
         let k = k % MAX_SEGMENTATIONS;

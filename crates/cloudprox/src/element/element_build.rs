@@ -8,6 +8,7 @@ use crate::element::element_samples::element_samples;
 use crate::element::{ElementSettings, SurfaceElement, SurfaceElements};
 use crate::error::Result;
 use crate::math::Vector3;
+use crate::sample::splitmix64_mix;
 
 impl SurfaceElements {
     /// Groups `cloud`'s points into surface elements (see [`crate::element`]),
@@ -160,13 +161,11 @@ fn split_index(count: usize, first: usize, segmentation: u32) -> usize {
     if segmentation == 0 {
         return count / 2;
     }
-    // SplitMix64's finalizer over the three inputs.
-    let mut h = u64::from(segmentation).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (first as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9)
-        ^ (count as u64).wrapping_mul(0x94D0_49BB_1331_11EB);
-    h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    h ^= h >> 31;
+    let h = splitmix64_mix(
+        u64::from(segmentation).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (first as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9)
+            ^ (count as u64).wrapping_mul(0x94D0_49BB_1331_11EB),
+    );
     let unit = (h >> 11) as f64 / (1u64 << 53) as f64;
     let at = (count as f64 * (0.4 + 0.2 * unit)).round() as usize;
     at.clamp(1, count - 1)

@@ -29,7 +29,8 @@ pub struct ElementSettings {
     /// `rho = 1` averaging gains nothing (a depth camera's calibration error moves
     /// a whole patch together).
     pub noise_correlation: Real,
-    /// Which segmentation of the points (default 0): 0 halves every group
+    /// Which segmentation of the points (default 0, below
+    /// [`MAX_SEGMENTATIONS`](crate::cloud::MAX_SEGMENTATIONS)): 0 halves every group
     /// that fails the element tests at the median along its widest axis;
     /// `k > 0` at a quantile between 40% and 60% drawn from `k` and the
     /// group (deterministic), so that each `k` groups the same points into
@@ -71,6 +72,13 @@ impl ElementSettings {
             return Err(Error::invalid(format!(
                 "noise_correlation must be in [0, 1], got {}",
                 self.noise_correlation
+            )));
+        }
+        if self.segmentation >= crate::cloud::MAX_SEGMENTATIONS {
+            return Err(Error::invalid(format!(
+                "element segmentation must be below {}, got {}",
+                crate::cloud::MAX_SEGMENTATIONS,
+                self.segmentation
             )));
         }
         Ok(())

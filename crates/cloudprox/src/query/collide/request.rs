@@ -100,12 +100,13 @@ pub struct CollisionRequest {
     /// With the elements model, how many segmentations of the two clouds the
     /// query averages over (default 1, at most
     /// [`MAX_SEGMENTATIONS`](crate::cloud::MAX_SEGMENTATIONS)): the query runs
-    /// once on each pair of element sets `k = 0..segmentations`
+    /// once on each pair of element sets, each cloud's own segmentation and
+    /// the next `segmentations - 1`
     /// ([`PointCloud::segmentation`](crate::cloud::PointCloud::segmentation):
     /// the same points grouped into differently placed elements), and `P`
     /// and the per-point probabilities are their means; the state is `P`'s,
-    /// the patches are the first segmentation's, the counters and the time
-    /// are the sums. Which element planes read a contact depends on where
+    /// the patches are every run's, the counters their sums (the pruned
+    /// bound their mean) and the time the whole query's. Which element planes read a contact depends on where
     /// the element boundaries fall, and from one noise draw to the next
     /// that changes more than the noise of the planes themselves: the mean
     /// over a few segmentations ranks poses near contact better, for as many

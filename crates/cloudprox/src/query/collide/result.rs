@@ -199,7 +199,8 @@ pub struct QueryCounters {
     /// of either side faces the other within the noise's reach (their points
     /// keep `p_i = 0`).
     pub patches_beyond_reach: usize,
-    /// Element surface pairs found crossing by the hierarchies (0 or 1): with
+    /// Element surface pairs found crossing by the hierarchies (0 or 1 per
+    /// segmentation): with
     /// the elements model, `decide_only` looks for one before any patch (a
     /// collision decided without a classifier), and the full query where its
     /// patches found no collision (a part through a thin solid).
@@ -233,6 +234,22 @@ impl QueryCounters {
     pub(crate) fn combined(runs: &[&QueryCounters]) -> Self {
         let mut out = QueryCounters::default();
         for c in runs {
+            // Every field named, so that a new counter cannot be left out.
+            let QueryCounters {
+                node_pairs_visited: _,
+                leaf_pairs: _,
+                near_regions: _,
+                patches: _,
+                misfit_cuts: _,
+                patches_beyond_reach: _,
+                surface_crossings: _,
+                surface_links: _,
+                points_classified: _,
+                solver_iterations: _,
+                clarabel_fallbacks: _,
+                solver_fallbacks: _,
+                pruned_bound: _,
+            } = c;
             out.node_pairs_visited += c.node_pairs_visited;
             out.leaf_pairs += c.leaf_pairs;
             out.near_regions += c.near_regions;
