@@ -244,7 +244,7 @@ mod tests {
                     search.candidates_near(&centre, r, k, &mut scratch, &mut cand);
                     assert!(cand.len() < pts.len() || r >= 4.0, "centre {c}: no pruning");
                     for p in 0..20 {
-                        let a = 6.283 * p as Real / 20.0;
+                        let a = std::f64::consts::TAU * p as Real / 20.0;
                         let x = centre
                             + Vector3::new(a.cos(), a.sin(), 0.0) * r * (p % 3) as Real / 2.0;
                         search.nearest_among(&x, k, &cand, &mut got);
