@@ -132,8 +132,22 @@ fn the_mean_keeps_the_invariances_and_decide_only_its_state() {
         );
         let q = collide(&Pose::identity(), &a, &pb, &b, &quick).unwrap();
         assert_eq!(q.state, r0.state, "gap {gap}");
-        assert!((q.probability - r0.probability).abs() < 1e-12, "gap {gap}");
+        // Its runs leave out the per-point work and nothing that `P` reads:
+        // the same `P` to the bit, no per-point probabilities, no separation
+        // estimates (the full query's patches have theirs).
+        assert_eq!(
+            q.probability.to_bits(),
+            r0.probability.to_bits(),
+            "gap {gap}"
+        );
         assert!(q.probabilities_a.indices().is_empty());
+        assert!(q.probabilities_b.indices().is_empty());
+        assert_eq!(q.patches.len(), r0.patches.len(), "gap {gap}");
+        assert!(q.patches.iter().all(|p| p.separation.is_nan()), "gap {gap}");
+        assert!(
+            r0.patches.iter().all(|p| !p.separation.is_nan()),
+            "gap {gap}"
+        );
     }
     // Far apart and deep inside: every segmentation agrees.
     let far = collide(&Pose::identity(), &a, &sphere_pose(20.0 * SIGMA), &b, &req).unwrap();

@@ -2,12 +2,15 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use crate::bvh::{BvhWorkspace, PointSearch};
 use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
 use crate::probability::{normal_cdf, normal_quantile, Aggregation};
+use crate::query::collide::collide_many::prepare;
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
     element_crossings, element_pairs_within_reach, element_points, element_sides_within_reach,
@@ -76,28 +79,43 @@ pub(crate) fn collide_with_workspace(
     b: &PointCloud,
     request: &CollisionRequest,
     workspace: &mut BvhWorkspace,
-    mut warm: Option<&mut WarmStart>,
+    warm: Option<&mut WarmStart>,
 ) -> Result<CollisionResult> {
     request.validate()?;
     let k = request.segmentations;
     if request.model != QueryModel::Elements || k <= 1 {
-        return collide_segmentation(pose_a, a, pose_b, b, request, workspace, warm, 0);
+        let per_point = !request.decide_only;
+        return collide_segmentation(pose_a, a, pose_b, b, request, workspace, warm, 0, per_point);
     }
     // The mean over segmentations (see `CollisionRequest::segmentations`):
-    // each run's whole `P`, so deciding only, no early stop.
+    // each run's whole `P`, so deciding only, no early stop (and no per-point
+    // work, which only the full query reports). The runs after the first
+    // go to rayon's pool, each with its own workspace; the first, which a
+    // motion's warm start follows, runs here. Every set a run reads is built
+    // first: built inside the pool, a thread waiting for its `OnceLock`'s
+    // helpers could take up another run that needs the same set.
     let start = Instant::now();
+    prepare(a, request);
+    prepare(b, request);
     let each = CollisionRequest {
         decide_only: false,
         ..*request
     };
-    let mut runs = Vec::with_capacity(k as usize);
-    for s in 0..k {
-        // A motion's warm start follows the first segmentation's samples.
-        let w = if s == 0 { warm.as_deref_mut() } else { None };
-        runs.push(collide_segmentation(
-            pose_a, a, pose_b, b, &each, workspace, w, s,
-        )?);
-    }
+    let per_point = !request.decide_only;
+    let (first, rest) = rayon::join(
+        || collide_segmentation(pose_a, a, pose_b, b, &each, workspace, warm, 0, per_point),
+        || {
+            (1..k)
+                .into_par_iter()
+                .map(|s| {
+                    let mut own = BvhWorkspace::default();
+                    collide_segmentation(pose_a, a, pose_b, b, &each, &mut own, None, s, per_point)
+                })
+                .collect::<Result<Vec<_>>>()
+        },
+    );
+    let mut runs = vec![first?];
+    runs.extend(rest?);
     let probability = runs.iter().map(|r| r.probability).sum::<Real>() / Real::from(k);
     let (probabilities_a, probabilities_b) = if request.decide_only {
         (
@@ -129,6 +147,10 @@ pub(crate) fn collide_with_workspace(
 /// One run of the query: with the elements model, on the clouds' element
 /// sets of segmentation `offset` past each cloud's own
 /// ([`ElementSettings::segmentation`](crate::element::ElementSettings::segmentation)).
+/// `per_point` false leaves out what only the full query reports (per-point
+/// probabilities and separation estimates): `!decide_only` for a query on
+/// its own; false for a run of a mean over segmentations deciding only,
+/// which needs its whole `P` (`request.decide_only` false) and nothing else.
 #[allow(clippy::too_many_arguments)]
 fn collide_segmentation(
     pose_a: &Pose,
@@ -139,6 +161,7 @@ fn collide_segmentation(
     workspace: &mut BvhWorkspace,
     mut warm: Option<&mut WarmStart>,
     offset: u32,
+    per_point: bool,
 ) -> Result<CollisionResult> {
     validate_pose(pose_a, "pose_a")?;
     validate_pose(pose_b, "pose_b")?;
@@ -301,7 +324,7 @@ fn collide_segmentation(
                 spacing,
                 sigma,
                 request,
-                !request.decide_only,
+                per_point,
                 hint.as_deref(),
             )?;
             // A context sample (beyond the noise's reach of the other cloud) that
@@ -377,7 +400,7 @@ fn collide_segmentation(
             if inputs_a.is_empty() {
                 inputs_a = vec![0.0; sa.len()];
                 inputs_b = vec![0.0; sb.len()];
-                if !request.decide_only {
+                if per_point {
                     probabilities_a = vec![0.0; a.len()];
                     probabilities_b = vec![0.0; b.len()];
                 }
@@ -409,7 +432,7 @@ fn collide_segmentation(
             // the patch's surface.
             let (indices_a, indices_b) = match elements {
                 None => {
-                    if !request.decide_only {
+                    if per_point {
                         for (&i, &p) in ia.iter().zip(&fit.probabilities[..na]) {
                             probabilities_a[i as usize] = probabilities_a[i as usize].max(p);
                         }
@@ -421,7 +444,7 @@ fn collide_segmentation(
                 }
                 Some((ea, eb)) => {
                     let (oa, ob) = (unique_owners(ea, &ia), unique_owners(eb, &ib));
-                    if !request.decide_only {
+                    if per_point {
                         point_probabilities(sep, &rel, ea, &oa, 1.0, &mut probabilities_a);
                         let id = Pose::identity();
                         point_probabilities(sep, &id, eb, &ob, -1.0, &mut probabilities_b);
@@ -461,7 +484,7 @@ fn collide_segmentation(
     }
     // The points model's samples are its points: the same points, read for
     // their Eq. 3 probabilities (the inputs themselves unless `surface`).
-    let point_aggregates = (elements.is_none() && !request.decide_only).then(|| {
+    let point_aggregates = (elements.is_none() && per_point).then(|| {
         let values: Vec<Real> = core_values(indexed_inputs(&touched.0, &probabilities_a), &core.0)
             .chain(core_values(
                 indexed_inputs(&touched.1, &probabilities_b),
@@ -492,7 +515,7 @@ fn collide_segmentation(
     };
     // The points given a probability are the patches' points (none deciding only).
     let per_point = |len: usize, dense: &[Real], side: fn(&ContactPatch) -> &[u32]| {
-        if request.decide_only {
+        if !per_point {
             return PointProbabilities::zeros(len);
         }
         PointProbabilities::gather(len, dense, patches.iter().flat_map(side).copied().collect())

@@ -110,9 +110,12 @@ pub struct CollisionRequest {
     /// the element boundaries fall, and from one noise draw to the next
     /// that changes more than the noise of the planes themselves: the mean
     /// over a few segmentations ranks poses near contact better, for as many
-    /// times the work. Deciding only, each segmentation's query still
-    /// computes its whole `P` (a mean of early stops would not be the full
-    /// query's). Must be 1 with the points model.
+    /// times the work (the runs after the first go to rayon's pool, so on
+    /// several cores a query waits for less). Deciding only, each
+    /// segmentation's query still computes its whole `P` (a mean of early
+    /// stops would not be the full query's), without the per-point
+    /// probabilities and separation estimates. Must be 1 with the points
+    /// model.
     pub segmentations: u32,
 }
 
