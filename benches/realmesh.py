@@ -157,18 +157,23 @@ METHODS = {
 def method_name(method: str) -> str | None:
     """Return the table's name of ``method``, None if unknown.
 
-    ``method`` is a key of :data:`METHODS` or ``elements-xK``: the elements averaged
-    over ``K`` segmentations (1 to 16).
+    ``method`` is a key of :data:`METHODS` or ``elements[-xK][-cC]``: the elements
+    averaged over ``K`` segmentations (1 to 16), with ``C`` spacings of context
+    (``near_context``, at least 0.5; see :func:`cloudprox.reproduce.methods.model_options`).
     """
     if method in METHODS:
         return METHODS[method]
     try:
-        base, k = m.model_segmentations(method)
+        options = m.model_options(method)
     except ValueError:
         return None
-    if base != "elements" or not 1 <= k <= 16:
+    k, context = options.segmentations, options.near_context
+    if options.model != "elements" or not 1 <= k <= 16:
         return None
-    return f"elements, {k} segmentations"
+    if context is not None and not context >= 0.5:
+        return None
+    name = "elements" if k == 1 else f"elements, {k} segmentations"
+    return name if context is None else f"{name}, context {context:g}"
 
 
 def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
@@ -181,7 +186,7 @@ def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
         return m.nn_gap_answer(draw, q)
     if method == "collision-map":
         return m.collision_map_answer(draw, q, m.sampling_spacing(draw.room_points))
-    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}, elements-xK")
+    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}, elements[-xK][-cC]")
 
 
 def main() -> None:
@@ -194,8 +199,9 @@ def main() -> None:
     ap.add_argument(
         "--methods",
         default=",".join(METHODS),
-        help=f"comma-separated, among {', '.join(METHODS)} or elements-xK (the elements "
-        "averaged over K segmentations) (default: all listed)",
+        help=f"comma-separated, among {', '.join(METHODS)} or elements[-xK][-cC] (the "
+        "elements averaged over K segmentations, with C spacings of context) "
+        "(default: all listed)",
     )
     ap.add_argument(
         "--bounds",

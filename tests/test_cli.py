@@ -105,6 +105,21 @@ def test_collide_with_segmentations(capsys, npy_files) -> None:
     assert code != 0 and "needs model 'elements'" in err
 
 
+def test_collide_with_near_context(capsys, npy_files) -> None:
+    args = ("collide", npy_files["a"], npy_files["b_deep"], "--sigma", "0.002", "--json")
+    classified = []
+    for context in ("2", "0.5"):
+        code, out, err = run(capsys, *args, "--model", "elements", "--near-context", context)
+        assert code == 0, err
+        doc = json.loads(out)
+        assert doc["state"] == "collision"
+        classified.append(doc["stats"]["points_classified"])
+    # Less context around the contact: fewer samples for the classifier.
+    assert 0 < classified[1] < classified[0]
+    code, _, err = run(capsys, *args, "--near-context", "0.2")
+    assert code != 0 and "near_context must be finite and >= 0.5" in err
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

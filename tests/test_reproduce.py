@@ -451,3 +451,45 @@ def test_reliability_bins_mean_prediction_and_observed_share() -> None:
     assert mean_p[0] == pytest.approx(0.05) and observed[0] == 0.5
     assert mean_p[9] == pytest.approx((0.95 + 0.95 + 1.0) / 3) and observed[9] == 1.0
     assert observed[5] == 0.0 and np.isnan(observed[1])
+
+
+def test_model_names_carry_the_elements_options() -> None:
+    from types import SimpleNamespace
+
+    from cloudprox.reproduce.methods import (
+        ModelOptions,
+        cloudprox_answer,
+        model_options,
+        model_segmentations,
+        variant_name,
+    )
+
+    assert model_options("points") == ModelOptions("points")
+    assert model_options("elements") == ModelOptions("elements")
+    assert model_options("elements-x3") == ModelOptions("elements", 3)
+    assert model_options("elements-c1") == ModelOptions("elements", 1, 1.0)
+    assert model_options("elements-x3-c0.5") == ModelOptions("elements", 3, 0.5)
+    assert model_segmentations("elements-x3-c1") == ("elements", 3)
+    assert variant_name("elements-x3-c1", "quadric", "max") == "cloudprox elements quadric x3 c1"
+    assert variant_name("elements-c1.5", "quadric", "max") == "cloudprox elements quadric c1.5"
+    assert variant_name("elements", "quadric", "max") == "cloudprox elements quadric"
+    for bad in ("elements-y3", "elements-x", "elements-cX", "points-x3", "elements-x3-"):
+        with pytest.raises(ValueError, match="model"):
+            model_options(bad)
+    # The options reach the query's request; without them the core's defaults.
+    seen = []
+
+    def many(a: object, b: object, poses: np.ndarray, request: object) -> list[SimpleNamespace]:
+        seen.append(request)
+        done = SimpleNamespace(time_seconds=0.0)
+        return [SimpleNamespace(probability=0.0, state="free", stats=done) for _ in poses]
+
+    pts = np.zeros((3, 3))
+    draw = Draw(
+        pts, np.broadcast_to(np.eye(3), (3, 3, 3)), pts, np.broadcast_to(np.eye(3), (3, 3, 3))
+    )
+    for model in ("elements-x3-c1", "elements"):
+        cloudprox_answer(draw, np.eye(4)[None], "quadric", "max", model, many)
+    (asked, default) = seen
+    assert (asked.model, asked.segmentations, asked.near_context) == ("elements", 3, 1.0)
+    assert (default.segmentations, default.near_context) == (1, 2.0)

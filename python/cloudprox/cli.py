@@ -234,6 +234,7 @@ def _cmd_collide(args: argparse.Namespace) -> int:
         solver=args.solver,
         decide_only=args.decide_only,
         segmentations=args.segmentations,
+        near_context=args.near_context,
     )
     _check_view_arguments(args)
     result = collide(
@@ -886,6 +887,15 @@ def _add_query_arguments(
         metavar="K",
         help="with --model elements: average P over K segmentations of the clouds "
         "(1 to 16; better ranking near contact for K times the work; default 1)",
+    )
+    col.add_argument(
+        "--near-context",
+        type=float,
+        default=None,
+        metavar="C",
+        help="spacings of surface around the contact that the classifier sees (at least "
+        "0.5; fewer is faster near contact, see the README's 'Surface elements'; "
+        f"default {defaults.near_context:g})",
     )
     col.add_argument(
         "--surface",

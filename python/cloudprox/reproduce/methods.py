@@ -350,9 +350,13 @@ def cloudprox_answers(
             f"not {rest} with model {model!r}"
         )
     piano, room = draw.clouds()
-    base, segmentations = model_segmentations(model)
+    options = model_options(model)
     request = CollisionRequest(
-        surface=surface, aggregation=first, model=base, segmentations=segmentations
+        surface=surface,
+        aggregation=first,
+        model=options.model,
+        segmentations=options.segmentations,
+        near_context=options.near_context,
     )
     results = (many or collide_many)(piano, room, poses, request=request)
     seconds = np.array([r.stats.time_seconds for r in results])
@@ -445,19 +449,70 @@ def variant_answers(
     return {variant_name(*v): answers[variant_name(*v)] for v in variants}
 
 
+@dataclass(frozen=True)
+class ModelOptions:
+    """A variant's model name read as the query's model and its options.
+
+    Attributes
+    ----------
+    model : str
+        ``"points"`` or ``"elements"``.
+    segmentations : int
+        ``CollisionRequest(segmentations=...)``: 1 unless the name asks for more.
+    near_context : float or None
+        ``CollisionRequest(near_context=...)``; ``None`` keeps the core's default.
+    """
+
+    model: str
+    segmentations: int = 1
+    near_context: float | None = None
+
+
+def model_options(model: str) -> ModelOptions:
+    """Read a variant's model name: ``"points"``, or ``"elements"`` with suffixes.
+
+    ``"-xK"`` averages the elements over ``K`` segmentations
+    (``CollisionRequest(segmentations=K)``); ``"-cC"`` gives the classifier ``C``
+    spacings of context (``CollisionRequest(near_context=C)``): ``"elements-x3"``,
+    ``"elements-c1"``, ``"elements-x3-c1"``.
+    """
+    base, *suffixes = model.split("-")
+    if base != "elements":
+        if suffixes:
+            raise ValueError(f"model {model!r}: only the elements take -xK or -cC")
+        return ModelOptions(base)
+    segmentations, near_context = 1, None
+    for suffix in suffixes:
+        kind, value = suffix[:1], suffix[1:]
+        if kind == "x" and value.isdigit():
+            segmentations = int(value)
+        elif kind == "c" and _is_number(value):
+            near_context = float(value)
+        else:
+            raise ValueError(
+                f"model {model!r}: expected elements[-xK][-cC] with an integer K "
+                f"and a number C, got {suffix!r}"
+            )
+    return ModelOptions(base, segmentations, near_context)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def model_segmentations(model: str) -> tuple[str, int]:
     """Split a variant's model name into the query's model and its segmentations.
 
     ``"points"`` and ``"elements"`` query one segmentation; ``"elements-xK"`` the
     elements model averaged over ``K`` segmentations
-    (``CollisionRequest(segmentations=K)``).
+    (``CollisionRequest(segmentations=K)``); see :func:`model_options`.
     """
-    if model.startswith("elements-x"):
-        k = model.removeprefix("elements-x")
-        if not k.isdigit():
-            raise ValueError(f"model {model!r}: expected elements-xK with an integer K")
-        return "elements", int(k)
-    return model, 1
+    options = model_options(model)
+    return options.model, options.segmentations
 
 
 def variant_name(model: str, surface: str, aggregation: str) -> str:
@@ -465,11 +520,14 @@ def variant_name(model: str, surface: str, aggregation: str) -> str:
 
     ``"cloudprox quadric max"`` for the points model (the paper's, with its
     aggregation), ``"cloudprox elements quadric"`` for the surface elements
-    (``"cloudprox elements quadric x3"`` averaged over 3 segmentations).
+    (``"cloudprox elements quadric x3"`` averaged over 3 segmentations,
+    ``"... c1"`` with 1 spacing of context).
     """
-    base, segmentations = model_segmentations(model)
-    if base == "elements":
-        suffix = f" x{segmentations}" if segmentations > 1 else ""
+    options = model_options(model)
+    if options.model == "elements":
+        suffix = f" x{options.segmentations}" if options.segmentations > 1 else ""
+        if options.near_context is not None:
+            suffix += f" c{options.near_context:g}"
         return f"cloudprox elements {surface}{suffix}"
     return f"cloudprox {surface} {aggregation}"
 

@@ -53,6 +53,11 @@ pub struct PointProbabilities {
     values: Vec<Real>,
 }
 
+/// Up to this many dense entries per index, [`PointProbabilities::gather`]
+/// reads the dense array instead of sorting the indices (a sort costs about
+/// `log2 m` comparisons and moves per index, a pass one read per entry).
+const GATHER_SCAN_RATIO: usize = 16;
+
 impl PointProbabilities {
     /// `len` zeros.
     pub fn zeros(len: usize) -> Self {
@@ -108,7 +113,26 @@ impl PointProbabilities {
     /// The non-zero entries of `dense` at `indices` (any order, repeats
     /// allowed; every other entry of `dense` must be 0) among `len` points
     /// (`dense` may be empty when `indices` is).
+    ///
+    /// Both ways below give the same entries in index order: a pass over
+    /// `dense` (every non-zero entry is at one of `indices`) where it is at
+    /// most [`GATHER_SCAN_RATIO`] times as long as `indices`, else `indices`
+    /// sorted (a query against a large cloud then does not read all of it).
     pub(crate) fn gather(len: usize, dense: &[Real], mut indices: Vec<u32>) -> Self {
+        if !indices.is_empty() && dense.len() <= GATHER_SCAN_RATIO * indices.len() {
+            let mut kept = Self {
+                len,
+                indices: Vec::with_capacity(indices.len()),
+                values: Vec::with_capacity(indices.len()),
+            };
+            for (i, &v) in (0u32..).zip(dense) {
+                if v != 0.0 {
+                    kept.indices.push(i);
+                    kept.values.push(v);
+                }
+            }
+            return kept;
+        }
         indices.sort_unstable();
         indices.dedup();
         Self::nonzero(len, indices.into_iter().map(|i| (i, dense[i as usize])))
@@ -371,6 +395,36 @@ mod tests {
             PointProbabilities::gather(7, &[], Vec::new()),
             PointProbabilities::zeros(7)
         );
+    }
+
+    #[test]
+    fn gathering_reads_the_same_entries_by_a_pass_or_by_sorting() {
+        // Non-zero values at every third index below 60, one index written
+        // as 0 (a point on its own side far from the surface).
+        let indices: Vec<u32> = (0..20).rev().map(|k| 3 * k).chain([9, 30]).collect();
+        let value = |i: u32| {
+            if i == 27 {
+                0.0
+            } else {
+                0.01 * Real::from(i + 1)
+            }
+        };
+        for len in [64, 10_000] {
+            let mut dense = vec![0.0; len];
+            for &i in &indices {
+                dense[i as usize] = value(i);
+            }
+            // 64 entries for 22 indices: a pass; 10 000: a sort.
+            assert_eq!(len <= GATHER_SCAN_RATIO * indices.len(), len == 64);
+            let p = PointProbabilities::gather(len, &dense, indices.clone());
+            let want: Vec<u32> = (0..20).map(|k| 3 * k).filter(|&i| i != 27).collect();
+            assert_eq!(p.indices(), &want[..], "len {len}");
+            assert_eq!(
+                p.values(),
+                &want.iter().map(|&i| value(i)).collect::<Vec<_>>()[..]
+            );
+            assert_eq!(p.to_dense(), dense);
+        }
     }
 
     #[test]
