@@ -168,9 +168,7 @@ def method_name(method: str) -> str | None:
     except ValueError:
         return None
     k, context = options.segmentations, options.near_context
-    if options.model != "elements" or not 1 <= k <= 16:
-        return None
-    if context is not None and not context >= 0.5:
+    if options.model != "elements":
         return None
     name = "elements" if k == 1 else f"elements, {k} segmentations"
     return name if context is None else f"{name}, context {context:g}"
@@ -219,9 +217,17 @@ def main() -> None:
     methods = list(dict.fromkeys(x.strip() for x in args.methods.split(",") if x.strip()))
     if not methods:
         ap.error("--methods is empty")
-    unknown = [x for x in methods if method_name(x) is None]
-    if unknown:
-        ap.error(f"unknown method(s) {unknown}; known: {', '.join(METHODS)}")
+    for x in methods:
+        if method_name(x) is None:
+            try:
+                m.model_options(x)  # says what is wrong with an elements name
+            except ValueError as e:
+                ap.error(str(e))
+            ap.error(f"unknown method {x!r}; known: {', '.join(METHODS)}, elements[-xK][-cC]")
+    names = [method_name(x) for x in methods]
+    same = sorted({n for n in names if names.count(n) > 1 and n is not None})
+    if same:
+        ap.error(f"--methods names the same method twice: {same}")
     if not (np.isfinite(args.noise_scale) and args.noise_scale > 0.0):
         ap.error(f"--noise-scale must be finite and > 0, got {args.noise_scale}")
     if args.poses < 1:

@@ -473,9 +473,13 @@ def test_model_names_carry_the_elements_options() -> None:
     assert variant_name("elements-x3-c1", "quadric", "max") == "cloudprox elements quadric x3 c1"
     assert variant_name("elements-c1.5", "quadric", "max") == "cloudprox elements quadric c1.5"
     assert variant_name("elements", "quadric", "max") == "cloudprox elements quadric"
-    for bad in ("elements-y3", "elements-x", "elements-cX", "points-x3", "elements-x3-"):
-        with pytest.raises(ValueError, match="model"):
-            model_options(bad)
+    bad = ["elements-y3", "elements-x", "elements-cX", "points-x3", "elements-x3-"]
+    # Out of the query's domain, or said twice: refused before any query.
+    bad += ["elements-x0", "elements-x17", "elements-c0.2", "elements-cnan", "elements-cinf"]
+    bad += ["elements-x3-x5", "elements-c1-c2", "elements-c1e3", "elements-x\u00b3"]
+    for name in bad:
+        with pytest.raises(ValueError, match=f"model {name!r}"):
+            model_options(name)
     # The options reach the query's request; without them the core's defaults.
     seen = []
 

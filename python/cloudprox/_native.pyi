@@ -764,8 +764,9 @@ class CollisionRequest:
         and counters those of every run. Where the element boundaries fall
         near a contact changes which planes read it, from one noise draw to
         the next more than the planes' own noise; the mean ranks poses near
-        contact better, for as many times the work (see the README); the
-        runs after the first go to the thread pool. Deciding only, each run
+        contact better, for as many times the work (see the README); in a
+        query on its own the runs after the first go to the thread pool.
+        Deciding only, each run
         still computes its whole ``P``, without the per-point work.
 
     Examples

@@ -31,6 +31,7 @@ Baselines, each with parameters set from the data, not tuned to the scene:
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
@@ -468,40 +469,50 @@ class ModelOptions:
     near_context: float | None = None
 
 
+#: The most segmentations a query averages over (the core's ``MAX_SEGMENTATIONS``).
+MAX_SEGMENTATIONS = 16
+#: The least context a query takes (``CollisionRequest(near_context=...)``).
+MIN_NEAR_CONTEXT = 0.5
+_SEGMENTATIONS = re.compile(r"x([0-9]+)")
+_CONTEXT = re.compile(r"c([0-9]+(?:\.[0-9]+)?)")
+
+
 def model_options(model: str) -> ModelOptions:
     """Read a variant's model name: ``"points"``, or ``"elements"`` with suffixes.
 
-    ``"-xK"`` averages the elements over ``K`` segmentations
-    (``CollisionRequest(segmentations=K)``); ``"-cC"`` gives the classifier ``C``
-    spacings of context (``CollisionRequest(near_context=C)``): ``"elements-x3"``,
-    ``"elements-c1"``, ``"elements-x3-c1"``.
+    ``"-xK"`` averages the elements over ``K`` segmentations (1 to
+    :data:`MAX_SEGMENTATIONS`; ``CollisionRequest(segmentations=K)``); ``"-cC"``
+    gives the classifier ``C`` spacings of context (at least
+    :data:`MIN_NEAR_CONTEXT`; ``CollisionRequest(near_context=C)``), each at most
+    once: ``"elements-x3"``, ``"elements-c1"``, ``"elements-x3-c1"``. Raises
+    ``ValueError`` naming the model on anything else.
     """
     base, *suffixes = model.split("-")
     if base != "elements":
         if suffixes:
             raise ValueError(f"model {model!r}: only the elements take -xK or -cC")
         return ModelOptions(base)
-    segmentations, near_context = 1, None
+    segmentations: int | None = None
+    near_context: float | None = None
     for suffix in suffixes:
-        kind, value = suffix[:1], suffix[1:]
-        if kind == "x" and value.isdigit():
-            segmentations = int(value)
-        elif kind == "c" and _is_number(value):
-            near_context = float(value)
+        if (k := _SEGMENTATIONS.fullmatch(suffix)) and segmentations is None:
+            segmentations = int(k.group(1))
+            if not 1 <= segmentations <= MAX_SEGMENTATIONS:
+                raise ValueError(
+                    f"model {model!r}: K must be in 1..={MAX_SEGMENTATIONS}, got {segmentations}"
+                )
+        elif (c := _CONTEXT.fullmatch(suffix)) and near_context is None:
+            near_context = float(c.group(1))
+            if near_context < MIN_NEAR_CONTEXT:
+                raise ValueError(
+                    f"model {model!r}: C must be at least {MIN_NEAR_CONTEXT}, got {near_context:g}"
+                )
         else:
             raise ValueError(
-                f"model {model!r}: expected elements[-xK][-cC] with an integer K "
-                f"and a number C, got {suffix!r}"
+                f"model {model!r}: expected elements[-xK][-cC] (each at most once, K an "
+                f"integer, C a decimal number), got {suffix!r}"
             )
-    return ModelOptions(base, segmentations, near_context)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    return ModelOptions(base, segmentations or 1, near_context)
 
 
 def model_segmentations(model: str) -> tuple[str, int]:

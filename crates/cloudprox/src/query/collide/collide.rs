@@ -83,39 +83,58 @@ pub(crate) fn collide_with_workspace(
 ) -> Result<CollisionResult> {
     request.validate()?;
     let k = request.segmentations;
+    let per_point = !request.decide_only;
     if request.model != QueryModel::Elements || k <= 1 {
-        let per_point = !request.decide_only;
         return collide_segmentation(pose_a, a, pose_b, b, request, workspace, warm, 0, per_point);
     }
     // The mean over segmentations (see `CollisionRequest::segmentations`):
     // each run's whole `P`, so deciding only, no early stop (and no per-point
-    // work, which only the full query reports). The runs after the first
-    // go to rayon's pool, each with its own workspace; the first, which a
-    // motion's warm start follows, runs here. Every set a run reads is built
-    // first: built inside the pool, a thread waiting for its `OnceLock`'s
-    // helpers could take up another run that needs the same set.
+    // work, which only the full query reports). Called from outside rayon's
+    // pool (a query on its own), the runs after the first go to the pool,
+    // each with its own workspace, while the first, which a motion's warm
+    // start follows, runs here; every set a run reads is built first (built
+    // inside the pool, a thread waiting for its `OnceLock`'s helpers could
+    // take up another run that needs the same set). Inside the pool (one of
+    // `collide_many`'s queries) the runs go one after another: the pool's
+    // threads are busy with the other queries, and a thread waiting for its
+    // helpers could take up another query, whose work the time of this one
+    // would then count.
+    validate_pose(pose_a, "pose_a")?;
+    validate_pose(pose_b, "pose_b")?;
     let start = Instant::now();
-    prepare(a, request);
-    prepare(b, request);
     let each = CollisionRequest {
         decide_only: false,
         ..*request
     };
-    let per_point = !request.decide_only;
-    let (first, rest) = rayon::join(
-        || collide_segmentation(pose_a, a, pose_b, b, &each, workspace, warm, 0, per_point),
-        || {
-            (1..k)
-                .into_par_iter()
-                .map(|s| {
-                    let mut own = BvhWorkspace::default();
-                    collide_segmentation(pose_a, a, pose_b, b, &each, &mut own, None, s, per_point)
-                })
-                .collect::<Result<Vec<_>>>()
-        },
-    );
-    let mut runs = vec![first?];
-    runs.extend(rest?);
+    let mut runs = Vec::with_capacity(k as usize);
+    if rayon::current_thread_index().is_some() {
+        let mut warm = warm;
+        for s in 0..k {
+            let w = if s == 0 { warm.as_deref_mut() } else { None };
+            runs.push(collide_segmentation(
+                pose_a, a, pose_b, b, &each, workspace, w, s, per_point,
+            )?);
+        }
+    } else {
+        prepare(a, request);
+        prepare(b, request);
+        let (first, rest) = rayon::join(
+            || collide_segmentation(pose_a, a, pose_b, b, &each, workspace, warm, 0, per_point),
+            || {
+                (1..k)
+                    .into_par_iter()
+                    .map(|s| {
+                        let mut own = BvhWorkspace::default();
+                        collide_segmentation(
+                            pose_a, a, pose_b, b, &each, &mut own, None, s, per_point,
+                        )
+                    })
+                    .collect::<Result<Vec<_>>>()
+            },
+        );
+        runs.push(first?);
+        runs.extend(rest?);
+    }
     let probability = runs.iter().map(|r| r.probability).sum::<Real>() / Real::from(k);
     let (probabilities_a, probabilities_b) = if request.decide_only {
         (
@@ -395,8 +414,8 @@ fn collide_segmentation(
                 ),
             };
             // The arrays are made for the first patch read: a query that reads
-            // none (decided by its bounds) allocates none, and one deciding
-            // only no per-point array.
+            // none (decided by its bounds) allocates none, and one without
+            // per-point work no per-point array.
             if inputs_a.is_empty() {
                 inputs_a = vec![0.0; sa.len()];
                 inputs_b = vec![0.0; sb.len()];
@@ -513,15 +532,16 @@ fn collide_segmentation(
     } else {
         crossing(&mut stats, workspace).map_or(probability, |c| c.max(probability))
     };
-    // The points given a probability are the patches' points (none deciding only).
-    let per_point = |len: usize, dense: &[Real], side: fn(&ContactPatch) -> &[u32]| {
+    // The points given a probability are the patches' points (none without
+    // per-point work).
+    let gathered = |len: usize, dense: &[Real], side: fn(&ContactPatch) -> &[u32]| {
         if !per_point {
             return PointProbabilities::zeros(len);
         }
         PointProbabilities::gather(len, dense, patches.iter().flat_map(side).copied().collect())
     };
-    let probabilities_a = per_point(a.len(), &probabilities_a, |p| &p.indices_a);
-    let probabilities_b = per_point(b.len(), &probabilities_b, |p| &p.indices_b);
+    let probabilities_a = gathered(a.len(), &probabilities_a, |p| &p.indices_a);
+    let probabilities_b = gathered(b.len(), &probabilities_b, |p| &p.indices_b);
     stats.time_seconds = start.elapsed().as_secs_f64();
     Ok(CollisionResult {
         probability,

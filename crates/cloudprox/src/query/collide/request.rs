@@ -110,8 +110,10 @@ pub struct CollisionRequest {
     /// the element boundaries fall, and from one noise draw to the next
     /// that changes more than the noise of the planes themselves: the mean
     /// over a few segmentations ranks poses near contact better, for as many
-    /// times the work (the runs after the first go to rayon's pool, so on
-    /// several cores a query waits for less). Deciding only, each
+    /// times the work (in a query on its own the runs after the first go to
+    /// rayon's pool, so on several cores it waits for less; inside the pool,
+    /// as `collide_many`'s queries are, they run one after another).
+    /// Deciding only, each
     /// segmentation's query still computes its whole `P` (a mean of early
     /// stops would not be the full query's), without the per-point
     /// probabilities and separation estimates. Must be 1 with the points

@@ -120,18 +120,17 @@ impl PointProbabilities {
     /// sorted (a query against a large cloud then does not read all of it).
     pub(crate) fn gather(len: usize, dense: &[Real], mut indices: Vec<u32>) -> Self {
         if !indices.is_empty() && dense.len() <= GATHER_SCAN_RATIO * indices.len() {
-            let mut kept = Self {
-                len,
-                indices: Vec::with_capacity(indices.len()),
-                values: Vec::with_capacity(indices.len()),
-            };
-            for (i, &v) in (0u32..).zip(dense) {
-                if v != 0.0 {
-                    kept.indices.push(i);
-                    kept.values.push(v);
-                }
-            }
-            return kept;
+            debug_assert!(
+                {
+                    let mut at = vec![false; dense.len()];
+                    for &i in &indices {
+                        at[i as usize] = true;
+                    }
+                    dense.iter().zip(&at).all(|(&v, &i)| i || v == 0.0)
+                },
+                "a non-zero entry of the dense array outside the indices"
+            );
+            return Self::nonzero(len, (0u32..).zip(dense.iter().copied()));
         }
         indices.sort_unstable();
         indices.dedup();
@@ -182,7 +181,9 @@ impl PointProbabilities {
     pub(crate) fn mean(runs: &[&PointProbabilities]) -> Self {
         let len = runs.first().map_or(0, |r| r.len);
         let mut all: Vec<(u32, Real)> = runs.iter().flat_map(|r| r.iter()).collect();
-        all.sort_unstable_by_key(|&(i, _)| i);
+        // Stable: each point's values are summed in the runs' order, as a sum
+        // over the runs' dense arrays would.
+        all.sort_by_key(|&(i, _)| i);
         let k = runs.len().max(1) as Real;
         let mut summed: Vec<(u32, Real)> = Vec::with_capacity(all.len());
         for (i, p) in all {
@@ -226,8 +227,9 @@ pub struct QueryCounters {
     /// Element surface pairs found crossing by the hierarchies (0 or 1 per
     /// segmentation): with
     /// the elements model, `decide_only` looks for one before any patch (a
-    /// collision decided without a classifier), and the full query where its
-    /// patches found no collision (a part through a thin solid).
+    /// collision decided without a classifier; on one segmentation: the runs
+    /// of a mean over several compute their whole `P`), and the full query
+    /// where its patches found no collision (a part through a thin solid).
     pub surface_crossings: usize,
     /// Element pairs whose surfaces face within the noise's reach although
     /// none of the samples that stand for one of them was near the other (a
