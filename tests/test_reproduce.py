@@ -460,7 +460,6 @@ def test_model_names_carry_the_elements_options() -> None:
         ModelOptions,
         cloudprox_answer,
         model_options,
-        model_segmentations,
         variant_name,
     )
 
@@ -469,7 +468,7 @@ def test_model_names_carry_the_elements_options() -> None:
     assert model_options("elements-x3") == ModelOptions("elements", 3)
     assert model_options("elements-c1") == ModelOptions("elements", 1, 1.0)
     assert model_options("elements-x3-c0.5") == ModelOptions("elements", 3, 0.5)
-    assert model_segmentations("elements-x3-c1") == ("elements", 3)
+    assert model_options("elements-x3-c1") == ModelOptions("elements", 3, 1.0)
     assert variant_name("elements-x3-c1", "quadric", "max") == "cloudprox elements quadric x3 c1"
     assert variant_name("elements-c1.5", "quadric", "max") == "cloudprox elements quadric c1.5"
     assert variant_name("elements", "quadric", "max") == "cloudprox elements quadric"

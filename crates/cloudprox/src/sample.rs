@@ -51,8 +51,6 @@ pub fn box_surface(center: &Point3, half: &Vector3, spacing: Real) -> Vec<Point3
     out
 }
 
-/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator
-/// seeded by `seed` (Knuth's MMIX constants): the tests' fixed streams.
 /// SplitMix64's output function: a bijection of `u64` that spreads every input
 /// bit over the output (Steele, Lea and Flood, *Fast splittable pseudorandom
 /// number generators*, 2014). [`NormalRng`] applies it to its counter; the
@@ -63,6 +61,8 @@ pub(crate) fn splitmix64_mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator
+/// seeded by `seed` (Knuth's MMIX constants): the tests' fixed streams.
 #[cfg(test)]
 pub(crate) fn lcg_uniform(seed: u64) -> impl FnMut() -> Real {
     let mut state = seed;

@@ -515,17 +515,6 @@ def model_options(model: str) -> ModelOptions:
     return ModelOptions(base, segmentations or 1, near_context)
 
 
-def model_segmentations(model: str) -> tuple[str, int]:
-    """Split a variant's model name into the query's model and its segmentations.
-
-    ``"points"`` and ``"elements"`` query one segmentation; ``"elements-xK"`` the
-    elements model averaged over ``K`` segmentations
-    (``CollisionRequest(segmentations=K)``); see :func:`model_options`.
-    """
-    options = model_options(model)
-    return options.model, options.segmentations
-
-
 def variant_name(model: str, surface: str, aggregation: str) -> str:
     """Return the row name of a cloudprox variant.
 
