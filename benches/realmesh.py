@@ -26,7 +26,9 @@ set, at ``F`` times the level's sigma, while the poses and the metrics stay
 in the level's sigma, to see what the noise costs against what the sampling
 does; ``--bounds``: per row, the near-contact AUC the same scores reach with
 every pose beyond 1 and beyond 0.5 pair sigma of contact ranked perfectly).
-``--methods`` draws no random numbers, so a subset reads the same as the
+``--reliability``: per row, the reliability table behind its ECE (ECE,
+Brier score, log-loss and the worst bin holding 20 or more poses are columns of
+every row). ``--methods`` draws no random numbers, so a subset reads the same as the
 full run for the methods it keeps. Each pair's sampling spacing (in pair
 sigma) is printed with its progress line.
 """
@@ -47,7 +49,7 @@ from tests.realfiles import real_file
 
 import cloudprox as cp
 from cloudprox.reproduce import methods as m
-from cloudprox.reproduce.metrics import auc_near, compute_metrics
+from cloudprox.reproduce.metrics import auc_near, calibration, compute_metrics
 
 PAIRS = (
     ("stl_panda_hand", "stl_binary_bunny"),
@@ -146,9 +148,9 @@ def poses(
 
 #: The methods compared (``--methods`` names) and their names in the table.
 METHODS = {
-    "elements": "elements",
+    "elements": "elements (default)",
     "elements-x3": "elements, 3 segmentations",
-    "points": "points (default)",
+    "points": "points (the paper's)",
     "nn-gap": "nn-gap",
     "collision-map": "collision map",
 }
@@ -206,6 +208,12 @@ def main() -> None:
         action="store_true",
         help="also print each row's AUC near with every pose beyond 1 (0.5) pair sigma "
         "of contact ranked perfectly",
+    )
+    ap.add_argument(
+        "--reliability",
+        action="store_true",
+        help="also print each row's reliability table (ten bins of P: poses, mean P, "
+        "share that truly collides)",
     )
     ap.add_argument(
         "--noise-scale",
@@ -282,11 +290,13 @@ def main() -> None:
             "poses and metrics in the level's pair sigma\n"
         )
     print(
-        "| level | method | AUC near | decided acc. | undecided | hard flips "
-        "| FP > 3σ | FN < -3σ | ms |\n|---|---|---|---|---|---|---|---|---|"
+        "| level | method | ECE | Brier | log-loss | worst bin | AUC near | decided acc. "
+        "| undecided | hard flips | FP > 3σ | FN < -3σ | ms |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     )
     saved: dict[str, np.ndarray] = {}
     bounds: list[str] = []
+    reliability: list[str] = []
     for (level, name), parts in rows.items():
         sc = np.concatenate([p[0] for p in parts], axis=1)
         st = np.concatenate([p[1] for p in parts], axis=1)
@@ -304,8 +314,15 @@ def main() -> None:
             }
         )
         mt = compute_metrics(sc, st, se, d, np.sqrt(2.0) * sigmas[level])
+        cal = calibration(np.clip(sc, 0.0, 1.0), np.broadcast_to(d <= 0.0, sc.shape))
+        if args.reliability:
+            reliability.append(f"{level:.1%} {name}: P bin | poses | mean P | share colliding")
+            reliability += [
+                f"  [{lo:.1f}, {hi:.1f}) | {n} | {p:.3f} | {f:.3f}" for lo, hi, n, p, f in cal.table
+            ]
         print(
-            f"| {level:.1%} | {name} | {mt.auc_near:.3f} | {mt.decided_accuracy:.3f} | "
+            f"| {level:.1%} | {name} | {cal.ece:.3f} | {cal.brier:.3f} | {cal.log_loss:.3f} | "
+            f"{cal.worst_bin():.3f} | {mt.auc_near:.3f} | {mt.decided_accuracy:.3f} | "
             f"{mt.undecided:.1%} | {mt.hard_flip:.1%} | {mt.false_positive_3s:.1%} | "
             f"{mt.false_negative_3s:.1%} | {mt.median_ms:.2f} |"
         )
@@ -322,6 +339,9 @@ def main() -> None:
             f"| {level:.1%} | python-fcl on the exact meshes: distance() {1e3 * d:.3f} ms, "
             f"collide() {1e3 * c:.3f} ms (medians of the pairs' medians) | | | | | | | |"
         )
+    if reliability:
+        print()
+        print("\n".join(reliability))
     if bounds:
         print()
         print("\n".join(bounds))

@@ -101,7 +101,7 @@ def test_collide_with_segmentations(capsys, npy_files) -> None:
     assert doc["stats"]["patches"] >= len(one["patches"]) and len(doc["patches"]) > len(
         one["patches"]
     )
-    code, _, err = run(capsys, *args, "--segmentations", "3")
+    code, _, err = run(capsys, *args, "--model", "points", "--segmentations", "3")
     assert code != 0 and "needs model 'elements'" in err
 
 

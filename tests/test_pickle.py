@@ -93,7 +93,8 @@ def test_result_and_region_roundtrip() -> None:
     base = cp.synthetic.sample_sphere(800, 0.1)
     a = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=1), sigma=0.002)
     b = cp.PointCloud(cp.synthetic.add_noise(base, 0.002, seed=2), sigma=0.002)
-    result = cp.collide(a, b, pose_b=from_translation((0.199, 0.0, 0.0)))
+    # The paper's model: its result carries the per-point aggregates too.
+    result = cp.collide(a, b, pose_b=from_translation((0.199, 0.0, 0.0)), model="points")
     assert result.patches and result.point_aggregates is not None
     back = roundtrip(result)
     assert_same_result(result, back)

@@ -70,9 +70,9 @@ def test_frozen() -> None:
 
 def test_replace_returns_a_new_validated_request() -> None:
     r = cp.CollisionRequest(surface="linear")
-    s = r.replace(threshold_free=0.2, model="elements")
-    assert (s.surface, s.threshold_free, s.model) == ("linear", 0.2, "elements")
-    assert (r.threshold_free, r.model) == (0.1, "points")
+    s = r.replace(threshold_free=0.2, model="points")
+    assert (s.surface, s.threshold_free, s.model) == ("linear", 0.2, "points")
+    assert (r.threshold_free, r.model) == (0.1, "elements")
     assert r.replace() == r
     assert r.replace(surface=None) == r  # None leaves an option as it is
     with pytest.raises(cp.InvalidInputError, match=r"unknown option 'lambda_'; valid options: "):
@@ -157,7 +157,9 @@ def test_choices_come_from_the_rust_enums() -> None:
     assert set(choices) == {"surface", "aggregation", "robust_model", "solver", "model"}
     for option, names in choices.items():
         for name in names:
-            assert getattr(cp.CollisionRequest(**{option: name}), option) == name
+            # aggregations other than max belong to the paper's per-point model
+            model = {"model": "points"} if option == "aggregation" else {}
+            assert getattr(cp.CollisionRequest(**model, **{option: name}), option) == name
 
 
 def _same(r: cp.CollisionResult, s: cp.CollisionResult) -> None:
@@ -212,7 +214,7 @@ def test_segmentations_average_the_elements_model(spheres) -> None:
     with pytest.raises(cp.InvalidInputError, match=r"segmentations must be in 1..=16, got -1"):
         cp.CollisionRequest(model="elements", segmentations=-1)
     with pytest.raises(cp.InvalidInputError, match=r"needs model 'elements'"):
-        cp.CollisionRequest(segmentations=2)
+        cp.CollisionRequest(model="points", segmentations=2)
 
 
 def test_collide_rejects_bad_requests_and_options(spheres) -> None:

@@ -144,16 +144,20 @@ def test_far_from_the_cloud_no_link_is_queried(arm: cp.Robot) -> None:
 
 def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
     cloud = wall_cloud(x0=0.27, seed=5)  # cuts link2; link3, link4 and the tool within reach
+    # The paper's model: it queries every link within reach (the elements'
+    # reach test leaves the links whose element surfaces cannot touch).
     q = [0.0, 0.0, 0.0, 0.0]
-    full = cp.collide_robot(arm, q, cloud)
-    fast = cp.collide_robot(arm, q, cloud, decide_only=True)
+    full = cp.collide_robot(arm, q, cloud, model="points")
+    fast = cp.collide_robot(arm, q, cloud, decide_only=True, model="points")
     assert full.state == fast.state == "collision"
     assert fast.probability >= 0.9 and full.links["link2"].probability >= 0.9
     after = [fast.links[n] for n in ("link3", "link4", "tool")]
     assert all(np.isnan(x.probability) and not x.queried and x.result is None for x in after)
     assert fast.stats.links_after_decision == 3 and full.stats.links_after_decision == 0
     assert all(full.links[n].queried for n in ("link3", "link4", "tool"))
-    batch = cp.collide_robot_many(arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True)
+    batch = cp.collide_robot_many(
+        arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True, model="points"
+    )
     assert list(batch.states) == ["collision", "free"]
     assert np.isnan(batch.link_probabilities[0, 3:6]).all()  # link3, link4, tool
     assert not np.isnan(batch.link_probabilities[1]).any()
@@ -234,7 +238,8 @@ def test_check_motion_warm_start_saves_iterations_not_answers(arm: cp.Robot) -> 
     pts = cp.synthetic.sample_box_surface(tuple(half), 0.004, center=(0.2, 0.0, top - half[2]))
     post = cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
     q0, q1 = np.array([-0.3, 0, 0, 0]), np.array([0.3, 0, 0, 0])
-    opts = {"max_probability": 1.0, "self_collision": False}
+    # Warm starts are the paper's classifier's (the per-point model).
+    opts = {"max_probability": 1.0, "self_collision": False, "model": "points"}
     warm = cp.check_motion(arm, q0, q1, post, **opts)
     cold = cp.check_motion(arm, q0, q1, post, warm_start=False, **opts)
     assert warm.states_checked == cold.states_checked == warm.states_total
@@ -243,7 +248,10 @@ def test_check_motion_warm_start_saves_iterations_not_answers(arm: cp.Robot) -> 
     assert 0 < warm.solver_iterations < cold.solver_iterations
     n = cold.states_total - 1
     s = np.arange(n + 1) / n  # the states' t = i / n
-    states = [cp.collide_robot(arm, q0 + t * (q1 - q0), post, self_collision=False) for t in s]
+    states = [
+        cp.collide_robot(arm, q0 + t * (q1 - q0), post, self_collision=False, model="points")
+        for t in s
+    ]
     assert cold.probability == max(r.probability for r in states)
     assert cold.solver_iterations == sum(r.stats.solver_iterations for r in states)
     with pytest.raises(cp.InvalidInputError, match="warm_start must be a bool"):
@@ -456,9 +464,7 @@ def test_readme_robot_python(readme_folder: Path, monkeypatch: pytest.MonkeyPatc
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         exec(compile(code, "README.md", "exec"), {})
-    assert out.getvalue().strip() == (
-        "1.0 collision ['panda_hand', 'panda_leftfinger', 'panda_rightfinger']"
-    )
+    assert out.getvalue().strip() == "1.0 collision ['panda_hand']"
 
 
 def test_readme_robot_cli(

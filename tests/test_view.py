@@ -380,7 +380,7 @@ def test_show_writes_and_opens(tmp_path, spheres_near, monkeypatch) -> None:
 def test_rerun_recording_reads_back(tmp_path, spheres_near) -> None:
     rr = pytest.importorskip("rerun")
     a, b, pose_b = spheres_near
-    result = cp.collide(a, b, pose_b=pose_b)
+    result = cp.collide(a, b, pose_b=pose_b, model="points")
     scene = view.collision_scene(result, labels=("left", "right"))
     path = view.write_rerun(scene, tmp_path / "near.rrd")
     columns: dict[str, dict[str, object]] = {}

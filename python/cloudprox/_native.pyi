@@ -26,12 +26,14 @@ __all__ = [
     "CollisionResult",
     "ContactPatch",
     "DepthCamera",
+    "DistanceField",
     "ExactShape",
     "FormatError",
     "InvalidInputError",
     "Lidar",
     "LinkCollision",
     "Mesh",
+    "MeshDistance",
     "MeshSample",
     "MotionResult",
     "PointCloud",
@@ -62,6 +64,7 @@ __all__ = [
     "exact_proximity",
     "exact_proximity_many",
     "exact_time_of_impact_many",
+    "facing_pairs",
     "parse_mesh",
     "pose_from_quaternion",
     "pose_from_rotation_vector",
@@ -97,7 +100,9 @@ _ModelName = Literal["elements", "points"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
 _SolverName = Literal["primal_dual", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
-_CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
+_CloudFormatName = Literal[
+    "auto", "ply", "pcd", "xyz", "xyzn", "xyzrgb", "txt", "pts", "csv", "npy", "las", "laz"
+]
 _MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
 _EncodingName = Literal[
     "ascii", "binary", "binary_little_endian", "binary_big_endian", "binary_compressed"
@@ -711,7 +716,7 @@ class CollisionRequest:
         the largest probability that the surface around a point (the point and
         its 6 nearest neighbours of its patch, margins averaged) is on the wrong
         side, better near contact on the piano scene but blind to deep crossings
-        (see the README). Only points within the noise's reach of the other
+        (see docs/method.md). Only points within the noise's reach of the other
         cloud count.
     threshold_collision : float, optional
         ``P >= threshold_collision`` is ``"collision"``.
@@ -764,7 +769,7 @@ class CollisionRequest:
         and counters those of every run. Where the element boundaries fall
         near a contact changes which planes read it, from one noise draw to
         the next more than the planes' own noise; the mean ranks poses near
-        contact better, for as many times the work (see the README); in a
+        contact better, for as many times the work (docs/design/segmentations.md); in a
         query on its own the runs after the first go to the thread pool.
         Deciding only, each run
         still computes its whole ``P``, without the per-point work.
@@ -857,6 +862,30 @@ class CollisionRequest:
     def __eq__(self, value: object, /) -> bool: ...
     def __hash__(self) -> int: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+def facing_pairs(
+    a: PointCloud | Mesh | Any,
+    b: PointCloud | Mesh | Any,
+    pose_a: npt.ArrayLike | None = None,
+    pose_b: npt.ArrayLike | None = None,
+    *,
+    request: CollisionRequest | None = None,
+    **options: Any,
+) -> dict[str, npt.NDArray[Any]]:
+    """Return the elements model's facing pairs of ``collide(a, b, pose_a, pose_b)``, for diagnostics.
+
+    One row per pair of surface elements that face each other in the query's
+    patches: ``from_a`` (the probe element is A's), ``element`` and
+    ``other_element`` (their indices), ``probe`` and ``facing`` (the two
+    surfaces' points, world frame, shape (n, 3)), ``direction`` (the unit
+    normal the gap is measured along), ``gap`` and ``std`` (the estimated gap
+    and its standard deviation, metres), ``probability`` (its wrong-side
+    probability), ``within_reach``, ``beside`` (the probe lies past the other
+    element's extent), ``probe_edge``, ``count``, ``other_count``, ``size``,
+    ``other_size`` and ``own_std``. ``benches/calibration.py`` compares
+    ``gap`` with the exact gap: ``(g_true - gap) / std`` should be standard
+    normal.
+    """
 
 def collide(
     a: PointCloud | Mesh | Any,
@@ -1395,8 +1424,60 @@ class CloudFile:
     def skipped(self) -> int:
         """Points skipped because a coordinate was NaN or infinite."""
     @property
+    def at_origin(self) -> int:
+        """Points of an organized scan left out for lying at exactly the sensor origin.
+
+        The driver's no-return points; 0 for an unorganized cloud, which keeps them.
+        """
+    @property
+    def no_returns(self) -> int:
+        """The no-returns of an organized scan: ``at_origin`` plus ``skipped``.
+
+        None of them is in ``points``; the organized layout keeps their pixels
+        (``pixels`` skips them). 0 for an unorganized cloud.
+        """
+    @property
+    def topic(self) -> str | None:
+        """For a cloud read from a bag: its topic, else ``None``."""
+    @property
+    def index(self) -> int | None:
+        """For a cloud read from a bag: the message's index in its topic, else ``None``."""
+    @property
+    def frame_id(self) -> str | None:
+        """For a cloud read from a message: the frame its points are expressed in.
+
+        The TF frame they were moved to, else the message's ``frame_id``; ``None``
+        for a file.
+        """
+    @property
+    def sensor_frame(self) -> str | None:
+        """For a cloud read from a message: its ``header.frame_id``, else ``None``."""
+    @property
+    def stamp(self) -> int | None:
+        """For a cloud read from a message: ``header.stamp`` in nanoseconds, else ``None``."""
+    @property
     def path(self) -> str:
         """The file it was read from."""
+    @staticmethod
+    def _from_message(
+        message: object,
+        encoding: str,
+        *,
+        name: str,
+        path: str,
+        pose: npt.ArrayLike | None = None,
+        frame_id: str | None = None,
+        topic: str | None = None,
+        index: int | None = None,
+    ) -> CloudFile:
+        """Read a serialized PointCloud2 message (``"cdr"`` or ``"ros1"``) in place.
+
+        The sensor sits at the origin of the message's frame; ``pose`` moves the
+        points and the sensor into ``frame_id``. ``name`` goes into errors.
+        """
+    @staticmethod
+    def _message_header(message: object, encoding: str, *, name: str) -> tuple[str, int]:
+        """Return the ``(frame_id, stamp)`` of a serialized PointCloud2 message."""
     def to_point_cloud(
         self,
         sigma: npt.ArrayLike | None = None,
@@ -1890,3 +1971,164 @@ def check_motion(
     state that close to ``max_probability`` can be judged otherwise; ``False``
     makes each state's answer exactly :func:`collide_robot`'s).
     """
+
+_SignMethodName = Literal["auto", "pseudo_normal", "winding_number"]
+
+@final
+class MeshDistance:
+    """A triangle mesh prepared for exact signed-distance queries in its own frame.
+
+    Vertices with equal coordinates are welded, faces re-oriented to agree with their
+    neighbours and inward-facing shells turned outwards (``topology`` reports what was
+    done). The sign is then read by the angle-weighted pseudo-normal of the closest
+    feature when the mesh is closed, without degenerate faces, self-intersections or
+    overlapping shells, and by the generalized winding number otherwise (inside when
+    it exceeds 1/2; for an open mesh, roughly the solid its holes would enclose if
+    closed).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh, in its own frame.
+    sign_method : {"auto", "pseudo_normal", "winding_number"}, default "auto"
+        Force a sign method instead of choosing it from the topology.
+
+    Raises
+    ------
+    InvalidInputError
+        If every face is degenerate (zero area), or ``sign_method`` is unknown.
+
+    Notes
+    -----
+    Query points are ``(n, 3)`` array-likes of finite coordinates in metres; a
+    non-finite coordinate raises ``InvalidInputError``. The GIL is released during
+    the queries, which run in parallel for large batches.
+    """
+
+    def __new__(cls, mesh: Mesh, *, sign_method: _SignMethodName = "auto") -> MeshDistance: ...
+    @property
+    def sign_method(self) -> Literal["pseudo_normal", "winding_number"]:
+        """How the sign is read: ``"pseudo_normal"`` or ``"winding_number"``."""
+    @property
+    def topology(self) -> dict[str, int | bool | None]:
+        """What welding and re-orientation found.
+
+        Keys ``vertices`` (after welding), ``shells``, ``boundary_edges``,
+        ``non_manifold_edges``, ``degenerate_faces``, ``reoriented_faces``,
+        ``closed`` and ``self_intersecting`` (``None`` when not checked).
+        """
+    @property
+    def num_faces(self) -> int:
+        """The number of faces of the mesh."""
+    def signed_distance(self, points: npt.ArrayLike) -> _FloatArray:
+        """Return the signed distance of each point, shape ``(n,)``, negative inside."""
+    def distance(self, points: npt.ArrayLike) -> _FloatArray:
+        """Return the unsigned distance of each point to the surface, shape ``(n,)``."""
+    def closest(self, points: npt.ArrayLike) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """Return the closest surface point of each query point.
+
+        Parameters
+        ----------
+        points : array_like, shape (n, 3)
+            Query points (metres), finite.
+
+        Returns
+        -------
+        distances : ndarray, shape (n,)
+            Signed distances, negative inside.
+        points : ndarray, shape (n, 3)
+            The closest points on the surface.
+        normals : ndarray, shape (n, 3)
+            Unit gradients of the signed distance (the outward normal: from the
+            closest point towards an outside query point).
+        """
+    def closest_within(
+        self, points: npt.ArrayLike, max_distance: float
+    ) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """Return :meth:`closest` for points within ``max_distance`` of the surface.
+
+        Rows of points farther away are NaN, found without searching farther (for
+        broad phases). ``max_distance`` must be >= 0.
+        """
+    def winding_number(self, points: npt.ArrayLike) -> _FloatArray:
+        """Return the generalized winding number of each point, shape ``(n,)`` (exact)."""
+    def contains(self, points: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Return whether each point is inside, shape ``(n,)``, per :attr:`sign_method`."""
+    def field(self, resolution: float, band: float) -> DistanceField:
+        """Build the :class:`DistanceField` of this mesh (see there)."""
+
+@final
+class DistanceField:
+    """A signed-distance grid in a mesh's own frame, with an error bound per query.
+
+    Nodes every ``resolution`` metres over the mesh's box grown by ``band``; nodes
+    within ``band`` of the surface hold the exact signed distance. Queries
+    interpolate trilinearly and return a rigorous bound ``|exact - distance| <=
+    bound``, from the 1-Lipschitz property of the signed distance: with ``s_i`` the
+    corners' values and ``r_i`` their distances to the point, the exact value lies in
+    ``[max(s_i - r_i), min(s_i + r_i)]`` (at most half a cell diagonal from the
+    interpolant). Points outside the grid, in cells with a corner beyond the band or
+    near a hole of an open mesh get the exact query (bound 0).
+
+    Parameters
+    ----------
+    mesh_distance : MeshDistance
+        The mesh.
+    resolution : float
+        Node spacing (metres), > 0.
+    band : float
+        Distance from the surface within which nodes are exact (metres), > 0.
+
+    Raises
+    ------
+    InvalidInputError
+        If ``resolution`` or ``band`` is not finite and positive, or the grid would
+        have more than 2**25 nodes.
+    """
+
+    def __new__(
+        cls, mesh_distance: MeshDistance, resolution: float, band: float
+    ) -> DistanceField: ...
+    def evaluate(self, points: npt.ArrayLike) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """Evaluate the field at points in the mesh's frame.
+
+        Parameters
+        ----------
+        points : array_like, shape (n, 3)
+            Query points (metres), finite.
+
+        Returns
+        -------
+        distances : ndarray, shape (n,)
+            Signed distances, negative inside.
+        gradients : ndarray, shape (n, 3)
+            Gradient of the interpolant (of the exact signed distance, unit, where the
+            exact query answered).
+        bounds : ndarray, shape (n,)
+            Error bounds: ``|exact - distance| <= bound`` (0 where exact).
+        """
+    @property
+    def resolution(self) -> float:
+        """Node spacing (metres)."""
+    @property
+    def band(self) -> float:
+        """Distance from the surface within which nodes are exact (metres)."""
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """Nodes per axis."""
+    @property
+    def origin(self) -> _FloatArray:
+        """Position of node ``(0, 0, 0)``, shape ``(3,)``."""
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the grid."""
+    @property
+    def stats(self) -> dict[str, int]:
+        """What the build found, counted.
+
+        Keys: ``nodes``, ``nodes_in_band``, ``cells_interpolated``,
+        ``cells_sign_agnostic``, ``cells_exact``, ``cells_beyond``, ``exact_sign_nodes``.
+        """
+    @property
+    def mesh_distance(self) -> MeshDistance:
+        """The exact queries the field falls back to."""

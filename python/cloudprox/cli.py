@@ -9,8 +9,9 @@
 ``cloudprox view A B [--html FILE] [--rerun FILE.rrd] [--no-open]``
     The query of ``collide``, shown in 3D in the web browser (``collide`` and
     ``robot`` write the same view with ``--html`` / ``--rerun``).
-``cloudprox info FILE``
-    A summary of a point-cloud or mesh file.
+``cloudprox info FILE [--topic T] [--index I]``
+    A summary of a point-cloud or mesh file, or the topics of a ROS bag (with
+    ``--topic`` / ``--index``, that frame too).
 ``cloudprox example [DIR]``
     Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 ``cloudprox bench``
@@ -26,11 +27,12 @@ line to stderr and exits with status 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -158,6 +160,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             f"{1e3 * result.stats.time_seconds:.1f}",
         )
     console.print(table)
+    console.print(
+        "P: the probability, under the noise, that the two sampled surfaces cross "
+        "(of poses read P = 0.3, about 3 in 10 collide)."
+    )
 
     # The figure: touching, and the first undecided case (else the 4 sigma one).
     touching = next(r for r in runs if r[0] == 0.0)
@@ -217,10 +223,11 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     try:
         sensor = _sensor_spec(args)
         steps = [parse_filter(f) for f in args.filter]
-        sides = [
-            load_side(args.a, sensor, steps),
-            load_side(args.b, sensor, steps, sigma_override=args.sigma_b),
-        ]
+        with _bag_frame(args, args.a, args.b):
+            sides = [
+                load_side(args.a, sensor, steps),
+                load_side(args.b, sensor, steps, sigma_override=args.sigma_b),
+            ]
         poses = [
             None if text is None else parse_pose(text, what)
             for text, what in ((args.pose_a, "--pose-a"), (args.pose_b, "--pose-b"))
@@ -300,6 +307,36 @@ def _cmd_collide(args: argparse.Namespace) -> int:
     console.print(f"stats: {stats}")
     _write_views(args, scene)
     return 0
+
+
+@contextlib.contextmanager
+def _bag_frame(args: argparse.Namespace, *paths: str) -> Iterator[None]:
+    """Read the ``--topic`` / ``--index`` frame of the bags among ``paths`` inside the context."""
+    from cloudprox.bags import bag_selection, is_bag
+
+    given = args.topic is not None or args.index is not None
+    if given and not any(is_bag(p) for p in paths):
+        raise CliError("--topic and --index apply to ROS bags (.bag, .db3, .mcap) only")
+    try:
+        with bag_selection(args.topic, 0 if args.index is None else args.index):
+            yield
+    except ModuleNotFoundError as e:
+        raise CliError(str(e)) from None
+
+
+def _add_bag_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--topic`` and ``--index``: which frame of a ROS bag a cloud side is read from."""
+    parser.add_argument(
+        "--topic",
+        default=None,
+        help="ROS bags: the sensor_msgs/PointCloud2 topic (default: the bag's only one)",
+    )
+    parser.add_argument(
+        "--index",
+        type=int,
+        default=None,
+        help="ROS bags: the message's index in the topic (default 0; negative: from the end)",
+    )
 
 
 def _check_view_arguments(args: argparse.Namespace) -> None:
@@ -420,7 +457,8 @@ def _cmd_robot(args: argparse.Namespace) -> int:
     try:
         sensor = _sensor_spec(args)
         steps = [parse_filter(f) for f in args.filter]
-        side = load_side(args.scan, sensor, steps)
+        with _bag_frame(args, args.scan):
+            side = load_side(args.scan, sensor, steps)
         base = None if args.base_pose is None else parse_pose(args.base_pose, "--base-pose")
     except (PipelineError, FileNotFoundError) as e:
         raise CliError(str(e)) from None
@@ -548,24 +586,52 @@ def _cmd_example(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- info
 
 
-def file_info(path: str) -> dict[str, Any]:
-    """Summarize a point-cloud or mesh file as plain JSON.
+def file_info(path: str, topic: str | None = None, index: int | None = None) -> dict[str, Any]:
+    """Summarize a point-cloud, mesh or ROS bag file as plain JSON.
 
-    Point clouds: format, points, non-finite points skipped, organized layout,
-    fields, bounds, sensor pose and the estimated sampling spacing (median and
-    5th/95th percentiles of each point's distance to its 6th nearest neighbour).
+    Point clouds: format, points, non-finite points skipped, the no-returns of an
+    organized scan (at the sensor origin, and NaN), organized layout, fields,
+    bounds, sensor pose and the estimated sampling spacing (median and 5th/95th
+    percentiles of each point's distance to its 6th nearest neighbour).
     Meshes: vertices, faces (dropped degenerate ones), bounds, area, volume,
-    whether closed.
+    whether closed. Bags: the topics with their message types and counts; with
+    ``topic`` or ``index``, that PointCloud2 frame as a point cloud too.
     """
-    from cloudprox import io
+    from cloudprox import bags, io
     from cloudprox.pipeline import is_mesh_file, read_mesh_file
 
     p = Path(path)
     if not p.exists():
         raise CliError(f"{path}: no such file")
-    if p.is_dir():
+    is_bag = bags.is_bag(path)
+    if p.is_dir() and not is_bag:
         raise CliError(f"{path} is a directory, expected a point-cloud or mesh file")
+    if (topic is not None or index is not None) and not is_bag:
+        raise CliError("--topic and --index apply to ROS bags (.bag, .db3, .mcap) only")
     info: dict[str, Any] = {"path": path, "format": p.suffix.lower().lstrip(".")}
+    if is_bag:
+        try:
+            topics = bags.topics(path)
+            info |= {
+                "format": info["format"] or "rosbag2",
+                "kind": "ROS bag",
+                "topics": [
+                    {"name": t.name, "type": t.msgtype, "messages": t.count} for t in topics
+                ],
+            }
+            if topic is None and index is None:
+                return info
+            scan = bags.read_point_cloud(path, topic, 0 if index is None else index)
+        except ModuleNotFoundError as e:
+            raise CliError(str(e)) from None
+        info["frame"] = {
+            "topic": scan.topic,
+            "index": scan.index,
+            "stamp_ns": scan.stamp,
+            "sensor_frame": scan.sensor_frame,
+            "frame_id": scan.frame_id,
+        } | _cloud_info(scan)
+        return info
     if is_mesh_file(path):
         mesh, dropped = read_mesh_file(path)
         lo, hi = mesh.bounds()
@@ -584,12 +650,20 @@ def file_info(path: str) -> dict[str, Any]:
             "volume_m3": mesh.volume if mesh.is_closed else None,
         }
         return info
-    scan = io.read_point_cloud(path)
+    return info | _cloud_info(io.read_point_cloud(path))
+
+
+def _cloud_info(scan: Any) -> dict[str, Any]:
+    """Return the point-cloud part of :func:`file_info` for a ``CloudFile``."""
     pts = np.asarray(scan.points)
-    info |= {
+    info: dict[str, Any] = {
         "kind": "point cloud",
         "points": len(pts),
         "skipped_non_finite": scan.skipped,
+    }
+    if scan.grid_shape is not None:
+        info |= {"no_returns": scan.no_returns, "no_returns_at_sensor_origin": scan.at_origin}
+    info |= {
         "organized": None if scan.grid_shape is None else list(scan.grid_shape),
         "fields": scan.fields,
         "has_normals": scan.normals is not None,
@@ -606,17 +680,27 @@ def file_info(path: str) -> dict[str, Any]:
     return info
 
 
-def _cmd_info(args: argparse.Namespace) -> int:
-    info = file_info(args.file)
-    if args.json:
-        print(json.dumps(info, indent=2))
-        return 0
-    console = _console()
-    console.print(f"[bold]{info['path']}[/bold]: {info['kind']} ({info['format'].upper()})")
+def _print_info(console: Any, info: dict[str, Any], indent: str = "  ") -> None:
+    """Print the items of a :func:`file_info` summary, one per line."""
+    from_bag = "sensor_frame" in info
     for key, value in info.items():
         if key in ("path", "kind", "format") or (key == "warnings" and not value):
             continue
-        if key == "bounds":
+        if key == "topics":
+            console.print(f"{indent}topics: {len(value)}")
+            for t in value:
+                console.print(f"{indent}  {t['name']}: {t['type']}, {t['messages']} messages")
+            continue
+        if key == "frame":
+            console.print(f"{indent}frame {value['index']} of {value['topic']}:")
+            _print_info(console, value, indent + "  ")
+            continue
+        if key in ("no_returns_at_sensor_origin", "sensor_pose_is_default"):
+            continue
+        if key == "no_returns":
+            at = info["no_returns_at_sensor_origin"]
+            value = f"{value} ({at} at the sensor origin, {value - at} non-finite)"
+        elif key == "bounds":
             lo, hi = value
             value = (
                 "["
@@ -633,14 +717,26 @@ def _cmd_info(args: argparse.Namespace) -> int:
         elif key == "sensor_pose" and value is not None:
             value = "origin (" + ", ".join(f"{row[3]:.4g}" for row in value[:3]) + ")"
             if info.get("sensor_pose_is_default"):
-                value += ", the PCD default VIEWPOINT (identity)"
-        elif key == "sensor_pose_is_default":
-            continue
+                value += (
+                    ", the origin of the message's frame (no TF for it)"
+                    if from_bag
+                    else ", the PCD default VIEWPOINT (identity)"
+                )
         elif key == "fields":
             value = " ".join(value)
         elif isinstance(value, float):
             value = f"{value:.4g}"
-        console.print(f"  {key.replace('_', ' ')}: {value}")
+        console.print(f"{indent}{key.replace('_', ' ')}: {value}")
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    info = file_info(args.file, args.topic, args.index)
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    console = _console()
+    console.print(f"[bold]{info['path']}[/bold]: {info['kind']} ({info['format'].upper()})")
+    _print_info(console, info)
     return 0
 
 
@@ -813,8 +909,9 @@ def _add_query_arguments(
     col: argparse.ArgumentParser, defaults: CollisionRequest, names: dict[str, tuple[str, ...]]
 ) -> None:
     """Add the arguments of one query between two files (``collide`` and ``view``)."""
-    col.add_argument("a", metavar="A", help="point-cloud or mesh file of side A")
-    col.add_argument("b", metavar="B", help="point-cloud or mesh file of side B")
+    col.add_argument("a", metavar="A", help="point-cloud, mesh or ROS bag file of side A")
+    col.add_argument("b", metavar="B", help="point-cloud, mesh or ROS bag file of side B")
+    _add_bag_arguments(col)
     col.add_argument(
         "--sigma", type=float, default=None, help="isotropic noise standard deviation (metres)"
     )
@@ -894,7 +991,7 @@ def _add_query_arguments(
         default=None,
         metavar="C",
         help="spacings of surface around the contact that the classifier sees (at least "
-        "0.5; fewer is faster near contact, see the README's 'Surface elements'; "
+        "0.5; fewer is faster near contact, see docs/design/near-context.md; "
         f"default {defaults.near_context:g})",
     )
     col.add_argument(
@@ -1027,7 +1124,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     rob.add_argument("urdf", metavar="URDF", help="the robot's URDF file")
-    rob.add_argument("scan", metavar="SCAN", help="point-cloud file of the environment")
+    rob.add_argument("scan", metavar="SCAN", help="point-cloud or ROS bag file of the environment")
+    _add_bag_arguments(rob)
     rob.add_argument(
         "--q", default=None, help="one configuration: joint values separated by commas"
     )
@@ -1084,9 +1182,11 @@ def build_parser() -> argparse.ArgumentParser:
     ex.set_defaults(func=_cmd_example)
 
     info = sub.add_parser(
-        "info", help="summarize a point-cloud or mesh file (points, bounds, fields, spacing)"
+        "info",
+        help="summarize a point-cloud, mesh or ROS bag file (points, bounds, fields, topics)",
     )
-    info.add_argument("file", metavar="FILE", help="point-cloud or mesh file")
+    info.add_argument("file", metavar="FILE", help="point-cloud, mesh or ROS bag file")
+    _add_bag_arguments(info)
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
     info.set_defaults(func=_cmd_info)
 

@@ -159,3 +159,72 @@ pub fn collide_along(
         run,
     )
 }
+
+/// The elements model's facing pairs in the patches of `collide(a, b, pose_a,
+/// pose_b)` ([`cloudprox::query::facing_pairs`]), for diagnostics: a dict of
+/// arrays, one row per pair (`from_a`, `element`, `other_element`, `probe`,
+/// `facing`, `direction`, `gap`, `std`, `probability`, `within_reach`,
+/// `beside`).
+#[pyfunction]
+#[pyo3(signature = (a, b, pose_a=None, pose_b=None, *, request=None, **options))]
+pub fn facing_pairs<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    pose_a: Option<&Bound<'py, PyAny>>,
+    pose_b: Option<&Bound<'py, PyAny>>,
+    request: Option<&Bound<'py, PyCollisionRequest>>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::convert::{points_to_py, vec_to_py};
+    use numpy::IntoPyArray;
+    let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
+    let pose_a = pose_from(py, pose_a, "pose_a")?;
+    let pose_b = pose_from(py, pose_b, "pose_b")?;
+    let (ca, cb) = resolve_pair(py, a, b, None)?;
+    let pairs = run_detached(py, move || {
+        cloudprox::query::facing_pairs(&pose_a, &ca, &pose_b, &cb, &request)
+    })?;
+    let out = PyDict::new(py);
+    let bools = |f: fn(&cloudprox::probability::FacingPair) -> bool| {
+        pairs.iter().map(f).collect::<Vec<bool>>().into_pyarray(py)
+    };
+    let ints = |f: fn(&cloudprox::probability::FacingPair) -> u32| {
+        pairs
+            .iter()
+            .map(|p| i64::from(f(p)))
+            .collect::<Vec<i64>>()
+            .into_pyarray(py)
+    };
+    let reals = |f: fn(&cloudprox::probability::FacingPair) -> f64| {
+        vec_to_py(py, &pairs.iter().map(f).collect::<Vec<f64>>())
+    };
+    out.set_item("from_a", bools(|p| p.from_a))?;
+    out.set_item("element", ints(|p| p.element))?;
+    out.set_item("other_element", ints(|p| p.other_element))?;
+    out.set_item(
+        "probe",
+        points_to_py(py, &pairs.iter().map(|p| p.probe).collect::<Vec<_>>())?,
+    )?;
+    out.set_item(
+        "facing",
+        points_to_py(py, &pairs.iter().map(|p| p.facing).collect::<Vec<_>>())?,
+    )?;
+    let dirs: Vec<cloudprox::math::Point3> = pairs
+        .iter()
+        .map(|p| cloudprox::math::Point3::from(p.direction))
+        .collect();
+    out.set_item("direction", points_to_py(py, &dirs)?)?;
+    out.set_item("gap", reals(|p| p.gap))?;
+    out.set_item("std", reals(|p| p.std))?;
+    out.set_item("probability", reals(|p| p.probability))?;
+    out.set_item("within_reach", bools(|p| p.within_reach))?;
+    out.set_item("beside", bools(|p| p.beside))?;
+    out.set_item("probe_edge", reals(|p| p.probe_edge))?;
+    out.set_item("count", ints(|p| p.counts[0]))?;
+    out.set_item("other_count", ints(|p| p.counts[1]))?;
+    out.set_item("size", reals(|p| p.sizes[0]))?;
+    out.set_item("other_size", reals(|p| p.sizes[1]))?;
+    out.set_item("own_std", reals(|p| p.own_std))?;
+    Ok(out)
+}

@@ -294,9 +294,17 @@ fn collide_along_answers_as_collide_many_with_fewer_iterations() {
         let iterations = |rs: &[CollisionResult]| -> u64 {
             rs.iter().map(|r| r.stats.counters.solver_iterations).sum()
         };
+        // The elements model's `P` combines every facing pair's reading over
+        // the contact, so a warm start's slightly different separating surface
+        // moves it a little more than the points model's largest tail.
+        let tolerance = if model == QueryModel::Points {
+            1e-4
+        } else {
+            1e-3
+        };
         for (k, (x, y)) in along.iter().zip(&many).enumerate() {
             assert!(
-                (x.probability - y.probability).abs() <= 1e-4,
+                (x.probability - y.probability).abs() <= tolerance,
                 "{model:?} pose {k}: along {} many {}",
                 x.probability,
                 y.probability
@@ -532,7 +540,9 @@ fn a_sparse_cloud_against_a_dense_one_gets_bounded_patches() {
         0.0005,
     )
     .unwrap();
+    // The points model's regions (the elements model's samples are few).
     let request = CollisionRequest {
+        model: QueryModel::Points,
         region_max_points: 500,
         ..CollisionRequest::default()
     };

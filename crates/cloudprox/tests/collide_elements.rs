@@ -110,21 +110,27 @@ fn parallel_plates_probability_is_calibrated() {
         decided_wrong <= draws / 10,
         "{decided_wrong} of {draws} decided wrongly"
     );
-    // At +-12 standard errors of the gap (1.4 sigma) these draws' states are
-    // decided. (The curvature rule splits a flat face's group about one time
-    // in nine, and a split face's pieces are located less precisely than the
-    // whole face: over 40 pairs of noise draws, 13 were undecided at +8
-    // standard errors, 4 at +12; with the 1% curvature test that the rule
-    // replaced, 4 at +8. The -8 side was decided in all 40 either way.)
-    let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1);
-    let b = slab(k, h, (0.0, 0.0), 0.02, sigma, 2);
-    for (gap, state) in [
-        (12.0 * se, CollisionState::Free),
-        (-12.0 * se, CollisionState::Collision),
-    ] {
-        let r = collide_at_height(&a, &b, gap, &req);
-        assert_eq!(r.state, state, "gap {gap}: P = {}", r.probability);
+    // At +-12 standard errors of the gap (1.4 sigma) the states are decided
+    // in most draws: a flat face's group splits now and then (the curvature
+    // rule), and a split face's pieces are located less precisely than the
+    // whole face, so a few draws stay undecided; none is decided wrongly.
+    let (mut free, mut collision) = (0, 0);
+    let pairs: u64 = 20;
+    for seed in 0..pairs {
+        let a = slab(k, h, (0.0, 0.0), -0.02, sigma, 1 + 2 * seed);
+        let b = slab(k, h, (0.0, 0.0), 0.02, sigma, 2 + 2 * seed);
+        let above = collide_at_height(&a, &b, 12.0 * se, &req).state;
+        let below = collide_at_height(&a, &b, -12.0 * se, &req).state;
+        assert_ne!(above, CollisionState::Collision, "seed {seed}");
+        assert_ne!(below, CollisionState::Free, "seed {seed}");
+        free += u64::from(above == CollisionState::Free);
+        collision += u64::from(below == CollisionState::Collision);
     }
+    assert!(free >= pairs * 3 / 4, "{free} of {pairs} decided free");
+    assert!(
+        collision >= pairs * 3 / 4,
+        "{collision} of {pairs} decided collision"
+    );
 }
 
 #[test]
@@ -320,7 +326,14 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
     // The brute-force path (every pair, no hierarchies) reads the same
     // crossings: at the reach, beyond it (the strict threshold), and none
     // where the surfaces are apart.
-    for (request, gap, crossings) in [(&quick, -3.0, 1), (&strict, -6.0, 1), (&quick, 3.0, 0)] {
+    // (Deep into each other the strict threshold's crossing may or may not be
+    // read, by how uncertain the curved element surfaces are near their
+    // edges; both paths read the same.)
+    for (request, gap, crossings) in [
+        (&quick, -3.0, Some(1)),
+        (&strict, -6.0, None),
+        (&quick, 3.0, Some(0)),
+    ] {
         let brute = CollisionRequest {
             use_hierarchy: false,
             ..*request
@@ -329,10 +342,14 @@ fn deciding_only_a_crossing_of_element_surfaces_is_a_collision_without_a_classif
         let h = collide(&Pose::identity(), &a, &pose, &b, request).unwrap();
         let bf = collide(&Pose::identity(), &a, &pose, &b, &brute).unwrap();
         assert_eq!(bf.stats.counters.node_pairs_visited, 0, "gap {gap}");
-        for r in [&h, &bf] {
-            assert_eq!(r.stats.counters.surface_crossings, crossings, "gap {gap}");
+        assert_eq!(
+            h.stats.counters.surface_crossings, bf.stats.counters.surface_crossings,
+            "gap {gap}"
+        );
+        if let Some(crossings) = crossings {
+            assert_eq!(h.stats.counters.surface_crossings, crossings, "gap {gap}");
         }
-        if crossings > 0 {
+        if h.stats.counters.surface_crossings > 0 {
             assert_eq!(
                 (bf.state, bf.probability),
                 (h.state, h.probability),

@@ -167,6 +167,7 @@ fn bad_segmentation_counts_are_named() {
         (averaged(17), "segmentations must be in 1..=16, got 17"),
         (
             CollisionRequest {
+                model: QueryModel::Points,
                 segmentations: 2,
                 ..CollisionRequest::default()
             },

@@ -8,7 +8,15 @@ import numpy as np
 import numpy.typing as npt
 from scipy.stats import rankdata, spearmanr
 
-__all__ = ["Metrics", "auc", "auc_near", "compute_metrics", "roc_curve"]
+__all__ = [
+    "Calibration",
+    "Metrics",
+    "auc",
+    "auc_near",
+    "calibration",
+    "compute_metrics",
+    "roc_curve",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -134,3 +142,61 @@ def compute_metrics(
         median_ms=float(np.nanmedian(seconds) * 1e3),
         n=int(s.size),
     )
+
+
+#: The reliability table's bins of ``P``: ten of equal width, as ECE is defined.
+RELIABILITY_BINS = 10
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """How well a probability matches the observed frequency of collision.
+
+    ``ece`` is the expected calibration error: the mean over ten equal-width
+    bins of ``P`` of ``|mean P - observed frequency|``, weighted by the bins'
+    counts. ``brier`` is the mean of ``(P - label)^2``, ``log_loss`` the mean
+    of ``-log`` of the probability given to what happened (``P`` clipped to
+    ``[1e-6, 1 - 1e-6]``). ``table`` holds one row per non-empty bin: ``(low,
+    high, count, mean P, observed frequency)``.
+    """
+
+    ece: float
+    brier: float
+    log_loss: float
+    table: tuple[tuple[float, float, int, float, float], ...]
+
+    def worst_bin(self, min_count: int = 20) -> float:
+        """Return the largest ``|mean P - frequency|`` over bins holding ``min_count`` or more."""
+        gaps = [abs(p - f) for _, _, n, p, f in self.table if n >= min_count]
+        return max(gaps, default=float("nan"))
+
+
+def calibration(probability: FloatArray, label: npt.NDArray[np.bool_]) -> Calibration:
+    """Return the calibration of ``probability`` against the exact ``label`` (same shape).
+
+    Raises
+    ------
+    ValueError
+        On empty or mismatched arrays, or a probability outside ``[0, 1]`` or NaN.
+    """
+    p = np.asarray(probability, dtype=np.float64).ravel()
+    y = np.asarray(label, dtype=bool).ravel()
+    if p.size == 0 or p.shape != y.shape:
+        raise ValueError(f"calibration needs two arrays of one size > 0, got {p.size}, {y.size}")
+    if not np.all((p >= 0.0) & (p <= 1.0)):
+        raise ValueError("calibration: every probability must be in [0, 1] (and not NaN)")
+    edges = np.linspace(0.0, 1.0, RELIABILITY_BINS + 1)
+    which = np.clip(np.digitize(p, edges[1:-1]), 0, RELIABILITY_BINS - 1)
+    rows = []
+    ece = 0.0
+    for k in range(RELIABILITY_BINS):
+        inside = which == k
+        n = int(inside.sum())
+        if n == 0:
+            continue
+        mean_p, freq = float(p[inside].mean()), float(y[inside].mean())
+        ece += n / p.size * abs(mean_p - freq)
+        rows.append((float(edges[k]), float(edges[k + 1]), n, mean_p, freq))
+    q = np.clip(p, 1e-6, 1.0 - 1e-6)
+    log_loss = float(-np.mean(np.where(y, np.log(q), np.log1p(-q))))
+    return Calibration(float(ece), float(np.mean((p - y) ** 2)), log_loss, tuple(rows))

@@ -142,7 +142,7 @@ fn split_run(
                 probes: vec![[0.0; 2]],
                 spacing: 0.0,
                 cov_mean: total[i],
-                height: [0.0; 3],
+                height: [0.0; 6],
                 height_cov: nalgebra::SMatrix::zeros(),
                 common_var: 0.0,
                 footprint: Vec::new(),

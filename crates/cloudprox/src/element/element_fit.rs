@@ -186,8 +186,11 @@ pub(crate) fn fit_element(
     if !wald.is_finite() || wald > split_at {
         return median();
     }
-    // Curvature too small to matter: the element's surface is the plane (the
-    // quadric's extra coefficients would add more noise than they take sag).
+    // Curvature small enough that a plane would describe the points about as
+    // well: the element stays this size. Its surface is still the quadric
+    // (fitted over the element's own tangent axes below): a plane lies outside
+    // a convex surface near the element's edges by a fraction of the noise,
+    // where two surfaces first meet.
     match weighted_fit(&local, plane_row) {
         Some(p) if spans_a_plane(&p) => {
             // The tangent axes of the points' tightest bounding rectangle (a
@@ -439,8 +442,22 @@ fn element(
             [clamp(local[i].0, extent[0]), clamp(local[i].1, extent[1])]
         })
         .collect();
-    let height = fit.coef.into();
-    let height_cov = fit.cov * (1.0 - rho);
+    // The surface is the quadric over the element's own tangent axes (the
+    // plane where the points do not determine one: then its curvature terms
+    // are 0 and certain).
+    let quadric = weighted_fit(local, quadric_row)
+        .map(|q| lateral_noise_corrected(&q, idx, sensor, &tangents))
+        .filter(|(coef, cov)| curvature_matters(fit, coef, cov, &extent));
+    let (height, height_cov) = if let Some((coef, cov)) = quadric {
+        (coef.into(), cov * (1.0 - rho))
+    } else {
+        let mut coef = [0.0; 6];
+        coef[..3].copy_from_slice(fit.coef.as_slice());
+        let mut cov = SMatrix::<Real, 6, 6>::zeros();
+        cov.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(fit.cov * (1.0 - rho)));
+        (coef, cov)
+    };
     // Where the surface was sampled, by cells of one mean spacing.
     let h = idx.iter().map(|&i| spacing[i as usize]).sum::<Real>() / n;
     let mut footprint: Vec<FootprintPoint> = if h > 0.0 {
@@ -470,6 +487,64 @@ fn element(
         spacing: h,
         footprint,
     }
+}
+
+/// Whether an element's surface is better read as the quadric `(coef, cov)`
+/// than as the plane `plane` where two surfaces first meet, at the corners of
+/// its extent: there the plane's sag `d = q - p` is largest. The quadric reads
+/// the surface without that bias and with the variance `var(q) - var(p)` more
+/// (the fits are nested); the plane's expected squared error exceeds the
+/// quadric's where `d^2 - var(d) > var(d)` (the local form of Mallows' Cp,
+/// with `d^2 - var(d)` estimating the squared bias). A flat face keeps its plane (its
+/// `d` is noise: one corner in six reads above twice its variance by chance),
+/// a curved patch takes the quadric.
+const QUADRIC_AT: Real = 2.0;
+
+fn curvature_matters(
+    plane: &HeightFit<3>,
+    coef: &Vec6,
+    cov: &SMatrix<Real, 6, 6>,
+    extent: &[[Real; 2]; 2],
+) -> bool {
+    let [[u0, u1], [v0, v1]] = *extent;
+    [(u0, v0), (u1, v0), (u0, v1), (u1, v1)]
+        .iter()
+        .any(|&(u, v)| {
+            let (q, p) = (quadric_row(u, v), plane_row(u, v));
+            let d = q.dot(coef) - p.dot(&plane.coef);
+            let var = q.dot(&(cov * q)) - p.dot(&(plane.cov * p));
+            d * d > QUADRIC_AT * var.max(0.0)
+        })
+}
+
+/// The quadric `fit` of points whose noise also moves them along the surface
+/// (covariances `sensor` of the points `idx`, tangents `tangents`), corrected
+/// for that: a point moved by `(du, dv)` along a curved surface lies off it by
+/// the surface's rise there, so the points' heights over the surface average
+/// `c_uu s_uu + c_uv s_uv + c_vv s_vv` more than the surface's own (`c` the
+/// quadric's curvature coefficients, `s` the points' mean covariance along
+/// the tangents): a convex surface is read that much outside itself. The
+/// constant term is lowered by it, and the covariance of the coefficients
+/// carries the correction's uncertainty (it is linear in the curvature).
+fn lateral_noise_corrected(
+    fit: &HeightFit<6>,
+    idx: &[u32],
+    sensor: &[Matrix3],
+    tangents: &[Vector3; 2],
+) -> (Vec6, SMatrix<Real, 6, 6>) {
+    let n = idx.len() as Real;
+    let along = |a: &Vector3, b: &Vector3| {
+        idx.iter()
+            .map(|&i| a.dot(&(sensor[i as usize] * b)))
+            .sum::<Real>()
+            / n
+    };
+    let [t1, t2] = tangents;
+    let mut m = SMatrix::<Real, 6, 6>::identity();
+    m[(0, 3)] = -along(t1, t1);
+    m[(0, 4)] = -along(t1, t2);
+    m[(0, 5)] = -along(t2, t2);
+    (m * fit.coef, m * fit.cov * m.transpose())
 }
 
 /// Where a surface sampled at the tangential coordinates `along` (noisy,

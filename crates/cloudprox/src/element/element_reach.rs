@@ -44,8 +44,12 @@ pub(crate) struct Hull {
     /// The largest variance of the fitted height over the extent (at a corner:
     /// the variance is a convex quadratic of the tangential coordinates).
     pub var_max: Real,
-    /// The largest distance of a corner from the mean.
+    /// The largest distance of a corner from the mean, plus `sag`: every
+    /// point of the surface lies within it of the mean.
     pub radius: Real,
+    /// How far, along the normal, the fitted surface may lie from the corners'
+    /// convex hull ([`SurfaceElement::sag_bound`]; 0 for a single point).
+    pub sag: Real,
     /// A bound on the standard deviation, along any direction, of any point
     /// of the surface or of the element's samples.
     pub sigma: Real,
@@ -85,7 +89,9 @@ impl Hull {
                 var_max = var_max.max(var);
                 radius = radius.max((x - e.mean).norm());
             }
+            var_max = var_max.max(e.height_var_bound());
         }
+        let sag = e.sag_bound();
         let spacing = if e.is_point() {
             e.spacing.max(sample_spacing)
         } else {
@@ -96,7 +102,8 @@ impl Hull {
             normal: e.normal,
             corners,
             var_max,
-            radius,
+            radius: radius + sag,
+            sag,
             sigma: (var_max + across.trace()).max(0.0).sqrt().max(sample_sigma),
             margin: HALF_SPACING * spacing,
             point: e.is_point(),
@@ -196,7 +203,8 @@ impl NodeBounds {
                     continue;
                 }
                 for c in &h.corners {
-                    out.boxes[id].take_point(c);
+                    out.boxes[id].take_point(&(c + h.normal * h.sag));
+                    out.boxes[id].take_point(&(c - h.normal * h.sag));
                 }
                 out.sigma[id] = out.sigma[id].max(h.sigma);
                 out.margin[id] = out.margin[id].max(h.margin);
@@ -267,7 +275,9 @@ fn pair_may_reach(a: &Hull, posed: &PosedHull, b: &Hull, k: Real) -> bool {
         && hull_gap(
             (&posed.mean, &posed.normal, &posed.corners),
             (&b.mean, &b.normal, &b.corners),
-        ) <= limit
+        ) - a.sag
+            - b.sag
+            <= limit
 }
 
 /// A hull's mean, normal and corners moved into the other cloud's frame.
@@ -466,12 +476,10 @@ mod tests {
         PointCloud::from_sigma(points, sigma).unwrap()
     }
 
-    /// Every pair of hulls, without the hierarchy.
+    /// Every pair of hulls, without the hierarchy (the tests of
+    /// [`all_pairs`]).
     fn brute_force(a: &ElementHulls, rel: &Pose, b: &ElementHulls, k: Real) -> bool {
-        a.hulls.iter().any(|h| {
-            let p = PosedHull::new(h, rel);
-            b.hulls.iter().any(|g| pair_may_reach(h, &p, g, k))
-        })
+        !all_pairs(a, rel, b, k).is_empty()
     }
 
     /// Every pair of hulls that reach each other, without the hierarchy: by
@@ -482,7 +490,10 @@ mod tests {
         let boxes = BoxGap::new(rel);
         let corners_box = |h: &Hull| {
             let mut x = Aabb::empty();
-            h.corners.iter().for_each(|c| x.take_point(c));
+            for c in &h.corners {
+                x.take_point(&(c + h.normal * h.sag));
+                x.take_point(&(c - h.normal * h.sag));
+            }
             x
         };
         let mut out = Vec::new();
@@ -564,8 +575,10 @@ mod tests {
         assert!(a.elements().multi_point_count() > 20);
         let mut ws = BvhWorkspace::default();
         let (mut reached, mut not) = (0, 0);
+        // (Curved element surfaces reach by their sag too: the sweep runs
+        // far enough for some poses to be beyond every reach.)
         for step in 0..60 {
-            let gap = -3.0 * sigma + step as Real * 0.5 * sigma;
+            let gap = -3.0 * sigma + step as Real * 1.5 * sigma;
             let turn = UnitQuaternion::from_euler_angles(0.1 * step as Real, 0.4, -0.3);
             let dir = Vector3::new(1.0, 0.3 * (step % 5) as Real, -0.2).normalize();
             let pose = Pose::from_parts(Translation3::from(dir * (0.09 + gap)), turn);
@@ -592,9 +605,11 @@ mod tests {
             // A sample lies on its element's surface: no farther from the mean
             // than the farthest corner, and inside the corners' box.
             assert!((x - h.mean).norm() <= h.radius + 1e-12 || h.radius == 0.0);
+            // (The surface is curved: within `sag` of the corners' hull.)
             let mut b = Aabb::empty();
             for c in &h.corners {
-                b.take_point(c);
+                b.take_point(&(c + h.normal * h.sag));
+                b.take_point(&(c - h.normal * h.sag));
             }
             assert!(b.distance_squared_to_point(&x) <= 1e-20, "sample {k}");
             assert!(els.samples().sigma_max()[k] <= h.sigma * (1.0 + 1e-12));

@@ -88,13 +88,14 @@ impl ElementSettings {
 /// A group of points that samples one smooth piece of surface within their
 /// noise, or a single point. In the cloud's own frame.
 ///
-/// The surface is a plane over the points' principal plane: a point at
-/// tangential coordinates `(u, v)` from the mean lies at height
-/// `h(u, v) = height . (1, u, v)` along the normal, fitted by weighted least
-/// squares (elements are accepted only where a curvature would not describe
-/// the points better, see the [module docs](crate::element)); the variance
-/// of the fitted height there is `x^T height_cov x + common_var` with
-/// `x = (1, u, v)`.
+/// The surface is a quadric height field over the points' principal plane: a
+/// point at tangential coordinates `(u, v)` from the mean lies at height
+/// `h(u, v) = height . x` along the normal, `x = (1, u, v, u^2, u v, v^2)`,
+/// fitted by weighted least squares; the variance of the fitted height there
+/// is `x^T height_cov x + common_var`. (A plane fitted to a curved patch lies
+/// outside a convex surface near the patch's edges, where two surfaces first
+/// meet: the quadric reads the gap there without that bias, with the
+/// variance its curvature terms add.)
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceElement {
     /// Index of the element's first point in [`SurfaceElements::indices`].
@@ -129,10 +130,10 @@ pub struct SurfaceElement {
     /// Covariance of the mean (metres squared): `sum(Sigma_i) / m^2` for
     /// independent noise.
     pub cov_mean: Matrix3,
-    /// Coefficients of the fitted plane's height.
-    pub height: [Real; 3],
+    /// Coefficients of the fitted quadric's height over `(1, u, v, u^2, u v, v^2)`.
+    pub height: [Real; 6],
     /// Covariance of `height` (the share of independent noise).
-    pub height_cov: SMatrix<Real, 3, 3>,
+    pub height_cov: SMatrix<Real, 6, 6>,
     /// Variance added to every fitted height by noise correlated between the
     /// points (see [`ElementSettings::noise_correlation`]).
     pub common_var: Real,
@@ -140,6 +141,11 @@ pub struct SurfaceElement {
     /// sorted by cells of side [`SurfaceElement::spacing`] (see
     /// [`SurfaceElement::covers`]). Empty for a single point.
     pub footprint: Vec<FootprintPoint>,
+}
+
+/// The quadric height field's row `(1, u, v, u^2, u v, v^2)`.
+pub(crate) fn height_row(u: Real, v: Real) -> SVector<Real, 6> {
+    SVector::<Real, 6>::new(1.0, u, v, u * u, u * v, v * v)
 }
 
 /// One point of an element's footprint: its cell `(i, j)` of side `spacing`
@@ -152,6 +158,49 @@ pub(crate) fn footprint_cell(u: Real, v: Real, cell: Real) -> (i32, i32) {
 }
 
 impl SurfaceElement {
+    /// The fitted height at `(u, v)` (without its variance).
+    pub fn height_at(&self, u: Real, v: Real) -> Real {
+        height_row(u, v).dot(&SVector::<Real, 6>::from(self.height))
+    }
+
+    /// A bound on how far the fitted surface over the extent lies, along the
+    /// normal, from the convex hull of its four extent corners: the surface's
+    /// bilinear interpolation between the corners lies in their hull, and the
+    /// quadric differs from it by `c_uu (u - u0)(u - u1) + c_vv (v - v0)(v - v1)`
+    /// (the `u v` term is bilinear itself), at most `(|c_uu| du^2 + |c_vv|
+    /// dv^2) / 4` over the extent. 0 for a single point.
+    pub(crate) fn sag_bound(&self) -> Real {
+        if self.is_point() {
+            return 0.0;
+        }
+        let [[u0, u1], [v0, v1]] = self.extent;
+        let h = &self.height;
+        0.25 * (h[3].abs() * (u1 - u0).powi(2) + h[5].abs() * (v1 - v0).powi(2))
+    }
+
+    /// The largest variance of the fitted height over the extent, read on a
+    /// 5 x 5 grid over it (the variance is a smooth quartic of `(u, v)`
+    /// there, largest towards the corners), with a tenth more for what lies
+    /// between the grid's nodes.
+    pub(crate) fn height_var_bound(&self) -> Real {
+        if self.is_point() {
+            return 0.0;
+        }
+        let [[u0, u1], [v0, v1]] = self.extent;
+        let mut largest: Real = 0.0;
+        for i in 0..5 {
+            for j in 0..5 {
+                let (u, v) = (
+                    u0 + (u1 - u0) * Real::from(i) / 4.0,
+                    v0 + (v1 - v0) * Real::from(j) / 4.0,
+                );
+                let x = height_row(u, v);
+                largest = largest.max(x.dot(&(self.height_cov * x)));
+            }
+        }
+        1.1 * largest.max(0.0) + self.common_var
+    }
+
     /// Whether the element is a single point kept as it is.
     pub fn is_point(&self) -> bool {
         self.count == 1
@@ -165,8 +214,8 @@ impl SurfaceElement {
     /// The point of the fitted surface over tangential coordinates `(u, v)`
     /// and the variance of its height along the normal.
     pub fn surface_point(&self, u: Real, v: Real) -> (Point3, Real) {
-        let x = SVector::<Real, 3>::new(1.0, u, v);
-        let h = x.dot(&SVector::<Real, 3>::from(self.height));
+        let x = height_row(u, v);
+        let h = x.dot(&SVector::<Real, 6>::from(self.height));
         let var = x.dot(&(self.height_cov * x)) + self.common_var;
         (
             self.mean + self.tangents[0] * u + self.tangents[1] * v + self.normal * h,
@@ -345,7 +394,7 @@ mod tests {
             probes: Vec::new(),
             spacing,
             cov_mean: Matrix3::zeros(),
-            height: [0.0; 3],
+            height: [0.0; 6],
             height_cov: SMatrix::zeros(),
             common_var: 0.0,
             footprint,

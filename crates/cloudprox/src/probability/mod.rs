@@ -20,9 +20,11 @@ pub(crate) use aggregation::NEIGHBOURHOOD;
 pub use aggregation::{surface_probability, Aggregation};
 pub use crossing::crossing_probabilities;
 pub(crate) use crossing::{crossing_probabilities_in, CrossingSide};
+pub use element::FacingPair;
+pub use element::{contact_probability, ElementReading};
 pub(crate) use element::{
-    element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
-    elements_within_reach, ElementSide,
+    element_crossing_probabilities, element_facing_pairs, element_pair_crosses,
+    element_pair_within_reach, elements_within_reach, ElementSide,
 };
 pub use gaussian::{normal_cdf, normal_quantile};
 pub use point::point_probability;

@@ -9,7 +9,7 @@ pub mod collide;
 pub mod exact;
 
 pub use collide::{
-    collide, collide_along, collide_many, collide_mesh_cloud, prepare, CollisionRequest,
-    CollisionResult, ContactPatch, MeshSampling, PointAggregates, PointProbabilities,
-    QueryCounters, QueryModel, QueryStats, ALONG_RUN,
+    collide, collide_along, collide_many, collide_mesh_cloud, facing_pairs, prepare,
+    CollisionRequest, CollisionResult, ContactPatch, MeshSampling, PointAggregates,
+    PointProbabilities, QueryCounters, QueryModel, QueryStats, ALONG_RUN,
 };

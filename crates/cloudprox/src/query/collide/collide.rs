@@ -9,7 +9,9 @@ use crate::classify::{SocpSolver, SolveStatus};
 use crate::cloud::{validate_pose, PointCloud};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose};
-use crate::probability::{normal_cdf, normal_quantile, Aggregation};
+use crate::probability::{
+    contact_probability, normal_cdf, normal_quantile, Aggregation, ElementReading,
+};
 use crate::query::collide::collide_many::prepare;
 use crate::query::collide::contact::{fit_patch, least_spread_axis, mean};
 use crate::query::collide::elements::{
@@ -284,11 +286,18 @@ fn collide_segmentation(
     let mut inputs_a: Vec<Real> = Vec::new();
     let mut inputs_b: Vec<Real> = Vec::new();
     let mut patches = Vec::new();
+    // With elements: every facing pair's reading within reach, over all
+    // patches, and the largest value of a patch without surface elements.
+    let mut readings: Vec<ElementReading> = Vec::new();
+    let mut lone: Real = 0.0;
     // The samples given an input: every other input is 0, which changes no
     // aggregate, so `P` reads these alone (a query against a cloud of 10^7
     // points then does not pass over all of them).
     let mut touched: (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
+    // (With elements the pair's `P` combines the readings of every patch
+    // (`contact_probability`): a patch alone does not decide it.)
     let stop_early = request.decide_only
+        && elements.is_none()
         && matches!(request.aggregation, Aggregation::Max | Aggregation::Surface);
     if let Some(w) = warm.as_deref_mut() {
         w.begin(sa.len(), sb.len());
@@ -391,8 +400,12 @@ fn collide_segmentation(
             let sep = &fit.classification.separator;
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
             let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
+            let contact = crossings.as_ref().map(|c| {
+                readings.extend_from_slice(&c.3);
+                contact_probability(&c.3)
+            });
             let (qa, qb) = match (crossings, request.aggregation) {
-                (Some((qa, qb, _)), _) => (qa, qb),
+                (Some((qa, qb, _, _)), _) => (qa, qb),
                 (None, Aggregation::Surface) if elements.is_none() => {
                     let (search_a, search_b) = (PointSearch::new(own_a), PointSearch::new(own_b));
                     // Each point's largest deviation, kept by its cloud (a
@@ -434,10 +447,14 @@ fn collide_segmentation(
             }
             touched.0.extend_from_slice(&ia);
             touched.1.extend_from_slice(&ib);
-            let patch_probability = request.aggregation.aggregate(
-                core_values(indexed(&ia, &qa), &core.0)
-                    .chain(core_values(indexed(&ib, &qb), &core.1)),
-            );
+            let patch_probability = contact.unwrap_or_else(|| {
+                let p = request.aggregation.aggregate(
+                    core_values(indexed(&ia, &qa), &core.0)
+                        .chain(core_values(indexed(&ib, &qb), &core.1)),
+                );
+                lone = lone.max(p);
+                p
+            });
             stats.counters.points_classified += pts.len();
             stats.counters.solver_iterations += u64::from(fit.classification.iterations);
             stats.counters.clarabel_fallbacks += usize::from(
@@ -514,8 +531,17 @@ fn collide_segmentation(
     });
     // A paper aggregation of the points model is one of those (the same
     // values in the same order); otherwise the inputs are aggregated.
-    let probability = point_aggregates
-        .and_then(|g| g.get(request.aggregation))
+    // With elements, each patch is one contact and its probability the
+    // contact's (`contact_probability`): `P` is the most probable contact's.
+    // The readings of all patches together: a contact cut into several
+    // patches is still one contact (the largest of the patches' values
+    // would read the minimum of their noisy estimates again). Patches of lone
+    // points (no element readings) keep their own values.
+    let by_patch = elements
+        .is_some()
+        .then(|| contact_probability(&readings).max(lone));
+    let probability = by_patch
+        .or_else(|| point_aggregates.and_then(|g| g.get(request.aggregation)))
         .unwrap_or_else(|| {
             request.aggregation.aggregate(
                 core_values(indexed_inputs(&touched.0, &inputs_a), &core.0)

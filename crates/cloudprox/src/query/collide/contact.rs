@@ -1,7 +1,7 @@
 //! Contact regions: a patch's trained surface, per-sample margins and
 //! probabilities, and the contact point, normal and separation estimate.
 
-use crate::classify::{train_hinted, Classification};
+use crate::classify::{train_hinted, Classification, Surface};
 use crate::error::Result;
 use crate::math::{Matrix3, Point3, Pose, PrincipalAxes, Vector3};
 use crate::probability::point_probability;
@@ -27,6 +27,9 @@ pub(crate) struct PatchFit {
 
 /// Trains the surface for `pts` (the first `na` from A) and derives the per-point
 /// probabilities (Eq. 3), the contact point, normal and separation estimate.
+/// The fewest samples a quadric separating surface is trained on.
+const MIN_QUADRIC_SAMPLES: usize = 3 * 10;
+
 pub(crate) fn fit_patch(
     pts: &[Point3],
     covs: &[Matrix3],
@@ -41,7 +44,16 @@ pub(crate) fn fit_patch(
     let labels: Vec<Real> = (0..pts.len())
         .map(|i| if i < na { 1.0 } else { -1.0 })
         .collect();
-    let (classification, support) = train_hinted(pts, covs, &labels, &request.classify, warm)?;
+    // A quadric has ten coefficients: trained on fewer than three samples per
+    // coefficient (a few elements' samples) it is free to fold away from the
+    // samples and put the surfaces they stand for on the wrong side (two flat
+    // faces 1.4 sigma apart, 15 samples: 77% of one face's points across the
+    // surface); a plane is trained there instead.
+    let mut settings = request.classify;
+    if settings.surface == Surface::Quadric && pts.len() < MIN_QUADRIC_SAMPLES {
+        settings.surface = Surface::Linear;
+    }
+    let (classification, support) = train_hinted(pts, covs, &labels, &settings, warm)?;
     let sep = &classification.separator;
     let mut probabilities = Vec::with_capacity(pts.len());
     let mut margins = Vec::with_capacity(pts.len());

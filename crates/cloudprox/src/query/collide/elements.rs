@@ -10,7 +10,7 @@ use crate::element::{surfaces_may_reach, Hull, SurfaceElement, SurfaceElements};
 use crate::math::Pose;
 use crate::probability::{
     element_crossing_probabilities, element_pair_crosses, element_pair_within_reach,
-    elements_within_reach, ElementSide,
+    elements_within_reach, ElementReading, ElementSide,
 };
 use crate::query::collide::near::SampleLink;
 use crate::Real;
@@ -18,10 +18,12 @@ use crate::Real;
 /// The probability, per sample of a patch (`ia` of A's elements `ea`, at `pose_a`
 /// in the separator's frame; `ib` of B's), that the fitted surface of the
 /// element it stands for crosses the other side's
-/// ([`element_crossing_probabilities`]), and whether some pair that the
+/// ([`element_crossing_probabilities`]), whether some pair that the
 /// separating surface does not describe would raise the patch's value above
 /// what the described pairs give (the patch is then cut like a misfit; see
-/// [`crate::probability::element::ElementCrossings`]).
+/// [`crate::probability::element::ElementCrossings`]), and every facing
+/// pair's reading within reach (with A's elements as `own`, B's as `other`),
+/// for [`crate::probability::contact_probability`].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn element_crossings(
     ea: &SurfaceElements,
@@ -32,7 +34,7 @@ pub(crate) fn element_crossings(
     pose_b: &Pose,
     sep: &Separator,
     reach_sds: Real,
-) -> (Vec<Real>, Vec<Real>, bool) {
+) -> (Vec<Real>, Vec<Real>, bool, Vec<ElementReading>) {
     let (ua, ub) = (unique_owners(ea, ia), unique_owners(eb, ib));
     let (sa, sb) = (
         element_side(ea, &ua, pose_a, 1.0),
@@ -53,10 +55,27 @@ pub(crate) fn element_crossings(
             })
             .collect::<Vec<Real>>()
     };
+    // Both sides' readings as pairs of (A's element, B's element), by their
+    // indices in the clouds' elements.
+    let readings: Vec<ElementReading> = ca
+        .readings
+        .iter()
+        .map(|r| ElementReading {
+            own: ua[r.own as usize],
+            other: ub[r.other as usize],
+            ..*r
+        })
+        .chain(cb.readings.iter().map(|r| ElementReading {
+            own: ua[r.other as usize],
+            other: ub[r.own as usize],
+            ..*r
+        }))
+        .collect();
     (
         per_sample(ea, ia, &ua, &ca.values),
         per_sample(eb, ib, &ub, &cb.values),
         undescribed,
+        readings,
     )
 }
 
@@ -350,7 +369,7 @@ pub(crate) fn element_sides_within_reach(
 }
 
 /// The elements `unique` of `els` as one side of a patch.
-fn element_side<'a>(
+pub(crate) fn element_side<'a>(
     els: &'a SurfaceElements,
     unique: &[u32],
     pose: &Pose,

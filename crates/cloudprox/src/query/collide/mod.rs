@@ -28,6 +28,7 @@ mod collide;
 mod collide_many;
 mod collide_mesh_cloud;
 mod contact;
+mod diagnose;
 mod elements;
 mod near;
 mod probabilities;
@@ -42,6 +43,7 @@ pub use collide_many::{collide_along, collide_many, prepare, ALONG_RUN};
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
 };
+pub use diagnose::facing_pairs;
 pub(crate) use elements::element_surfaces_may_reach;
 pub use request::{CollisionRequest, QueryModel};
 pub use result::{

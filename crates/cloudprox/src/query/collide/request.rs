@@ -6,22 +6,23 @@ use crate::error::{Error, Result};
 use crate::probability::{Aggregation, Thresholds};
 use crate::Real;
 
-/// What a query classifies and aggregates: the points themselves (the paper's
-/// method) or the surface elements they sample ([`crate::element`]).
+/// What a query classifies and aggregates: the surface elements the points
+/// sample ([`crate::element`], the default) or the points themselves (the
+/// paper's method).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum QueryModel {
-    /// Surface elements: each cloud's points grouped, once per cloud, into
-    /// pieces of surface that fit a plane within their noise; the classifier
-    /// trains on the elements' samples (their means and extents, with the
-    /// covariance of the fitted plane), so a near region holds tens of samples
-    /// at any noise level, and `P` is the probability that the sampled surfaces
-    /// cross (the crate-internal `element_crossing_probabilities`). Per-point
-    /// probabilities (Eq. 3 with each point's own covariance against the trained
-    /// surface) are still reported.
+    /// Surface elements (the default): each cloud's points grouped, once per
+    /// cloud, into pieces of surface that fit a quadric height field within
+    /// their noise; the classifier trains on the elements' samples, and `P` is
+    /// the probability that the two sampled surfaces cross, read at every
+    /// facing pair of element surfaces (gap and its standard deviation) and
+    /// combined over the contact ([`crate::probability::contact_probability`]).
+    /// Per-point probabilities (Eq. 3 with each point's own covariance against
+    /// the trained surface) are still reported.
+    #[default]
     Elements,
     /// Every point is a sample of the classifier and a candidate for `P` (the
-    /// paper's method, with the aggregations [`Aggregation`]). The default.
-    #[default]
+    /// paper's method, with the aggregations [`Aggregation`]).
     Points,
 }
 
@@ -55,7 +56,7 @@ crate::names::named_options!(QueryModel, "model", {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CollisionRequest {
     /// What is classified: surface elements or points (see [`QueryModel`];
-    /// default [`QueryModel::Points`]).
+    /// default [`QueryModel::Elements`]).
     pub model: QueryModel,
     /// How separating surfaces are trained (default
     /// [`ClassifySettings::default`]).
