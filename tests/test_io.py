@@ -1158,3 +1158,74 @@ def test_pointcloud2_bad_layouts(
 def test_pointcloud2_malformed_field_tuples() -> None:
     with pytest.raises(InvalidInputError, match=r"fields\[0\] must be \(name, offset"):
         read_organized(organized_message(False), [("x", 0, F32), *PC2_FIELDS[1:]])
+
+
+# ------------------------------------------------------ no-returns, XYZ columns
+
+
+def test_organized_no_returns_at_the_sensor_origin(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A raw lidar frame: the driver writes beams that returned nothing as (0, 0, 0).
+    path = tmp_path / "frame.pcd"
+    path.write_text(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 2\n"
+        "POINTS 6\nDATA ascii\n0 0 0\n1 0 2\nnan nan nan\n0 0 0\n0.5 0.5 1\n2 -1 0.5\n"
+    )
+    cf = cp.io.read_point_cloud(path)
+    np.testing.assert_array_equal(cf.points, [[1, 0, 2], [0.5, 0.5, 1], [2, -1, 0.5]])
+    np.testing.assert_array_equal(cf.pixels, [1, 4, 5])
+    assert (cf.skipped, cf.at_origin, cf.no_returns) == (1, 2, 3)
+    assert "3 no-returns" in repr(cf)
+    assert cf.topic is None and cf.frame_id is None and cf.stamp is None
+    # The sensor model takes the frame: no point lies at its origin any more.
+    cloud = cf.to_point_cloud(sensor=cp.Lidar(), discretization=False)
+    assert len(cloud) == 3
+    from cloudprox.cli import main
+
+    assert main(["info", str(path), "--json"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out)
+    assert (doc["skipped_non_finite"], doc["no_returns"]) == (1, 3)
+    assert doc["no_returns_at_sensor_origin"] == 2
+    # Written back, the no-returns become NaN records of the same layout.
+    out = tmp_path / "out.pcd"
+    cp.io.write_point_cloud(out, cf)
+    again = cp.io.read_point_cloud(out)
+    np.testing.assert_array_equal(again.pixels, [1, 4, 5])
+    assert (again.skipped, again.at_origin) == (3, 0)
+
+
+def unit_normals(n: int, seed: int = 0) -> np.ndarray:
+    v = np.random.default_rng(seed).normal(size=(n, 3))
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize(
+    ("layout", "fields"),
+    [
+        ("x y z nx ny nz", ["x", "y", "z", "nx", "ny", "nz"]),  # CGAL kitten.xyz, Open3D .xyzn
+        ("x y z r g b", ["x", "y", "z", "r", "g", "b"]),  # Open3D .xyzrgb, CloudCompare
+        ("x y z r g b nx ny nz", ["x", "y", "z", "r", "g", "b", "nx", "ny", "nz"]),  # CloudCompare
+        ("x y z nx ny nz r g b", ["x", "y", "z", "nx", "ny", "nz", "r", "g", "b"]),
+    ],
+    ids=["normals", "colours", "cloudcompare", "normals-colours"],
+)
+def test_xyz_six_and_nine_columns(tmp_path: Path, layout: str, fields: list[str]) -> None:
+    n = 40
+    pts = points(n)
+    nrm = unit_normals(n)
+    rgb = np.random.default_rng(1).integers(0, 256, size=(n, 3)).astype(float)
+    cols = {"x y z": pts, "nx ny nz": nrm, "r g b": rgb}
+    parts = [cols[" ".join(layout.split()[i : i + 3])] for i in range(0, len(fields), 3)]
+    path = tmp_path / "cloud.xyz"
+    np.savetxt(path, np.hstack(parts), fmt="%.6g")  # as CGAL and CloudCompare print them
+    got = cp.io.read_point_cloud(path)
+    assert got.fields == fields
+    np.testing.assert_allclose(got.points, pts, atol=1e-5)
+    if "nx" in fields:
+        assert got.normals is not None
+        np.testing.assert_allclose(got.normals, nrm, atol=1e-5)
+    else:
+        assert got.normals is None

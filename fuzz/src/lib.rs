@@ -78,7 +78,7 @@ fn check_size(size: usize) {
 static ALLOCATOR: CappedAllocator = CappedAllocator;
 
 /// The names of the fuzz targets, in the order `scripts/fuzz.sh` runs them.
-pub const TARGETS: [&str; 12] = [
+pub const TARGETS: [&str; 13] = [
     "ply",
     "pcd",
     "las",
@@ -88,6 +88,7 @@ pub const TARGETS: [&str; 12] = [
     "npy",
     "xyz",
     "pointcloud2",
+    "pointcloud2_message",
     "urdf",
     "collide",
     "exact",
@@ -106,6 +107,7 @@ pub fn run(name: &str, data: &[u8]) -> bool {
         "npy" => npy(data),
         "xyz" => xyz(data),
         "pointcloud2" => pointcloud2(data),
+        "pointcloud2_message" => pointcloud2_message(data),
         "urdf" => urdf(data),
         "collide" => collide(data),
         "exact" => exact(data),
@@ -309,6 +311,24 @@ pub fn pointcloud2(data: &[u8]) {
         row_step: tame(input.row_step, 4096),
     };
     if let Ok(cloud) = pointcloud2::read_pointcloud2(&layout, &input.data) {
+        round_trip_cloud(&cloud, data);
+    }
+}
+
+/// A serialized PointCloud2 message as a bag stores it: the first byte picks
+/// the encoding (even: CDR, as rosbag2 stores it; odd: ROS 1), the rest is
+/// the message, whose points are read straight from its bytes.
+pub fn pointcloud2_message(data: &[u8]) {
+    let Some((&pick, message)) = data.split_first() else {
+        return;
+    };
+    let encoding = if pick % 2 == 0 {
+        pointcloud2::MessageEncoding::Cdr
+    } else {
+        pointcloud2::MessageEncoding::Ros1
+    };
+    let name = "fuzz.db3 (topic /points, message 0)";
+    if let Ok((cloud, _)) = pointcloud2::read_pointcloud2_message(message, encoding, name) {
         round_trip_cloud(&cloud, data);
     }
 }
@@ -853,11 +873,51 @@ pub fn synthetic_seeds(target: &str) -> Vec<Vec<u8>> {
             push(xyz::write_xyz(&cloud, b' '));
             push(xyz::write_xyz(&with_normals, b','));
             push(xyz::write_xyz(&with_covs, b','));
+            // Six and nine columns as CGAL, Open3D and CloudCompare write them.
+            let text = |cols: &dyn Fn(usize) -> String, header: &str| {
+                let mut body = String::from(header);
+                for i in 0..12 {
+                    body += &[format!("{i}.5 0.25 -1 "), cols(i), "\n".into()].concat();
+                }
+                body.into_bytes()
+            };
+            out.push(text(&|i| format!("0.6 0.{} 0.8", i % 2 * 8), ""));
+            out.push(text(&|i| format!("{} 20 255", i * 9), ""));
+            out.push(text(&|i| format!("{} 20 255 0 0 1", i * 9), ""));
+            out.push(text(&|_| "0 1 0 0.5 0.25 1".into(), ""));
+            out.push(text(&|_| "1 2 3 0 0 1".into(), "//X Y Z R G B Nx Ny Nz\n"));
         }
         "pointcloud2" => {
             cloud.normals = Some(vec![Vector3::x(); points.len()]);
             if let Ok((layout, data)) = pointcloud2::write_pointcloud2(&cloud) {
                 out.push(encode_pc2(&layout, &data));
+            }
+        }
+        "pointcloud2_message" => {
+            let organized = pointcloud2::PointCloud2Layout {
+                height: 3,
+                width: 4,
+                ..pointcloud2::write_pointcloud2(&cloud)
+                    .map(|(l, _)| l)
+                    .expect("a small cloud encodes")
+            };
+            let mut layout = organized.clone();
+            layout.row_step = layout.point_step * layout.width;
+            let (_, data) = pointcloud2::write_pointcloud2(&cloud).expect("a small cloud encodes");
+            let header = pointcloud2::PointCloud2Header {
+                stamp_ns: 1_700_000_000_000_000_000,
+                frame_id: "velodyne".into(),
+                is_dense: false,
+            };
+            for (pick, encoding) in [
+                (0u8, pointcloud2::MessageEncoding::Cdr),
+                (1u8, pointcloud2::MessageEncoding::Ros1),
+            ] {
+                let mut m = vec![pick];
+                m.extend(pointcloud2::encode_pointcloud2(
+                    &header, &layout, &data, encoding,
+                ));
+                out.push(m);
             }
         }
         "urdf" => out.push(URDF_SEED.as_bytes().to_vec()),

@@ -3,13 +3,18 @@
 Point clouds: PLY (ascii, binary little/big endian), PCD (ascii, binary,
 binary_compressed; organized or not), XYZ/CSV, NPY, and LAS/LAZ (read only).
 Meshes: STL (ascii, binary), OBJ, PLY, OFF. ROS ``sensor_msgs/PointCloud2``
-messages are read from their raw bytes and field layout, no ROS needed.
+messages are read from their raw bytes and field layout, from a serialized
+message, or from ROS bags (rosbag2 sqlite3 ``.db3`` and MCAP, ROS 1 ``.bag``;
+see :mod:`cloudprox.bags`), no ROS needed.
 
 The parsers are the Rust core's (``cloudprox::io``); they release the GIL. A
 missing file raises ``FileNotFoundError``; a corrupt, truncated or unsupported
 file raises :class:`cloudprox.FormatError` naming the file and the problem.
 Points with a NaN or infinite coordinate (the holes of an organized depth image)
 are skipped and counted in :attr:`CloudFile.skipped`, never dropped silently.
+In an organized scan the points at exactly the sensor origin are no-returns
+too: left out and counted in :attr:`CloudFile.at_origin` (``no_returns`` is
+both counts), their pixels kept in the organized layout.
 
 Examples
 --------
@@ -23,7 +28,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -43,18 +48,22 @@ __all__ = [
     "CloudFile",
     "DegenerateFacesWarning",
     "from_ros_message",
+    "iter_point_clouds",
     "parse_mesh",
     "parse_numbers",
     "read_mesh",
     "read_point_cloud",
     "read_pointcloud2",
+    "read_pointcloud2_message",
     "read_pose",
     "write_mesh",
     "write_point_cloud",
     "write_pointcloud2",
 ]
 
-CloudFormatName = Literal["auto", "ply", "pcd", "xyz", "txt", "pts", "csv", "npy", "las", "laz"]
+CloudFormatName = Literal[
+    "auto", "ply", "pcd", "xyz", "xyzn", "xyzrgb", "txt", "pts", "csv", "npy", "las", "laz"
+]
 MeshFormatName = Literal["auto", "stl", "obj", "ply", "off"]
 EncodingName = Literal[
     "ascii", "binary", "binary_little_endian", "binary_big_endian", "binary_compressed"
@@ -63,23 +72,41 @@ PathLike = str | os.PathLike[str]
 FloatArray = npt.NDArray[np.float64]
 
 
-def read_point_cloud(path: PathLike, format: CloudFormatName = "auto") -> CloudFile:
-    """Read a point-cloud file.
+def read_point_cloud(
+    path: PathLike,
+    format: CloudFormatName = "auto",
+    *,
+    topic: str | None = None,
+    index: int | None = None,
+    frame: str | None = None,
+) -> CloudFile:
+    """Read a point-cloud file, or one frame of a ROS bag.
 
     Parameters
     ----------
     path : str or path-like
-        The file.
+        The file. A ROS 1 ``.bag``, a rosbag2 ``.db3`` or ``.mcap`` file, or a
+        rosbag2 folder (with its ``metadata.yaml``) is read as a bag.
     format : str, default "auto"
-        ``"auto"`` picks the format from the extension (``.ply .pcd .xyz .txt
-        .pts .csv .npy .las .laz``).
+        ``"auto"`` picks the format from the extension (``.ply .pcd .xyz .xyzn
+        .xyzrgb .txt .pts .csv .npy .las .laz``, and the bags').
+    topic : str, optional
+        Bags only: the ``sensor_msgs/PointCloud2`` topic; ``None`` picks the
+        bag's only one (an error lists them when there are several).
+    index : int, optional
+        Bags only: the message's index in the topic (default 0; negative counts
+        from the end).
+    frame : str, optional
+        Bags only: the TF frame to express the points in (default: the root of
+        the sensor frame's TF tree; see :mod:`cloudprox.bags`).
 
     Returns
     -------
     CloudFile
         Points ``(n, 3)`` with finite coordinates, and what else the file holds:
-        normals, covariances, the sensor pose (PCD ``VIEWPOINT``), the organized
-        layout, the field names and the number of skipped non-finite points.
+        normals, covariances, the sensor pose (PCD ``VIEWPOINT``; a bag's TF),
+        the organized layout, the field names, the number of skipped non-finite
+        points and of no-returns at the sensor origin (``at_origin``).
         ``CloudFile.to_point_cloud(...)`` makes a :class:`cloudprox.PointCloud`.
 
     Raises
@@ -88,11 +115,91 @@ def read_point_cloud(path: PathLike, format: CloudFormatName = "auto") -> CloudF
         If the file does not exist.
     cloudprox.FormatError
         If its content is corrupt, truncated or unsupported (the message names
-        the file and the problem).
+        the file and the problem; for a bag also the topic, message and field).
     cloudprox.InvalidInputError
-        If the format cannot be told from the extension or is unknown.
+        If the format cannot be told from the extension or is unknown; for a
+        bag, if the topic is unknown, ambiguous or not a PointCloud2, or the
+        index is out of range; ``topic``, ``index`` or ``frame`` given for a
+        file that is not a bag.
     """
+    from cloudprox import bags
+
+    if format == "auto" and bags.is_bag(path):
+        default_topic, default_index = bags.selected()
+        return bags.read_point_cloud(
+            path,
+            default_topic if topic is None else topic,
+            default_index if index is None else index,
+            frame=frame,
+        )
+    if topic is not None or index is not None or frame is not None:
+        raise InvalidInputError(
+            f"{os.fspath(path)}: topic=, index= and frame= apply to ROS bags (.bag, .db3, "
+            ".mcap or a rosbag2 folder) only"
+        )
     return _read_point_cloud(os.fspath(path), format)
+
+
+def iter_point_clouds(
+    path: PathLike, topic: str | None = None, *, frame: str | None = None
+) -> Iterator[CloudFile]:
+    """Yield the frames of a bag's ``sensor_msgs/PointCloud2`` topic, one at a time.
+
+    A generator: memory stays flat in the number of frames. See
+    :func:`cloudprox.bags.iter_point_clouds`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ROS 1 ``.bag``, a rosbag2 ``.db3`` or ``.mcap`` file, or a rosbag2 folder.
+    topic : str, optional
+        The PointCloud2 topic (``None``: the bag's only one).
+    frame : str, optional
+        The TF frame to express the points in (default: the TF root).
+
+    Yields
+    ------
+    CloudFile
+        One per message, in the bag's order.
+    """
+    from cloudprox import bags
+
+    return bags.iter_point_clouds(path, topic, frame=frame)
+
+
+def read_pointcloud2_message(
+    message: bytes | bytearray | memoryview,
+    encoding: Literal["cdr", "ros1"] = "cdr",
+    *,
+    name: str = "PointCloud2 message",
+) -> CloudFile:
+    """Read a serialized ``sensor_msgs/PointCloud2`` message, as a bag stores it.
+
+    Parameters
+    ----------
+    message : bytes-like
+        The message: CDR with its 4-byte encapsulation header (rosbag2, ROS 2
+        middleware), or the ROS 1 serialization (``.bag``). ``bytes`` are read in
+        place, without a copy.
+    encoding : {"cdr", "ros1"}, default "cdr"
+        Which of the two.
+    name : str, default "PointCloud2 message"
+        What errors call the message.
+
+    Returns
+    -------
+    CloudFile
+        As :func:`read_pointcloud2`, with ``stamp``, ``frame_id`` and
+        ``sensor_frame`` from the message's header and the sensor at the origin
+        of its frame.
+
+    Raises
+    ------
+    cloudprox.FormatError
+        If the message is truncated, its layout does not fit its data, or ``x``,
+        ``y`` or ``z`` is missing.
+    """
+    return CloudFile._from_message(message, encoding, name=name, path=name)
 
 
 def write_point_cloud(

@@ -7,7 +7,8 @@ use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
 use cloudprox::io::pointcloud2::{
-    read_pointcloud2 as read_pc2, write_pointcloud2 as write_pc2, PointCloud2Layout, PointField,
+    decode_pointcloud2, read_pointcloud2_message, read_pointcloud2_named,
+    write_pointcloud2 as write_pc2, MessageEncoding, PointCloud2Layout, PointField,
 };
 use cloudprox::io::{self, CloudData, CloudFormat, Encoding, Grid, MeshFormat};
 use cloudprox::math::Matrix3;
@@ -25,7 +26,7 @@ fn cloud_format(py: Python<'_>, format: &str) -> PyResult<Option<CloudFormat>> {
         "auto" => return Ok(None),
         "ply" => CloudFormat::Ply,
         "pcd" => CloudFormat::Pcd,
-        "xyz" | "txt" | "pts" => CloudFormat::Xyz,
+        "xyz" | "xyzn" | "xyzrgb" | "txt" | "pts" => CloudFormat::Xyz,
         "csv" => CloudFormat::Csv,
         "npy" => CloudFormat::Npy,
         "las" | "laz" => CloudFormat::Las,
@@ -163,6 +164,19 @@ fn encoding_from(
 pub struct PyCloudFile {
     pub(crate) data: Arc<CloudData>,
     path: String,
+    message: Option<MessageSource>,
+}
+
+/// Where a cloud read from a bag came from.
+#[derive(Debug, Clone)]
+struct MessageSource {
+    topic: Option<String>,
+    index: Option<usize>,
+    /// The message's `header.frame_id` (the sensor's frame).
+    sensor_frame: String,
+    /// The frame the points are expressed in.
+    frame_id: String,
+    stamp_ns: i64,
 }
 
 impl PyCloudFile {
@@ -170,8 +184,54 @@ impl PyCloudFile {
         Self {
             data: Arc::new(data),
             path,
+            message: None,
         }
     }
+}
+
+/// The encoding of a serialized message by its Python name.
+fn message_encoding(py: Python<'_>, encoding: &str) -> PyResult<MessageEncoding> {
+    match encoding.to_ascii_lowercase().as_str() {
+        "cdr" | "ros2" => Ok(MessageEncoding::Cdr),
+        "ros1" => Ok(MessageEncoding::Ros1),
+        other => Err(invalid_input(
+            py,
+            format!("unknown message encoding {other:?}; known: cdr (ROS 2), ros1"),
+        )),
+    }
+}
+
+/// The bytes of a bytes-like object: `bytes` borrowed (immutable, so it can
+/// be read with the GIL released), anything else copied.
+enum MessageBytes<'py> {
+    Borrowed(Bound<'py, PyBytes>),
+    Owned(Vec<u8>),
+}
+
+impl MessageBytes<'_> {
+    fn as_slice(&self) -> &[u8] {
+        match self {
+            MessageBytes::Borrowed(b) => b.as_bytes(),
+            MessageBytes::Owned(v) => v,
+        }
+    }
+}
+
+fn message_bytes<'py>(data: &Bound<'py, PyAny>, what: &str) -> PyResult<MessageBytes<'py>> {
+    let py = data.py();
+    if let Ok(b) = data.cast::<PyBytes>() {
+        return Ok(MessageBytes::Borrowed(b.clone()));
+    }
+    // bytearray, memoryview, array.array('B'), numpy uint8 arrays, lists of ints
+    let copied = py
+        .import("builtins")?
+        .getattr("bytes")?
+        .call1((data,))
+        .map_err(|e| invalid_input(py, format!("{what} must be bytes-like: {}", e.value(py))))?
+        .cast_into::<PyBytes>()?
+        .as_bytes()
+        .to_vec();
+    Ok(MessageBytes::Owned(copied))
 }
 
 #[pymethods]
@@ -346,6 +406,123 @@ impl PyCloudFile {
         self.data.skipped
     }
 
+    /// Points of an organized scan left out because they lie at exactly the
+    /// sensor origin: the driver's no-return points (0 for an unorganized
+    /// cloud, which keeps such points).
+    #[getter]
+    fn at_origin(&self) -> usize {
+        self.data.at_origin
+    }
+
+    /// The no-return points of an organized scan: `at_origin` plus the NaN or
+    /// infinite ones (`skipped`). None of them is in `points`; the organized
+    /// layout keeps their pixels (`pixels` skips them). 0 when unorganized.
+    #[getter]
+    fn no_returns(&self) -> usize {
+        self.data.no_returns()
+    }
+
+    /// For a cloud read from a bag: its topic, else `None`.
+    #[getter]
+    fn topic(&self) -> Option<String> {
+        self.message.as_ref().and_then(|m| m.topic.clone())
+    }
+
+    /// For a cloud read from a bag: the message's index in its topic, else `None`.
+    #[getter]
+    fn index(&self) -> Option<usize> {
+        self.message.as_ref().and_then(|m| m.index)
+    }
+
+    /// For a cloud read from a message: the frame its points are expressed in
+    /// (the TF frame they were moved to, else the message's `frame_id`);
+    /// `None` for a file.
+    #[getter]
+    fn frame_id(&self) -> Option<String> {
+        self.message.as_ref().map(|m| m.frame_id.clone())
+    }
+
+    /// For a cloud read from a message: the message's `header.frame_id`, the
+    /// sensor's frame; `None` for a file.
+    #[getter]
+    fn sensor_frame(&self) -> Option<String> {
+        self.message.as_ref().map(|m| m.sensor_frame.clone())
+    }
+
+    /// For a cloud read from a message: `header.stamp` in nanoseconds since
+    /// the epoch; `None` for a file.
+    #[getter]
+    fn stamp(&self) -> Option<i64> {
+        self.message.as_ref().map(|m| m.stamp_ns)
+    }
+
+    /// Reads a serialized `sensor_msgs/PointCloud2` message, as a bag stores
+    /// it (`encoding` `"cdr"` for rosbag2, `"ros1"` for a ROS 1 bag), straight
+    /// from its bytes. The sensor sits at the origin of the message's frame;
+    /// `pose` (the frame's pose in `frame_id`, a `(4, 4)`) moves the points
+    /// and the sensor there. `name` goes into errors, `path` is the file.
+    #[staticmethod]
+    #[pyo3(signature = (message, encoding, *, name, path, pose=None, frame_id=None, topic=None, index=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _from_message(
+        py: Python<'_>,
+        message: &Bound<'_, PyAny>,
+        encoding: &str,
+        name: &str,
+        path: String,
+        pose: Option<&Bound<'_, PyAny>>,
+        frame_id: Option<String>,
+        topic: Option<String>,
+        index: Option<usize>,
+    ) -> PyResult<Self> {
+        let encoding = message_encoding(py, encoding)?;
+        let pose = pose
+            .map(|p| crate::convert::pose_from(py, Some(p), "pose"))
+            .transpose()?;
+        let bytes = message_bytes(message, "message")?;
+        let slice = bytes.as_slice();
+        let (data, header) = run_detached(py, move || {
+            let (mut data, header) = read_pointcloud2_message(slice, encoding, name)?;
+            data.sensor = Some(cloudprox::math::Pose::identity());
+            data.sensor_is_default = true;
+            if let Some(p) = &pose {
+                data.transform(p);
+            }
+            Ok((data, header))
+        })?;
+        let frame_id = frame_id.unwrap_or_else(|| header.frame_id.clone());
+        Ok(Self {
+            data: Arc::new(data),
+            path,
+            message: Some(MessageSource {
+                topic,
+                index,
+                sensor_frame: header.frame_id,
+                frame_id,
+                stamp_ns: header.stamp_ns,
+            }),
+        })
+    }
+
+    /// The `(frame_id, stamp)` of a serialized `sensor_msgs/PointCloud2`
+    /// message (stamp in nanoseconds), as `_from_message` decodes it.
+    #[staticmethod]
+    #[pyo3(signature = (message, encoding, *, name))]
+    fn _message_header(
+        py: Python<'_>,
+        message: &Bound<'_, PyAny>,
+        encoding: &str,
+        name: &str,
+    ) -> PyResult<(String, i64)> {
+        let encoding = message_encoding(py, encoding)?;
+        let bytes = message_bytes(message, "message")?;
+        let slice = bytes.as_slice();
+        let header = run_detached(py, move || {
+            decode_pointcloud2(slice, encoding, name).map(|m| m.header)
+        })?;
+        Ok((header.frame_id, header.stamp_ns))
+    }
+
     /// The file it was read from.
     #[getter]
     fn path(&self) -> &str {
@@ -387,6 +564,27 @@ impl PyCloudFile {
             None
         };
         let sensor_pose = sensor_pose.or(file_pose.as_ref());
+        // A laser scanner has no optical axis (a spinning lidar sees all around):
+        // its model takes the pose's origin only, so that the points behind the
+        // pose's +z are not refused as "not in front of the sensor".
+        let lidar = sensor.is_some_and(|s| s.cast::<crate::sensor::PyLidar>().is_ok());
+        let lidar_origin = match (lidar, origin, sensor_pose) {
+            (true, None, Some(p)) => {
+                let pose = crate::convert::pose_from(py, Some(p), "sensor_pose")?;
+                Some(
+                    points_to_py(
+                        py,
+                        &[cloudprox::math::Point3::from(pose.translation.vector)],
+                    )?
+                    .call_method1("reshape", (3,))?,
+                )
+            }
+            _ => None,
+        };
+        let (origin, sensor_pose) = match &lidar_origin {
+            Some(o) => (Some(o), None),
+            None => (origin, sensor_pose),
+        };
         let noise = if sigma.is_none() && cov.is_none() && sensor.is_none() {
             match self.data.covariances.as_ref() {
                 Some(c) => crate::cloud::Noise::Covariances(c.clone()),
@@ -422,8 +620,21 @@ impl PyCloudFile {
         let grid = self.data.grid.as_ref().map_or(String::new(), |g| {
             format!(", organized {}x{}", g.width, g.height)
         });
+        let source = self.message.as_ref().map_or(String::new(), |m| {
+            let topic = m
+                .topic
+                .as_deref()
+                .map_or(String::new(), |t| format!(" {t}"));
+            let index = m.index.map_or(String::new(), |i| format!(" #{i}"));
+            format!("{topic}{index} in {}", m.frame_id)
+        });
+        let no_returns = if self.data.grid.is_some() {
+            format!(", {} no-returns", self.data.no_returns())
+        } else {
+            String::new()
+        };
         format!(
-            "CloudFile({:?}: {} points{grid}, {} skipped, fields {:?})",
+            "CloudFile({:?}{source}: {} points{grid}, {} skipped{no_returns}, fields {:?})",
             self.path,
             self.data.points.len(),
             self.data.skipped,
@@ -575,7 +786,9 @@ fn point_field_from(obj: &Bound<'_, PyAny>, i: usize) -> PyResult<PointField> {
 /// Reads a ROS `sensor_msgs/PointCloud2` from its raw `data` bytes and layout
 /// (no ROS needed). `fields` are `(name, offset, datatype, count)` tuples or ROS
 /// `PointField` objects. NaN points (holes of organized clouds) are skipped and
-/// counted in `CloudFile.skipped`.
+/// counted in `CloudFile.skipped`; in an organized cloud, points at exactly
+/// `(0, 0, 0)` (no-returns) in `CloudFile.at_origin`. `bytes` are read in
+/// place, other bytes-like objects copied.
 #[pyfunction]
 #[pyo3(signature = (data, fields, *, height, width, point_step, row_step, is_bigendian=false))]
 pub fn read_pointcloud2(
@@ -588,18 +801,7 @@ pub fn read_pointcloud2(
     row_step: u32,
     is_bigendian: bool,
 ) -> PyResult<PyCloudFile> {
-    let bytes: Vec<u8> = if let Ok(b) = data.cast::<PyBytes>() {
-        b.as_bytes().to_vec()
-    } else {
-        // bytearray, memoryview, array.array('B'), numpy uint8 arrays, lists of ints
-        py.import("builtins")?
-            .getattr("bytes")?
-            .call1((data,))
-            .map_err(|e| invalid_input(py, format!("data must be bytes-like: {}", e.value(py))))?
-            .cast_into::<PyBytes>()?
-            .as_bytes()
-            .to_vec()
-    };
+    let bytes = message_bytes(data, "data")?;
     let fields = fields
         .try_iter()?
         .enumerate()
@@ -613,7 +815,10 @@ pub fn read_pointcloud2(
         point_step,
         row_step,
     };
-    let data = run_detached(py, move || read_pc2(&layout, &bytes))?;
+    let slice = bytes.as_slice();
+    let data = run_detached(py, move || {
+        read_pointcloud2_named(&layout, slice, "PointCloud2")
+    })?;
     Ok(PyCloudFile::new(data, "PointCloud2".to_string()))
 }
 

@@ -46,6 +46,7 @@ mod sample;
 mod scan;
 mod sensor;
 mod side;
+mod signed_distance;
 
 /// The compiled part of cloudprox.
 #[pymodule]
@@ -58,6 +59,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(collide::collide, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_along, m)?)?;
+    m.add_function(wrap_pyfunction!(collide::facing_pairs, m)?)?;
     m.add_class::<request::PyCollisionRequest>()?;
     m.add_class::<result::PyQueryStats>()?;
     m.add_class::<mesh::PyMesh>()?;
@@ -114,5 +116,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(robot::collide_robot, m)?)?;
     m.add_function(wrap_pyfunction!(robot::collide_robot_many, m)?)?;
     m.add_function(wrap_pyfunction!(robot::check_motion, m)?)?;
+    m.add_class::<signed_distance::PyMeshDistance>()?;
+    m.add_class::<signed_distance::PyDistanceField>()?;
     Ok(())
 }

@@ -387,7 +387,14 @@ impl ScanPipeline {
                          sensor's origin or pose for the sensor model",
                     )
                 })?;
-                model.covariances(&scan.points, vp).map(Some)
+                // A laser scanner has no optical axis (a spinning lidar sees all
+                // around): its model needs the origin only, and a pose's +z
+                // must not make the points behind it "not in front".
+                let vp = match model {
+                    SensorModel::Lidar(_) => Viewpoint::at(vp.origin),
+                    _ => *vp,
+                };
+                model.covariances(&scan.points, &vp).map(Some)
             }
         }
     }

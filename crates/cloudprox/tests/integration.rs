@@ -40,6 +40,7 @@ mod robot_collide;
 mod robot_model;
 mod scan_pipeline;
 mod shape_exact;
+mod shape_signed_distance;
 mod surface_elements;
 mod uncertainty_discretization;
 mod uncertainty_sensor;

@@ -571,3 +571,32 @@ fn organized_cloud_with_holes_round_trips_in_every_encoding() {
         assert_eq!(g.pixels, vec![0, 2, 3, 5]);
     }
 }
+
+#[test]
+fn organized_no_returns_at_the_viewpoint_origin_are_left_out() {
+    let body = "0 0 0\n1 0 2\nnan nan nan\n0 0 0\n0.5 0.5 1\n2 2 2\n";
+    let head = |viewpoint: &str, height: usize| {
+        format!(
+            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {}\n\
+             HEIGHT {height}\n{viewpoint}POINTS 6\nDATA ascii\n{body}",
+            6 / height
+        )
+    };
+    // The default viewpoint: the sensor at (0, 0, 0), where the driver put its no-returns.
+    let c = read_pcd(head("", 2).as_bytes(), "o.pcd").unwrap();
+    assert_eq!(
+        (c.points.len(), c.skipped, c.at_origin, c.no_returns()),
+        (3, 1, 2, 3)
+    );
+    assert_eq!(c.grid.as_ref().unwrap().pixels, vec![1, 4, 5]);
+    // A VIEWPOINT elsewhere: the points at its origin are the no-returns.
+    let c = read_pcd(head("VIEWPOINT 2 2 2 1 0 0 0\n", 2).as_bytes(), "o.pcd").unwrap();
+    assert_eq!((c.points.len(), c.at_origin), (4, 1));
+    assert_eq!(c.grid.as_ref().unwrap().pixels, vec![0, 1, 3, 4]);
+    // Unorganized: a point at the origin may be a real point, and is kept.
+    let c = read_pcd(head("", 1).as_bytes(), "o.pcd").unwrap();
+    assert_eq!(
+        (c.points.len(), c.skipped, c.at_origin, c.no_returns()),
+        (5, 1, 0, 0)
+    );
+}

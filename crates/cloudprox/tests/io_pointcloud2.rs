@@ -3,8 +3,9 @@
 use crate::common;
 
 use cloudprox::io::pointcloud2::{
-    read_pointcloud2, write_pointcloud2, PointCloud2Layout, PointField, FLOAT32, FLOAT64, INT16,
-    UINT8,
+    decode_pointcloud2, encode_pointcloud2, read_pointcloud2, read_pointcloud2_message,
+    read_pointcloud2_named, write_pointcloud2, MessageEncoding, PointCloud2Header,
+    PointCloud2Layout, PointField, FLOAT32, FLOAT64, INT16, UINT8,
 };
 use cloudprox::io::{CloudData, Grid};
 use cloudprox::prelude::*;
@@ -110,16 +111,19 @@ fn reads_organized_big_endian_with_holes() {
     let (layout, data) = organized();
     let c = read_pointcloud2(&layout, &data).unwrap();
     assert_eq!(c.skipped, 2);
+    // Pixel 0 is (0, -0, 0): a no-return of an organized cloud, left out.
+    assert_eq!(c.at_origin, 1);
+    assert_eq!(c.no_returns(), 3);
     assert_eq!(
         c.grid,
         Some(Grid {
             width: 3,
             height: 2,
-            pixels: vec![0, 2, 3, 4]
+            pixels: vec![2, 3, 4]
         })
     );
-    assert_eq!(c.points[1], Point3::new(2.0, -2.0, 4.0));
-    assert_eq!(c.points[3], Point3::new(4.0, -4.0, 8.0));
+    assert_eq!(c.points[0], Point3::new(2.0, -2.0, 4.0));
+    assert_eq!(c.points[2], Point3::new(4.0, -4.0, 8.0));
     assert_eq!(c.fields, ["y", "x", "z", "intensity", "ring"]);
     // Extra data past row_step * height is ignored.
     let mut longer = data.clone();
@@ -239,4 +243,220 @@ fn duplicate_and_empty_fields_are_named() {
     let empty = layout(vec![field("x", 0, 0), field("y", 4, 1), field("z", 8, 1)]);
     let msg = read_pointcloud2(&empty, &data).unwrap_err().to_string();
     assert!(msg.contains("field 'x' has count 0"), "{msg}");
+}
+
+/// A float32 organized 4 x 2 cloud (x y z at 0 4 8, intensity at 12) with a
+/// no-return at the origin and a NaN hole, little or big endian.
+fn float_grid(big: bool) -> (PointCloud2Layout, Vec<u8>) {
+    let pts: [[f32; 3]; 8] = [
+        [1.0, 0.0, 0.5],
+        [0.0, 0.0, 0.0],
+        [f32::NAN, 0.0, 0.0],
+        [-1.0, 2.0, 3.0],
+        [0.25, 0.5, 0.75],
+        [-0.0, 0.0, -0.0],
+        [4.0, 5.0, 6.0],
+        [7.0, 8.0, 9.0],
+    ];
+    let mut data = Vec::new();
+    for (i, p) in pts.iter().enumerate() {
+        for v in p.iter().chain(std::iter::once(&(i as f32))) {
+            data.extend_from_slice(&if big {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            });
+        }
+    }
+    let layout = PointCloud2Layout {
+        height: 2,
+        width: 4,
+        fields: vec![
+            field("x", 0, FLOAT32),
+            field("y", 4, FLOAT32),
+            field("z", 8, FLOAT32),
+            field("intensity", 12, FLOAT32),
+        ],
+        is_bigendian: big,
+        point_step: 16,
+        row_step: 64,
+    };
+    (layout, data)
+}
+
+#[test]
+fn organized_no_returns_are_counted_and_their_pixels_kept() {
+    for big in [false, true] {
+        let (layout, data) = float_grid(big);
+        let c = read_pointcloud2(&layout, &data).unwrap();
+        assert_eq!((c.skipped, c.at_origin, c.no_returns()), (1, 2, 3));
+        assert_eq!(c.grid.as_ref().unwrap().pixels, vec![0, 3, 4, 6, 7]);
+        assert_eq!(c.points[1], Point3::new(-1.0, 2.0, 3.0));
+        // The general reader (normals present) agrees with the float32 fast path.
+        let mut with_normals = layout.clone();
+        with_normals.point_step = 16;
+        with_normals.fields.push(field("normal_x", 12, FLOAT32));
+        with_normals.fields.push(field("normal_y", 12, FLOAT32));
+        with_normals.fields.push(field("normal_z", 12, FLOAT32));
+        let g = read_pointcloud2(&with_normals, &data).unwrap();
+        assert_eq!(g.points, c.points);
+        assert_eq!(g.grid, c.grid);
+        assert_eq!((g.skipped, g.at_origin), (1, 2));
+        // Unorganized: the origin points are kept (they may be real points).
+        let mut flat = layout.clone();
+        flat.height = 1;
+        flat.width = 8;
+        flat.row_step = 128;
+        let f = read_pointcloud2(&flat, &data).unwrap();
+        assert_eq!(
+            (f.points.len(), f.skipped, f.at_origin, f.no_returns()),
+            (7, 1, 0, 0)
+        );
+    }
+}
+
+#[test]
+fn serialized_messages_round_trip_in_both_encodings() {
+    let (layout, data) = float_grid(false);
+    let header = PointCloud2Header {
+        stamp_ns: 1_700_000_000_123_456_789,
+        frame_id: "velodyne".into(),
+        is_dense: false,
+    };
+    let direct = read_pointcloud2(&layout, &data).unwrap();
+    for encoding in [MessageEncoding::Cdr, MessageEncoding::Ros1] {
+        let bytes = encode_pointcloud2(&header, &layout, &data, encoding);
+        let msg = decode_pointcloud2(&bytes, encoding, "m").unwrap();
+        assert_eq!(msg.header, header);
+        assert_eq!(msg.layout, layout);
+        assert_eq!(msg.data, &data[..]);
+        // The data is borrowed from the message, not copied.
+        let start = bytes.as_ptr() as usize;
+        let at = msg.data.as_ptr() as usize;
+        assert!(at >= start && at + msg.data.len() <= start + bytes.len());
+        let (cloud, h) = read_pointcloud2_message(&bytes, encoding, "m").unwrap();
+        assert_eq!(cloud, direct);
+        assert_eq!(h, header);
+        // Every cut is a format error naming the message, never a panic.
+        for cut in 0..bytes.len() {
+            match read_pointcloud2_message(&bytes[..cut], encoding, "bag.db3 (topic /p)") {
+                Err(Error::Format { path, problem, .. }) => {
+                    assert_eq!(path, "bag.db3 (topic /p)");
+                    assert!(problem.contains("truncated"), "cut {cut}: {problem}");
+                }
+                other => panic!("cut {cut}: expected a format error, got {other:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn big_endian_cdr_and_bad_encapsulations() {
+    let (layout, data) = float_grid(true);
+    let header = PointCloud2Header {
+        stamp_ns: -5,
+        frame_id: String::new(),
+        is_dense: true,
+    };
+    // A big-endian CDR message, written by hand: encapsulation 0x0000.
+    let mut m = vec![0u8, 0, 0, 0];
+    let be = |m: &mut Vec<u8>, v: u32| {
+        while (m.len() - 4) % 4 != 0 {
+            m.push(0);
+        }
+        m.extend_from_slice(&v.to_be_bytes());
+    };
+    be(&mut m, (-1i32) as u32);
+    be(&mut m, 999_999_995);
+    be(&mut m, 1);
+    m.push(0); // frame_id "" with its NUL
+    be(&mut m, layout.height);
+    be(&mut m, layout.width);
+    be(&mut m, layout.fields.len() as u32);
+    for f in &layout.fields {
+        be(&mut m, f.name.len() as u32 + 1);
+        m.extend_from_slice(f.name.as_bytes());
+        m.push(0);
+        be(&mut m, f.offset);
+        m.push(f.datatype);
+        be(&mut m, f.count);
+    }
+    m.push(1);
+    be(&mut m, layout.point_step);
+    be(&mut m, layout.row_step);
+    be(&mut m, data.len() as u32);
+    m.extend_from_slice(&data);
+    m.push(1);
+    let msg = decode_pointcloud2(&m, MessageEncoding::Cdr, "be").unwrap();
+    assert_eq!(msg.header, header);
+    assert_eq!(msg.layout, layout);
+    let cloud = read_pointcloud2_named(&msg.layout, msg.data, "be").unwrap();
+    assert_eq!(cloud.points.len(), 5);
+    m[1] = 7;
+    format_err_named(
+        decode_pointcloud2(&m, MessageEncoding::Cdr, "be"),
+        "be",
+        "unsupported CDR encapsulation 0x0007",
+    );
+    // A field count the message cannot hold allocates nothing.
+    let mut huge = encode_pointcloud2(&header, &layout, &data, MessageEncoding::Ros1);
+    huge[4 + 8 + 4 + 8..4 + 8 + 4 + 12].copy_from_slice(&u32::MAX.to_le_bytes());
+    format_err_named(
+        decode_pointcloud2(&huge, MessageEncoding::Ros1, "huge"),
+        "huge",
+        "4294967295 fields announced",
+    );
+}
+
+#[test]
+fn missing_fields_name_the_message() {
+    let (mut layout, data) = float_grid(false);
+    layout.fields.retain(|f| f.name != "z");
+    let header = PointCloud2Header {
+        stamp_ns: 0,
+        frame_id: "f".into(),
+        is_dense: false,
+    };
+    let bytes = encode_pointcloud2(&header, &layout, &data, MessageEncoding::Cdr);
+    format_err_named(
+        read_pointcloud2_message(&bytes, MessageEncoding::Cdr, "b.mcap (topic /p, message 3)")
+            .map(|r| r.0),
+        "b.mcap (topic /p, message 3)",
+        "no field 'z' (fields: x, y, intensity)",
+    );
+}
+
+fn format_err_named<T: std::fmt::Debug>(r: Result<T>, name: &str, needle: &str) {
+    match r {
+        Err(Error::Format { problem, path, .. }) => {
+            assert_eq!(path, name);
+            assert!(
+                problem.contains(needle),
+                "{problem:?} does not mention {needle:?}"
+            );
+        }
+        other => panic!("expected a format error mentioning {needle:?}, got {other:?}"),
+    }
+}
+
+#[test]
+fn transform_moves_points_normals_covariances_and_sensor() {
+    use cloudprox::math::{Matrix3, Pose};
+    use nalgebra::{Translation3, UnitQuaternion};
+    let mut c = CloudData::from_points(vec![Point3::new(1.0, 0.0, 0.0)]);
+    c.normals = Some(vec![Vector3::x()]);
+    c.covariances = Some(vec![Matrix3::from_diagonal(&Vector3::new(4.0, 1.0, 1.0))]);
+    c.sensor = Some(Pose::identity());
+    c.sensor_is_default = true;
+    let pose = Pose::from_parts(
+        Translation3::new(0.0, 0.0, 2.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+    );
+    c.transform(&pose);
+    assert!((c.points[0] - Point3::new(0.0, 1.0, 2.0)).norm() < 1e-12);
+    assert!((c.normals.as_ref().unwrap()[0] - Vector3::y()).norm() < 1e-12);
+    let cov = c.covariances.as_ref().unwrap()[0];
+    assert!((cov - Matrix3::from_diagonal(&Vector3::new(1.0, 4.0, 1.0))).norm() < 1e-12);
+    assert_eq!(c.sensor, Some(pose));
+    assert!(!c.sensor_is_default);
 }

@@ -160,3 +160,81 @@ fn prefixes_and_bit_flips_never_panic() {
         });
     }
 }
+
+/// `n` rows of `x y z` followed by the given columns of each row.
+fn rows(extra: &dyn Fn(usize) -> Vec<String>, n: usize) -> String {
+    (0..n)
+        .map(|i| {
+            let mut r = vec![format!("{}", i as f64 * 0.1), "0.5".into(), "-1".into()];
+            r.extend(extra(i));
+            r.join(" ") + "\n"
+        })
+        .collect()
+}
+
+/// A unit normal per row, as a tool prints it (six decimals).
+fn normal(i: usize) -> [f64; 3] {
+    let a = i as f64 * 0.7;
+    [a.cos() * 0.6, a.sin() * 0.6, 0.8]
+}
+
+fn normal_text(i: usize) -> Vec<String> {
+    normal(i).iter().map(|v| format!("{v:.6}")).collect()
+}
+
+#[test]
+fn six_and_nine_columns_are_normals_and_colours_as_the_tools_write_them() {
+    // CGAL write_XYZ (kitten.xyz), Open3D .xyzn, MeshLab: x y z nx ny nz.
+    let c = read_xyz(rows(&normal_text, 5).as_bytes(), "kitten.xyz").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "nx", "ny", "nz"]);
+    let n = c.normals.unwrap();
+    for (i, v) in n.iter().enumerate() {
+        assert!((v - Vector3::from(normal(i))).norm() < 1e-6);
+    }
+    // Open3D .xyzrgb (0..1) and CloudCompare (0..255): x y z r g b.
+    let rgb01 = |i: usize| vec![format!("{}", i as f64 / 10.0), "0.25".into(), "1".into()];
+    let rgb255 = |i: usize| vec![format!("{}", i * 40), "7".into(), "255".into()];
+    for extra in [&rgb01 as &dyn Fn(usize) -> Vec<String>, &rgb255] {
+        let c = read_xyz(rows(extra, 5).as_bytes(), "c.xyz").unwrap();
+        assert_eq!(c.fields, ["x", "y", "z", "r", "g", "b"]);
+        assert!(c.normals.is_none());
+    }
+    // CloudCompare's default order: x y z r g b nx ny nz; and x y z nx ny nz r g b.
+    let cc = |i: usize| [rgb255(i), normal_text(i)].concat();
+    let c = read_xyz(rows(&cc, 5).as_bytes(), "cc.xyz").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "r", "g", "b", "nx", "ny", "nz"]);
+    assert!((c.normals.unwrap()[3] - Vector3::from(normal(3))).norm() < 1e-6);
+    let nc = |i: usize| [normal_text(i), rgb01(i)].concat();
+    let c = read_xyz(rows(&nc, 5).as_bytes(), "nc.txt").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "nx", "ny", "nz", "r", "g", "b"]);
+    assert!(c.normals.is_some());
+    // Neither: the names stay col3 ... (and so do other column counts).
+    let other = |i: usize| {
+        vec![
+            format!("{}", i as f64 * 3.5 - 2.0),
+            "-9".into(),
+            "12.5".into(),
+        ]
+    };
+    let c = read_xyz(rows(&other, 5).as_bytes(), "o.xyz").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "col3", "col4", "col5"]);
+    assert!(c.normals.is_none());
+    // Open3D's extensions say which: .xyzn normals, .xyzrgb colours.
+    let c = read_xyz(rows(&other, 2).as_bytes(), "o.xyzn").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "nx", "ny", "nz"]);
+    let c = read_xyz(rows(&normal_text, 2).as_bytes(), "o.xyzrgb").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "r", "g", "b"]);
+    assert!(c.normals.is_none());
+}
+
+#[test]
+fn cloudcompare_column_header_comment_names_the_columns() {
+    let text = "//X,Y,Z,R,G,B,Nx,Ny,Nz\n1,2,3,10,20,30,0,0,1\n4,5,6,40,50,60,1,0,0\n";
+    let c = read_xyz(text.as_bytes(), "cc.txt").unwrap();
+    assert_eq!(c.fields, ["X", "Y", "Z", "R", "G", "B", "Nx", "Ny", "Nz"]);
+    assert_eq!(c.normals.unwrap()[1], Vector3::x());
+    assert_eq!(c.points[1], Point3::new(4.0, 5.0, 6.0));
+    // A comment that does not name x y z for every column is just a comment.
+    let c = read_xyz(b"// two words\n1 2 3 0 0 1\n", "c.xyz").unwrap();
+    assert_eq!(c.fields, ["x", "y", "z", "nx", "ny", "nz"]);
+}

@@ -349,10 +349,18 @@ fn bad_input_gives_errors_naming_the_problem() {
         std_ratio: 2.0,
     };
     assert!(msg(iso.clone().step(far_k).run(&data)).contains("statistical_outlier_removal"));
-    // A sensor pose the scan's points are behind.
+    // A camera pose the scan's points are behind. A lidar has no optical
+    // axis: the same pose places it and its points all around are seen.
     let behind = Pose::new(Vector3::new(0.0, 0.0, 5.0), Vector3::zeros());
+    let camera = ScanPipeline::new(ScanNoise::Sensor(SensorModel::DepthCamera(
+        DepthCamera::default(),
+    )));
     assert!(
-        msg(lidar.placement(SensorPlacement::Pose(behind)).run(&data))
+        msg(camera.placement(SensorPlacement::Pose(behind)).run(&data))
             .contains("not in front of the sensor")
     );
+    assert!(lidar
+        .placement(SensorPlacement::Pose(behind))
+        .run(&data)
+        .is_ok());
 }

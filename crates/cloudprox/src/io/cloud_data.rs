@@ -60,9 +60,56 @@ pub struct CloudData {
     pub fields: Vec<String>,
     /// How many points were skipped because a coordinate was NaN or infinite.
     pub skipped: usize,
+    /// How many points of an organized scan were skipped because they lie at
+    /// exactly the sensor origin: the driver's no-return points (a lidar beam
+    /// or a depth pixel that measured nothing is written as the origin of the
+    /// sensor's frame). Their pixels are left out of [`Grid::pixels`], as the
+    /// NaN holes are; an unorganized cloud keeps such points (0 here).
+    pub at_origin: usize,
 }
 
 impl CloudData {
+    /// The no-return points of an organized scan: the points at exactly the
+    /// sensor origin ([`CloudData::at_origin`]) and the NaN or infinite ones
+    /// ([`CloudData::skipped`]), none of which is in [`CloudData::points`].
+    /// 0 for an unorganized cloud, whose non-finite points are only skipped.
+    pub fn no_returns(&self) -> usize {
+        if self.grid.is_some() {
+            self.skipped + self.at_origin
+        } else {
+            0
+        }
+    }
+
+    /// Moves the cloud by the rigid `pose`: points `p -> pose * p`, normals
+    /// rotated, covariances `R C R^T`, the sensor pose `pose * sensor`
+    /// (then no longer the format's default unless `pose` is the identity).
+    /// Everything else (grid, fields, counts) is kept.
+    pub fn transform(&mut self, pose: &Pose) {
+        if *pose == Pose::identity() {
+            return;
+        }
+        let r = pose.rotation.to_rotation_matrix().into_inner();
+        let t = pose.translation.vector;
+        for p in &mut self.points {
+            p.coords = r * p.coords + t;
+        }
+        if let Some(normals) = self.normals.as_mut() {
+            for n in normals {
+                *n = r * *n;
+            }
+        }
+        if let Some(covs) = self.covariances.as_mut() {
+            for c in covs {
+                *c = r * *c * r.transpose();
+            }
+        }
+        if let Some(s) = self.sensor.as_mut() {
+            *s = pose * *s;
+            self.sensor_is_default = false;
+        }
+    }
+
     /// Checks that the normals and covariances, when present, have one entry
     /// per point (what every writer needs).
     ///
@@ -176,6 +223,7 @@ impl CloudData {
             }),
             fields: self.fields.clone(),
             skipped: self.skipped,
+            at_origin: self.at_origin,
         })
     }
 
@@ -196,6 +244,7 @@ pub struct CloudDataBuilder {
     data: CloudData,
     pixels: Vec<u32>,
     organized: Option<(usize, usize)>,
+    no_return_origin: Option<Point3>,
     with_normals: bool,
     with_covariances: bool,
 }
@@ -222,15 +271,26 @@ impl CloudDataBuilder {
             data,
             pixels: Vec::new(),
             organized,
+            no_return_origin: None,
             with_normals: normals,
             with_covariances: covariances,
         }
     }
 
+    /// Sets where the sensor sat in the cloud's frame, for an organized
+    /// cloud: the points at exactly that position are no-returns, counted in
+    /// [`CloudData::at_origin`] and not kept. Ignored for an unorganized cloud.
+    pub fn set_no_return_origin(&mut self, origin: Option<Point3>) {
+        self.no_return_origin = origin.filter(|_| self.organized.is_some());
+    }
+
     /// Adds the point read at position `index` of the file (its pixel, for an
     /// organized cloud). A point with a non-finite coordinate is counted in
-    /// `skipped` and not kept. Normals and covariances must be given iff the
-    /// builder was made for them.
+    /// `skipped` and not kept; in an organized cloud, a point at exactly the
+    /// no-return origin ([`CloudDataBuilder::set_no_return_origin`]) is
+    /// counted in `at_origin` and not kept. Normals and covariances must be
+    /// given iff the builder was made for them.
+    #[inline]
     pub fn push(
         &mut self,
         index: usize,
@@ -240,6 +300,10 @@ impl CloudDataBuilder {
     ) {
         if !point.coords.iter().all(|c| c.is_finite()) {
             self.data.skipped += 1;
+            return;
+        }
+        if self.no_return_origin == Some(point) {
+            self.data.at_origin += 1;
             return;
         }
         self.data.points.push(point);

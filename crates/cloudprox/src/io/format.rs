@@ -14,7 +14,8 @@ pub enum CloudFormat {
     Ply,
     /// Point Cloud Library PCD (`.pcd`).
     Pcd,
-    /// Whitespace-separated text, one point per line (`.xyz`, `.txt`, `.pts`).
+    /// Whitespace-separated text, one point per line (`.xyz`, `.xyzn`, `.xyzrgb`,
+    /// `.txt`, `.pts`).
     Xyz,
     /// Comma-separated text, with or without a header line (`.csv`).
     Csv,
@@ -64,7 +65,7 @@ impl CloudFormat {
         Some(match extension(path).as_str() {
             "ply" => Self::Ply,
             "pcd" => Self::Pcd,
-            "xyz" | "txt" | "pts" => Self::Xyz,
+            "xyz" | "xyzn" | "xyzrgb" | "txt" | "pts" => Self::Xyz,
             "csv" => Self::Csv,
             "npy" => Self::Npy,
             "las" | "laz" => Self::Las,
@@ -124,7 +125,7 @@ fn unknown_extension(path: &Path, what: &str, known: &str) -> Error {
     ))
 }
 
-const CLOUD_EXTENSIONS: &str = ".ply .pcd .xyz .txt .pts .csv .npy .las .laz";
+const CLOUD_EXTENSIONS: &str = ".ply .pcd .xyz .xyzn .xyzrgb .txt .pts .csv .npy .las .laz";
 const MESH_EXTENSIONS: &str = ".stl .obj .ply .off";
 
 /// Reads a point cloud from `bytes`; `name` is used in errors.

@@ -10,8 +10,11 @@
 //! cov_xy cov_xz cov_yy cov_yz cov_zz` covariances. Fields with `COUNT > 1`
 //! (descriptors) and packed `rgb` are skipped but named in
 //! [`CloudData::fields`]. A cloud with `HEIGHT > 1` is organized: the pixel of
-//! each kept point is in [`CloudData::grid`], and NaN points (the holes of a
-//! depth image) are counted in [`CloudData::skipped`].
+//! each kept point is in [`CloudData::grid`], and its no-return points are
+//! left out and counted: NaN points (the holes of a depth image) in
+//! [`CloudData::skipped`], points at exactly the `VIEWPOINT`'s origin (where a
+//! lidar driver writes a beam that returned nothing, `0 0 0` in a raw frame)
+//! in [`CloudData::at_origin`].
 //!
 //! `VIEWPOINT tx ty tz qw qx qy qz` becomes [`CloudData::sensor`], as PCL reads
 //! it: the identity `0 0 0 1 0 0 0`, written or left out (the format's
@@ -432,6 +435,7 @@ pub fn read_pcd(bytes: &[u8], name: &str) -> Result<CloudData> {
     let (pose, default) = sensor(h.viewpoint, name)?;
     b.set_sensor(Some(pose));
     b.set_sensor_is_default(default);
+    b.set_no_return_origin(Some(Point3::from(pose.translation.vector)));
     let step = h
         .fields
         .iter()
