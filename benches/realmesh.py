@@ -26,10 +26,14 @@ set, at ``F`` times the level's sigma, while the poses and the metrics stay
 in the level's sigma, to see what the noise costs against what the sampling
 does; ``--bounds``: per row, the near-contact AUC the same scores reach with
 every pose beyond 1 and beyond 0.5 pair sigma of contact ranked perfectly).
-``--reliability``: per row, the reliability table behind its ECE (ECE,
-Brier score, log-loss and the worst bin holding 20 or more poses are columns of
-every row). ``--methods`` draws no random numbers, so a subset reads the same as the
-full run for the methods it keeps. Each pair's sampling spacing (in pair
+``--residuals``: the elements' standardized residuals ``(g_true - gap) / std``
+at facing pairs near contact against the exact meshes, by level (mean 0 and
+spread 1 when the gaps and their variances are right; bias and
+over-confidence show as either off). ``--reliability``: per row, the
+reliability table behind its ECE (ECE, Brier score, log-loss and the worst bin
+holding 20 or more poses are columns of every row). ``--methods`` draws no
+random numbers, so a subset reads the same as the full run for the methods it
+keeps. Each pair's sampling spacing (in pair
 sigma) is printed with its progress line.
 """
 
@@ -96,6 +100,45 @@ def fcl_times(a: cp.Mesh, b: cp.Mesh, poses: np.ndarray) -> tuple[float, float] 
         dist.append(t1 - t0)
         coll.append(t2 - t1)
     return float(np.median(dist)), float(np.median(coll))
+
+
+def residuals(
+    ma: cp.Mesh, mb: cp.Mesh, draw: m.Draw, q: np.ndarray, dist: np.ndarray, reach: float
+) -> dict[str, np.ndarray]:
+    """Return the standardized residuals of the elements' facing pairs near contact.
+
+    For every pose within ``reach`` of contact and every pair whose exact and
+    estimated gaps are both within ``reach``, each facing pair's probe is
+    moved onto its own exact mesh (its closest point there) and the exact gap
+    is that point's signed distance to the other exact mesh; the residual is
+    ``(g_true - gap) / std``, standard normal if the gaps and their variances
+    are right. Also returned: whether the probe lies beside the other element,
+    and the element's size in units of its probe's own standard deviation.
+    """
+    a = cp.PointCloud(draw.piano_points, cov=draw.piano_sensor_cov)
+    b = cp.PointCloud(draw.room_points, cov=draw.room_sensor_cov)
+    da, db = cp.MeshDistance(ma), cp.MeshDistance(mb)
+    out: dict[str, list[np.ndarray]] = {"z": [], "beside": [], "from_a": []}
+    for pose in q[np.abs(dist) <= reach]:
+        f = cp._native.facing_pairs(a, b, pose_a=pose)
+        if len(f["gap"]) == 0:
+            continue
+        probe, from_a = np.asarray(f["probe"]), np.asarray(f["from_a"])
+        rot, t = pose[:3, :3], pose[:3, 3]
+        g_true = np.empty(len(probe))
+        # A's probes: closest point on A (its own frame), back to the world, to B.
+        if from_a.any():
+            _, on_a, _ = da.closest((probe[from_a] - t) @ rot)
+            g_true[from_a] = db.signed_distance(np.asarray(on_a) @ rot.T + t)
+        if (~from_a).any():
+            _, on_b, _ = db.closest(probe[~from_a])
+            g_true[~from_a] = da.signed_distance((np.asarray(on_b) - t) @ rot)
+        # Pairs at the contact: both the exact and the estimated gap within reach.
+        at = (np.abs(g_true) <= reach) & (np.abs(np.asarray(f["gap"])) <= reach)
+        out["z"].append(((g_true - np.asarray(f["gap"])) / np.asarray(f["std"]))[at])
+        out["beside"].append(np.asarray(f["beside"])[at])
+        out["from_a"].append(from_a[at])
+    return {k: np.concatenate(v) if v else np.zeros(0) for k, v in out.items()}
 
 
 def poses(
@@ -216,6 +259,12 @@ def main() -> None:
         "share that truly collides)",
     )
     ap.add_argument(
+        "--residuals",
+        action="store_true",
+        help="also print the elements' standardized residuals (g_true - gap) / std at "
+        "facing pairs, poses within 3 pair sigma of contact, first draw",
+    )
+    ap.add_argument(
         "--noise-scale",
         type=float,
         default=1.0,
@@ -244,6 +293,7 @@ def main() -> None:
     rows: dict[tuple[float, str], list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = {}
     fcl_rows: dict[float, list[tuple[float, float]]] = {}
     sigmas: dict[float, float] = {}
+    resid: dict[float, dict[str, list[np.ndarray]]] = {}
     for level in (float(x) for x in args.levels.split(",")):
         sigma = level * DIAGONAL
         sigmas[level] = sigma
@@ -274,6 +324,10 @@ def main() -> None:
                         dist,
                     )
                 )
+            if args.residuals:
+                res = residuals(ma, mb, draws[0], q, dist, 3.0 * pair_sigma)
+                for k, v in res.items():
+                    resid.setdefault(level, {}).setdefault(k, []).append(v)
             times = fcl_times(ma, mb, q)
             if times is not None:
                 fcl_rows.setdefault(level, []).append(times)
@@ -338,6 +392,19 @@ def main() -> None:
         print(
             f"| {level:.1%} | python-fcl on the exact meshes: distance() {1e3 * d:.3f} ms, "
             f"collide() {1e3 * c:.3f} ms (medians of the pairs' medians) | | | | | | | |"
+        )
+    if resid:
+        print(
+            "\n| level | facing pairs | residual mean | residual sd | over: mean, sd "
+            "| beside: mean, sd |\n|---|---|---|---|---|---|"
+        )
+    for level, parts in resid.items():
+        z, bs = (np.concatenate(parts[k]) for k in ("z", "beside"))
+        bs = bs.astype(bool)
+        cell = lambda x: f"{np.mean(x):+.2f}, {np.std(x):.2f}" if len(x) else "-"  # noqa: E731
+        print(
+            f"| {level:.1%} | {len(z)} | {np.mean(z):+.2f} | {np.std(z):.2f} | "
+            f"{cell(z[~bs])} | {cell(z[bs])} |"
         )
     if reliability:
         print()
