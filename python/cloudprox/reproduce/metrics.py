@@ -85,6 +85,10 @@ class Metrics:
         ``nan`` marks a query answered but not timed on its own).
     n : int
         Number of answers (poses times draws).
+    ece, brier : float
+        Expected calibration error and Brier score of the score read as a
+        probability (clipped to ``[0, 1]``; see :func:`calibration`), NaN when
+        a score is NaN.
     """
 
     auc_all: float
@@ -97,6 +101,8 @@ class Metrics:
     false_negative_3s: float
     median_ms: float
     n: int
+    ece: float = float("nan")
+    brier: float = float("nan")
 
 
 def _share(mask: npt.NDArray[np.bool_], among: npt.NDArray[np.bool_]) -> float:
@@ -141,7 +147,15 @@ def compute_metrics(
         false_negative_3s=_share(st == "free", d < -HARD_SIGMA * sigma),
         median_ms=float(np.nanmedian(seconds) * 1e3),
         n=int(s.size),
+        **_calibration_scores(s, label),
     )
+
+
+def _calibration_scores(score: FloatArray, label: npt.NDArray[np.bool_]) -> dict[str, float]:
+    if not np.all(np.isfinite(score)):
+        return {}
+    cal = calibration(np.clip(score, 0.0, 1.0), label)
+    return {"ece": cal.ece, "brier": cal.brier}
 
 
 #: The reliability table's bins of ``P``: ten of equal width, as ECE is defined.

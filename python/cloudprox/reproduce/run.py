@@ -267,14 +267,15 @@ def check_claims(summary: Summary) -> list[Claim]:
 
 def _table(summary: Summary) -> str:
     head = (
-        "| level | method | AUC all | AUC near | Spearman | decided acc. | undecided | "
-        "hard flips | FP > 3σ | FN < -3σ | median ms |"
+        "| level | method | ECE | Brier | AUC all | AUC near | Spearman | decided acc. | "
+        "undecided | hard flips | FP > 3σ | FN < -3σ | median ms |"
     )
-    lines = [head, "|" + "---|" * 11]
+    lines = [head, "|" + "---|" * 13]
     fmt = lambda x, p=".3f": "–" if not math.isfinite(x) else format(x, p)  # noqa: E731
     for (level, name), mt in summary.metrics.items():
         lines.append(
-            f"| {level} | {name} | {fmt(mt.auc_all)} | {fmt(mt.auc_near)} | {fmt(mt.spearman)} | "
+            f"| {level} | {name} | {fmt(mt.ece)} | {fmt(mt.brier)} | {fmt(mt.auc_all)} | "
+            f"{fmt(mt.auc_near)} | {fmt(mt.spearman)} | "
             f"{fmt(mt.decided_accuracy)} | {fmt(mt.undecided, '.1%')} | "
             f"{fmt(mt.hard_flip, '.1%')} | "
             f"{fmt(mt.false_positive_3s, '.1%')} | {fmt(mt.false_negative_3s, '.1%')} | "
