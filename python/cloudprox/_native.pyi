@@ -751,11 +751,12 @@ class CollisionRequest:
         What is classified: every point (the paper's
         method), or the cloud's *surface elements*: groups of points that fit a
         smooth surface within their noise, built once per cloud, each standing
-        for its fitted surface with the covariance of the fit. With
-        ``"elements"``, ``P`` is the largest probability that the fitted
-        surfaces of two facing elements cross, and near regions hold tens of
-        samples at any noise level; per-point probabilities are still Eq. 3 of
-        each point. ``aggregation="surface"`` belongs to ``"points"``.
+        for its fitted surface with the covariance of the fit (the default).
+        With ``"elements"``, ``P`` is the probability that the two fitted
+        surfaces cross at the contact, from the contact's independent facing
+        readings (see docs/method.md), and near regions hold tens of samples at
+        any noise level; per-point probabilities are still Eq. 3 of each
+        point. ``aggregation="surface"`` belongs to ``"points"``.
     decide_only : bool, optional
         Return as soon as the state is decided: no per-point
         probabilities or separation estimates (NaN), and with ``max`` the query
