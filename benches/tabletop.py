@@ -26,6 +26,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benches.mbm.checkers import fcl_mesh, fcl_robot
 from tests.realfiles import real_file
 
 import cloudprox as cp
@@ -106,18 +107,6 @@ def scan(meshes: dict[str, cp.Mesh], seed: int, scale: float = 1.0) -> tuple[cp.
 # ---------------------------------------------------------------- python-fcl checkers
 
 
-def fcl_mesh(mesh: cp.Mesh) -> Any:
-    """Return a python-fcl BVH model of a mesh."""
-    import fcl
-
-    bvh = fcl.BVHModel()
-    v, f = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
-    bvh.beginModel(len(v), len(f))
-    bvh.addSubModel(v, f)
-    bvh.endModel()
-    return bvh
-
-
 class FclChecker:
     """The robot's exact link meshes against fixed collision objects (python-fcl managers)."""
 
@@ -125,14 +114,7 @@ class FclChecker:
         import fcl
 
         self.robot = robot
-        self.links = {
-            n: fcl.CollisionObject(fcl_mesh(m), fcl.Transform())
-            for n in robot.link_names
-            if (m := robot.link_mesh(n)) is not None
-        }
-        self.robot_manager = fcl.DynamicAABBTreeCollisionManager()
-        self.robot_manager.registerObjects(list(self.links.values()))
-        self.robot_manager.setup()
+        self.links, self.robot_manager = fcl_robot(robot)
         self.scene = fcl.DynamicAABBTreeCollisionManager()
         self.scene.registerObjects(objects)
         self.scene.setup()

@@ -46,6 +46,7 @@ __all__ = [
     "dense_states",
     "discrete_motion",
     "fcl_mesh",
+    "fcl_robot",
     "first_collision",
     "self_collision_check",
     "voxel_boxes",
@@ -92,6 +93,21 @@ def fcl_mesh(mesh: cp.Mesh) -> Any:
     return bvh
 
 
+def fcl_robot(robot: cp.Robot) -> tuple[dict[str, Any], Any]:
+    """Return the robot's links with meshes as python-fcl objects and their set-up manager."""
+    import fcl
+
+    links = {
+        n: fcl.CollisionObject(fcl_mesh(m), fcl.Transform())
+        for n in robot.link_names
+        if (m := robot.link_mesh(n)) is not None
+    }
+    manager = fcl.DynamicAABBTreeCollisionManager()
+    manager.registerObjects(list(links.values()))
+    manager.setup()
+    return links, manager
+
+
 class FclChecker:
     """The robot's exact link meshes against fixed python-fcl collision objects.
 
@@ -123,14 +139,7 @@ class FclChecker:
         self.robot = robot
         self.self_free = self_collision_check(robot, allowed)
         self.base_pose = None if base_pose is None else np.asarray(base_pose, dtype=float)
-        self.links = {
-            n: fcl.CollisionObject(fcl_mesh(m), fcl.Transform())
-            for n in robot.link_names
-            if (m := robot.link_mesh(n)) is not None
-        }
-        self.robot_manager = fcl.DynamicAABBTreeCollisionManager()
-        self.robot_manager.registerObjects(list(self.links.values()))
-        self.robot_manager.setup()
+        self.links, self.robot_manager = fcl_robot(robot)
         self.objects = list(objects)
         self.names = list(names) if names is not None else [str(i) for i in range(len(objects))]
         self.scene = fcl.DynamicAABBTreeCollisionManager()

@@ -20,6 +20,16 @@ pub(crate) struct ElementSide<'a> {
     pub label: Real,
 }
 
+impl ElementSide<'_> {
+    /// The elements placed in the separator's frame.
+    fn posed(&self) -> Vec<Posed<'_>> {
+        self.elements
+            .iter()
+            .map(|&e| Posed::new(e, &self.pose))
+            .collect()
+    }
+}
+
 /// An element moved into the separator's frame.
 struct Posed<'a> {
     e: &'a SurfaceElement,
@@ -451,8 +461,7 @@ pub(crate) fn elements_within_reach(
     b: &ElementSide<'_>,
     reach_sds: Real,
 ) -> bool {
-    let pa: Vec<Posed<'_>> = a.elements.iter().map(|&e| Posed::new(e, &a.pose)).collect();
-    let pb: Vec<Posed<'_>> = b.elements.iter().map(|&e| Posed::new(e, &b.pose)).collect();
+    let (pa, pb) = (a.posed(), b.posed());
     // Stops at the first pair within reach.
     let reaches = |own: &[Posed<'_>], other: &[Posed<'_>]| {
         let active = within_reach_of(own, other, reach_sds);
@@ -494,16 +503,7 @@ pub(crate) fn element_crossing_probabilities(
     sep: &Separator,
     reach_sds: Real,
 ) -> ElementCrossings {
-    let po: Vec<Posed<'_>> = own
-        .elements
-        .iter()
-        .map(|&e| Posed::new(e, &own.pose))
-        .collect();
-    let pt: Vec<Posed<'_>> = other
-        .elements
-        .iter()
-        .map(|&e| Posed::new(e, &other.pose))
-        .collect();
+    let (po, pt) = (own.posed(), other.posed());
     let mut out = ElementCrossings {
         values: vec![0.0; po.len()],
         described_max: 0.0,
@@ -783,16 +783,7 @@ pub(crate) fn element_facing_pairs(
     sep: &Separator,
     reach_sds: Real,
 ) -> Vec<FacingPair> {
-    let po: Vec<Posed<'_>> = own
-        .elements
-        .iter()
-        .map(|&e| Posed::new(e, &own.pose))
-        .collect();
-    let pt: Vec<Posed<'_>> = other
-        .elements
-        .iter()
-        .map(|&e| Posed::new(e, &other.pose))
-        .collect();
+    let (po, pt) = (own.posed(), other.posed());
     let active = within_reach_of(&po, &pt, reach_sds);
     let form = sep.quadratic_form(&Pose::identity());
     let mut out = Vec::new();
