@@ -547,9 +547,12 @@ pub(crate) fn element_crossing_probabilities(
 /// standard deviation ([`contact_probability`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ElementReading {
-    /// The probe's element.
+    /// The element of one side (the probe's, as a patch reads it; A's, once
+    /// a query pools both sides' readings): [`contact_probability`] takes the
+    /// readings of one pair of elements, from either side, by `(own, other)`,
+    /// so pooled readings must name the two sides in one order.
     pub own: u32,
-    /// The facing element.
+    /// The element of the other side.
     pub other: u32,
     /// The gap between the two fitted surfaces there.
     pub gap: Real,
