@@ -5,6 +5,7 @@ use crate::classify::Separator;
 use crate::element::{across_normal, height_row, hull_gap, Hull, SurfaceElement, HALF_SPACING};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::gaussian::wrong_side;
+use crate::probability::ElementReading;
 use crate::Real;
 
 /// Elements of the other side tried as the facing one (the nearest by mean).
@@ -536,117 +537,12 @@ pub(crate) fn element_crossing_probabilities(
                 gap: r.gap,
                 std: r.std,
                 beside: f.key.0,
+                contact: 0,
             });
         }
         true
     });
     out
-}
-
-/// What one facing pair within reach reads: the two elements, the gap and its
-/// standard deviation ([`contact_probability`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ElementReading {
-    /// The element of one side (the probe's, as a patch reads it; A's, once
-    /// a query pools both sides' readings): [`contact_probability`] takes the
-    /// readings of one pair of elements, from either side, by `(own, other)`,
-    /// so pooled readings must name the two sides in one order.
-    pub own: u32,
-    /// The element of the other side.
-    pub other: u32,
-    /// The gap between the two fitted surfaces there.
-    pub gap: Real,
-    /// Its standard deviation.
-    pub std: Real,
-    /// Whether the probe lies beside the facing element (the gap read between
-    /// two surfaces' ends) rather than over it.
-    pub beside: bool,
-}
-
-/// How far apart, in the standard deviations of their difference, two
-/// element pairs' gaps may read and still be taken for readings of one
-/// contact ([`contact_probability`]).
-pub(crate) const CONTACT_WINDOW: Real = 2.0;
-
-/// The probability that the two sampled surfaces cross at a contact, from the
-/// facing pairs' readings: each an element pair (`own` one side's element,
-/// `other` the other side's, as indices that name the same element wherever
-/// it appears), its gap, the gap's standard deviation, and whether it was
-/// read beside the facing element rather than over it.
-///
-/// Each element pair is read once, by its most critical reading (the smallest
-/// `gap / std`) among those read over the facing element, or among its
-/// readings beside it where it has none over it: two surfaces' ends say less
-/// of a crossing than one surface over the other (their gap is uncertain by
-/// where each sampled surface ends). The most critical of these read over a
-/// surface places the contact (one beside only where none is over). The readings whose gaps agree with it within `CONTACT_WINDOW` (2)
-/// standard deviations of their difference read the same contact; taken once
-/// per element (an element's surface error is one random field: two readings
-/// sharing an element are not independent), the contact's own reading first
-/// and then the most precise, they are independent estimates of the gap
-/// there, and their inverse-variance mean `g` with standard deviation
-/// `s = (sum 1/s_k^2)^(-1/2)` estimates it: `P = Phi(-g / s)`. (A small
-/// element's imprecise reading at the contact keeps its elements' other
-/// readings out: its surface is read as its own, so a face split into a large
-/// and a small element is as uncertain as the small one where it meets the
-/// other surface.)
-///
-/// The largest single tail `max_k Phi(-g_k / s_k)` reads the minimum of many
-/// noisy readings, which is biased towards a crossing wherever several
-/// elements face each other (measured: on real meshes at 0.5% noise, of the
-/// poses it put between 0.3 and 0.7, none collided); the standardized residuals
-/// of the single readings against exact geometry are standard normal, so the
-/// readings themselves are honest and the aggregation was what overstated.
-/// 0 without readings.
-pub fn contact_probability(readings: &[ElementReading]) -> Real {
-    let z = |r: &ElementReading| {
-        if r.std > 0.0 {
-            r.gap / r.std
-        } else if r.gap > 0.0 {
-            Real::INFINITY
-        } else {
-            Real::NEG_INFINITY
-        }
-    };
-    // One reading per element pair: over before beside, then most critical.
-    let mut order: Vec<&ElementReading> = readings.iter().collect();
-    order.sort_by(|x, y| {
-        (x.own, x.other, x.beside)
-            .cmp(&(y.own, y.other, y.beside))
-            .then(z(x).total_cmp(&z(y)))
-    });
-    order.dedup_by(|x, y| (x.own, x.other) == (y.own, y.other));
-    // The contact is placed by the most critical reading over a surface, by
-    // one beside only where there is none over.
-    order.sort_by(|x, y| x.beside.cmp(&y.beside).then(z(x).total_cmp(&z(y))));
-    let Some(first) = order.first() else {
-        return 0.0;
-    };
-    let (g0, s0) = (first.gap, first.std);
-    if s0.is_nan() || s0 <= 0.0 {
-        return wrong_side(g0, s0);
-    }
-    // The contact's own reading first, then the most precise: readings far
-    // from the contact agree with it only loosely, and must not keep out a
-    // more precise reading of the same elements nearer to it.
-    order[1..].sort_by(|x, y| x.std.total_cmp(&y.std));
-    let (mut used_own, mut used_other): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
-    let (mut weights, mut weighted) = (0.0, 0.0);
-    for r in order {
-        let (g, s) = (r.gap, r.std);
-        if s.is_nan() || s <= 0.0 || used_own.contains(&r.own) || used_other.contains(&r.other) {
-            continue;
-        }
-        if (g - g0).abs() > CONTACT_WINDOW * (s * s + s0 * s0).sqrt() {
-            continue;
-        }
-        used_own.push(r.own);
-        used_other.push(r.other);
-        let w = 1.0 / (s * s);
-        weights += w;
-        weighted += w * g;
-    }
-    wrong_side(weighted / weights, weights.recip().sqrt())
 }
 
 /// What one facing pair reads (see [`element_crossing_probabilities`]).

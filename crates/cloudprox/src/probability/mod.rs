@@ -10,6 +10,7 @@
 //! - [`Thresholds`] and [`CollisionState`]: the decision `free` / `contact` / `collision`.
 
 mod aggregation;
+mod contact;
 mod crossing;
 mod element;
 mod gaussian;
@@ -18,10 +19,10 @@ mod state;
 
 pub(crate) use aggregation::NEIGHBOURHOOD;
 pub use aggregation::{surface_probability, Aggregation};
+pub use contact::{contact_probability, ElementReading};
 pub use crossing::crossing_probabilities;
 pub(crate) use crossing::{crossing_probabilities_in, CrossingSide};
 pub use element::FacingPair;
-pub use element::{contact_probability, ElementReading};
 pub(crate) use element::{
     element_crossing_probabilities, element_facing_pairs, element_pair_crosses,
     element_pair_within_reach, elements_within_reach, ElementSide,

@@ -401,7 +401,11 @@ fn collide_segmentation(
             let (own_a, own_b) = (&pts[..na], &pts[na..]);
             let (cov_a, cov_b) = (&covs[..na], &covs[na..]);
             let contact = crossings.as_ref().map(|c| {
-                readings.extend_from_slice(&c.3);
+                let of_region = |r: &ElementReading| ElementReading {
+                    contact: component.component,
+                    ..*r
+                };
+                readings.extend(c.3.iter().map(of_region));
                 contact_probability(&c.3)
             });
             let (qa, qb) = match (crossings, request.aggregation) {
