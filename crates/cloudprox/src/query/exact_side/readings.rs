@@ -1,0 +1,111 @@
+//! The cloud's surface elements read against the exact surface.
+
+use crate::element::{across_normal, SurfaceElement, SurfaceElements, HALF_SPACING};
+use crate::math::Vector3;
+use crate::probability::ElementReading;
+use crate::query::exact_side::frame::{Frame, Standing};
+use crate::Real;
+
+/// What the elements of one segmentation read against the surface.
+pub(crate) struct ElementScan {
+    /// Every reading within the noise's reach, with the element as `own`
+    /// and as `other` alike (the exact side has no element: its surface adds
+    /// no error, so no two readings share one of its errors).
+    pub readings: Vec<ElementReading>,
+    /// The elements within reach of the surface or deep inside it, each with
+    /// whether some reading of it is at or inside the surface.
+    pub near: Vec<(u32, bool)>,
+    /// Elements whose hull was tested against the surface.
+    pub tested: usize,
+}
+
+/// The readings of every element of `els` within reach of the surface
+/// (see the [module docs](crate::query::exact_side)).
+pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> ElementScan {
+    let mut scan = ElementScan {
+        readings: Vec::new(),
+        near: Vec::new(),
+        tested: 0,
+    };
+    for (k, e) in els.elements().iter().enumerate() {
+        let k = k as u32;
+        scan.tested += 1;
+        let before = scan.readings.len();
+        match frame.standing(els, k) {
+            Standing::Beyond => continue,
+            Standing::Deep => scan.readings.push(deep_reading(frame, els, k)),
+            Standing::Near if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
+            Standing::Near => probe_readings(frame, e, k, &mut scan.readings),
+        }
+        let touching = scan.readings[before..].iter().any(|r| r.gap <= 0.0);
+        scan.near.push((k, touching));
+    }
+    scan
+}
+
+/// A single point's reading: its signed distance and its covariance along
+/// the distance's gradient (Eq. 3). Always within reach (the broad phase
+/// found the surface within reach of it).
+fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
+    let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
+    let n = frame.to_cloud(&c.normal);
+    reading(k, c.signed_distance, n.dot(&(e.cov_mean * n)))
+}
+
+/// An element found deep inside: its least deep point lies at most its
+/// hull's radius above its mean, still beyond the reach inside.
+fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementReading {
+    let hull = els.hulls().hull(k);
+    let sd = frame.mesh.signed_distance(&frame.to_mesh(&hull.mean));
+    reading(k, sd + hull.radius, hull.sigma * hull.sigma)
+}
+
+/// The readings at the probes of a surface element: at each, the signed
+/// distance of the fitted surface's point there to the mesh, and its
+/// variance along the distance's gradient `n`: the fitted height's along the
+/// element's normal, the mean's across it, and the position of the sampled
+/// edge where the probe lies within half a spacing of it. Readings beyond
+/// reach (`sd > h/2 + reach s`, `h` the spacing) are left out; every reading
+/// inside the surface is kept (the element's surface is inside the solid).
+fn probe_readings(frame: &Frame<'_>, e: &SurfaceElement, k: u32, out: &mut Vec<ElementReading>) {
+    let across = across_normal(e);
+    let allowed = HALF_SPACING * e.spacing;
+    for &[u, v] in &e.probes {
+        let (x, var_h) = e.surface_point(u, v);
+        let c = frame.mesh.closest(&frame.to_mesh(&x));
+        let n = frame.to_cloud(&c.normal);
+        let along = e.normal.dot(&n);
+        let var = var_h * along * along + n.dot(&(across * n)) + edge_var_along(e, u, v, &n);
+        let r = reading(k, c.signed_distance, var);
+        if r.gap <= allowed + frame.reach * r.std {
+            out.push(r);
+        }
+    }
+}
+
+/// The reading of element `k` with gap `gap` and variance `var`.
+fn reading(k: u32, gap: Real, var: Real) -> ElementReading {
+    ElementReading {
+        own: k,
+        other: k,
+        gap,
+        std: var.max(0.0).sqrt(),
+        beside: false,
+    }
+}
+
+/// The variance that the position of the element's sampled edges adds along
+/// `dir` at tangential coordinates `(u, v)`: within half a spacing of an
+/// edge, the edge is known to half a spacing along the tangent across it,
+/// which moves the surface's end by `t . dir` of that (as the two-cloud
+/// readings count it for a probe's own element).
+fn edge_var_along(e: &SurfaceElement, u: Real, v: Real, dir: &Vector3) -> Real {
+    let half = HALF_SPACING * e.spacing;
+    let [[u0, u1], [v0, v1]] = e.extent;
+    [(u - u0).min(u1 - u), (v - v0).min(v1 - v)]
+        .iter()
+        .zip(&e.tangents)
+        .filter(|(to_edge, _)| **to_edge <= half)
+        .map(|(_, t)| (t.dot(dir) * half).powi(2))
+        .sum()
+}
