@@ -52,7 +52,7 @@ def test_either_order_and_many_poses_agree(sphere_cloud: cp.PointCloud) -> None:
     poses = np.stack([cube_pose(g * SIGMA) for g in (20.0, 2.0, 0.0, -3.0)])
     many = cp.collide_many(cube, sphere_cloud, poses)
     along = cp.collide_along(cube, sphere_cloud, poses)
-    for pose, m, a in zip(poses, many, along):
+    for pose, m, a in zip(poses, many, along, strict=True):
         one = cp.collide(cube, sphere_cloud, pose_a=pose)
         ba = cp.collide(sphere_cloud, cube, pose_b=pose)
         assert m.probability == one.probability == a.probability
@@ -61,7 +61,7 @@ def test_either_order_and_many_poses_agree(sphere_cloud: cp.PointCloud) -> None:
     # The cloud moving against a fixed mesh: the same relative poses.
     inverse = np.stack([np.linalg.inv(p) for p in poses])
     moved = cp.collide_many(sphere_cloud, cube, inverse)
-    for m, b in zip(many, moved):
+    for m, b in zip(many, moved, strict=True):
         assert b.probability == pytest.approx(m.probability, abs=1e-9)
 
 

@@ -5,7 +5,7 @@ use crate::bvh::Aabb;
 use crate::element::{Hull, SurfaceElements};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::normal_quantile;
-use crate::shape::MeshDistance;
+use crate::shape::{ClosestPoint, MeshDistance};
 use crate::Real;
 
 /// One query's view of the cloud from the mesh's own frame, where every
@@ -25,12 +25,13 @@ pub(crate) struct Frame<'a> {
 }
 
 /// Where an element stands against the surface after the broad phase.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Standing {
     /// Farther outside than the noise can reach: it reads nothing.
     Beyond,
-    /// Within reach of the surface.
-    Near,
+    /// Within reach of the surface: the surface's point closest to the
+    /// element's mean (mesh frame).
+    Near(Point3),
     /// Inside the mesh, farther from its surface than the reach.
     Deep,
 }
@@ -54,9 +55,26 @@ impl<'a> Frame<'a> {
         self.rel * p
     }
 
+    /// A point of the mesh's frame in the cloud's.
+    pub fn to_cloud_point(&self, p: &Point3) -> Point3 {
+        self.rel.inverse_transform_point(p)
+    }
+
     /// A direction of the mesh's frame in the cloud's.
     pub fn to_cloud(&self, v: &Vector3) -> Vector3 {
         self.rotation.transpose() * v
+    }
+
+    /// The mesh's closest point to `x` (mesh frame) if the surface lies
+    /// within `radius` of it or `x` is inside; `None` says `x` lies outside,
+    /// farther than `radius` (a bounded search: a point far from the surface
+    /// costs a few box tests).
+    pub fn closest_near(&self, x: &Point3, radius: Real) -> Option<ClosestPoint> {
+        if let Some(c) = self.mesh.closest_within(x, radius) {
+            return Some(c);
+        }
+        let inside = self.bounds.distance_squared_to_point(x) == 0.0 && self.mesh.contains(x);
+        inside.then(|| self.mesh.closest(x))
     }
 
     /// Where element `e` of `els` stands: its hull (every point of its
@@ -72,8 +90,8 @@ impl<'a> Frame<'a> {
         if to_box > limit * limit {
             return Standing::Beyond;
         }
-        if self.mesh.closest_within(&centre, limit).is_some() {
-            Standing::Near
+        if let Some(c) = self.mesh.closest_within(&centre, limit) {
+            Standing::Near(c.point)
         } else if to_box == 0.0 && self.mesh.contains(&centre) {
             Standing::Deep
         } else {

@@ -1,7 +1,7 @@
 //! The cloud's surface elements read against the exact surface.
 
 use crate::element::{across_normal, SurfaceElement, SurfaceElements, HALF_SPACING};
-use crate::math::Vector3;
+use crate::math::{Point3, Vector3};
 use crate::probability::ElementReading;
 use crate::query::exact_side::frame::{Frame, Standing};
 use crate::Real;
@@ -34,8 +34,11 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
         match frame.standing(els, k) {
             Standing::Beyond => continue,
             Standing::Deep => scan.readings.push(deep_reading(frame, els, k)),
-            Standing::Near if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
-            Standing::Near => probe_readings(frame, e, k, &mut scan.readings),
+            Standing::Near(_) if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
+            Standing::Near(start) => {
+                let radius = probe_radius(frame, els, k);
+                probe_readings(frame, e, k, (radius, start), &mut scan.readings);
+            }
         }
         let touching = scan.readings[before..].iter().any(|r| r.gap <= 0.0);
         scan.near.push((k, touching));
@@ -67,20 +70,96 @@ fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementRead
 /// edge where the probe lies within half a spacing of it. Readings beyond
 /// reach (`sd > h/2 + reach s`, `h` the spacing) are left out; every reading
 /// inside the surface is kept (the element's surface is inside the solid).
-fn probe_readings(frame: &Frame<'_>, e: &SurfaceElement, k: u32, out: &mut Vec<ElementReading>) {
-    let across = across_normal(e);
+/// Each probe's surface is searched within `radius` ([`probe_radius`]: every
+/// reading within reach lies within it). Then from the mesh's point
+/// closest to the probe nearest the surface, or from `start` (its point
+/// closest to the element's mean) when no probe is within `radius`, towards
+/// the element's point nearest the surface ([`refine`]).
+fn probe_readings(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (radius, start): (Real, Point3),
+    out: &mut Vec<ElementReading>,
+) {
     let allowed = HALF_SPACING * e.spacing;
+    let mut best: (Real, Point3) = (Real::INFINITY, start);
     for &[u, v] in &e.probes {
-        let (x, var_h) = e.surface_point(u, v);
-        let c = frame.mesh.closest(&frame.to_mesh(&x));
-        let n = frame.to_cloud(&c.normal);
-        let along = e.normal.dot(&n);
-        let var = var_h * along * along + n.dot(&(across * n)) + edge_var_along(e, u, v, &n);
-        let r = reading(k, c.signed_distance, var);
+        let Some((r, closest)) = read_at(frame, e, k, (u, v), radius) else {
+            continue;
+        };
+        if r.gap < best.0 {
+            best = (r.gap, closest);
+        }
         if r.gap <= allowed + frame.reach * r.std {
             out.push(r);
         }
     }
+    refine(frame, e, k, best, out);
+}
+
+/// A search radius for an element's probes that holds every reading within
+/// reach: half a spacing plus the reach times a bound on the reading's
+/// standard deviation (the hull's bound along any direction, with the
+/// sampled edges' half spacing along two tangents).
+fn probe_radius(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> Real {
+    let hull = els.hulls().hull(k);
+    let e = &els.elements()[k as usize];
+    let half = HALF_SPACING * e.spacing;
+    half + frame.reach * (hull.sigma * hull.sigma + 2.0 * half * half).sqrt()
+}
+
+/// Steps from the probe nearest the surface towards the element's point
+/// nearest it: the surface point straight across from the mesh's closest
+/// point, where the element was sampled (a mesh's corner pressed into the
+/// surface between the probes is read there), at most [`REFINE_STEPS`]
+/// times while the gap shrinks; each step's reading within reach is kept.
+fn refine(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (mut gap, mut closest): (Real, Point3),
+    out: &mut Vec<ElementReading>,
+) {
+    let [[u0, u1], [v0, v1]] = e.extent;
+    for _ in 0..REFINE_STEPS {
+        let q = frame.to_cloud_point(&closest) - e.mean;
+        let (u, v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
+        if !((u0..=u1).contains(&u) && (v0..=v1).contains(&v) && e.covers(u, v)) {
+            return;
+        }
+        let Some((r, next)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
+            return;
+        };
+        if r.gap >= gap - 1e-12 * e.spacing {
+            return;
+        }
+        if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
+            out.push(r);
+        }
+        (gap, closest) = (r.gap, next);
+    }
+}
+
+/// Steps of [`refine`].
+const REFINE_STEPS: usize = 3;
+
+/// The reading of element `k`'s fitted surface at tangential coordinates
+/// `(u, v)` (see [`probe_readings`]) and the mesh's closest point to it;
+/// `None` if the surface point lies outside, farther than `radius`.
+fn read_at(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (u, v): (Real, Real),
+    radius: Real,
+) -> Option<(ElementReading, Point3)> {
+    let (x, var_h) = e.surface_point(u, v);
+    let c = frame.closest_near(&frame.to_mesh(&x), radius)?;
+    let n = frame.to_cloud(&c.normal);
+    let along = e.normal.dot(&n);
+    let var = var_h * along * along + n.dot(&(across_normal(e) * n)) + edge_var_along(e, u, v, &n);
+    Some((reading(k, c.signed_distance, var), c.point))
 }
 
 /// The reading of element `k` with gap `gap` and variance `var`.
