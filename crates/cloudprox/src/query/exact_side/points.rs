@@ -11,18 +11,18 @@ use crate::shape::ClosestPoint;
 use crate::Real;
 
 /// `p_i = Phi(-sd(x_i) / sqrt(n^T Sigma_i n))` for the points of the
-/// elements `near` (each with whether it touches the surface; see
-/// [`super::readings::ElementScan::near`]), 0 for every other point of
-/// `cloud`.
+/// elements `near` (see [`super::readings::ElementScan::near`]), 0 for every
+/// other point of `cloud`.
 ///
-/// Each point's surface is searched within the noise's reach of it
-/// (`reach` times its largest standard deviation): a point with no surface
-/// there lies farther than the reach outside (`p < epsilon / 2`, stored as
-/// 0) or inside, which is asked only of the points of touching elements
-/// (an element whose readings all lie outside has its points outside but
-/// for noise beyond the reach). The previous point's closest point bounds
-/// the search (the surface is at most that far): an element's points lie
-/// together, so most searches are short.
+/// Only points within the noise's reach of the surface (`reach` times the
+/// point's largest standard deviation) or inside are read exactly; the
+/// others have `p < epsilon / 2`, stored as 0. An element's points lie
+/// together: each search is bounded by the previous point's closest point
+/// (the surface lies at most that far), and a point is passed over without
+/// one when the previous point's distance `d`, less the step between them,
+/// exceeds its reach while the previous point was outside (the ball of
+/// radius `d` about it holds no surface, so the point lies outside too,
+/// beyond its reach).
 pub(crate) fn point_probabilities(
     frame: &Frame<'_>,
     cloud: &PointCloud,
@@ -31,15 +31,21 @@ pub(crate) fn point_probabilities(
 ) -> Result<PointProbabilities> {
     let sigma = cloud.sigma_max();
     let mut pairs: Vec<(u32, Real)> = Vec::new();
-    for &(e, touching) in near {
-        let mut last: Option<Point3> = None;
+    for &(e, _) in near {
+        let mut last: Option<(Point3, ClosestPoint)> = None;
         for (i, p, cov) in els.members(e) {
             let x = frame.to_mesh(p);
             let radius = frame.reach * sigma[i as usize];
-            let Some(c) = closest_for_point(frame, &x, radius, last, touching) else {
+            if let Some((xr, cr)) = &last {
+                if !cr.is_inside() && cr.distance() - (x - xr).norm() > radius {
+                    continue;
+                }
+            }
+            let c = closest_from(frame, &x, last.as_ref().map(|(_, c)| &c.point));
+            last = Some((x, c));
+            if !c.is_inside() && c.distance() > radius {
                 continue;
-            };
-            last = Some(c.point);
+            }
             let n = frame.to_cloud(&c.normal);
             let value = point_probability(c.signed_distance, &n, cov, 1.0).clamp(0.0, 1.0);
             if value > 0.0 {
@@ -53,40 +59,16 @@ pub(crate) fn point_probabilities(
     PointProbabilities::from_sparse(cloud.len(), indices, values)
 }
 
-/// The surface's closest point to `x` (mesh frame) if it lies within
-/// `radius` or `x` is inside (asked only when `touching`), searched no
-/// farther than `last` (a point of the surface) when given.
-fn closest_for_point(
-    frame: &Frame<'_>,
-    x: &Point3,
-    radius: Real,
-    last: Option<Point3>,
-    touching: bool,
-) -> Option<ClosestPoint> {
-    let Some(q) = last else {
-        return frame
-            .mesh
-            .closest_within(x, radius)
-            .or_else(|| (touching && frame.mesh.contains(x)).then(|| frame.mesh.closest(x)));
+/// The surface's closest point to `x` (mesh frame), searched no farther
+/// than `hint` (a point of the surface) when given.
+fn closest_from(frame: &Frame<'_>, x: &Point3, hint: Option<&Point3>) -> ClosestPoint {
+    let Some(q) = hint else {
+        return frame.mesh.closest(x);
     };
-    // The surface is within `hint` of `x`; a margin over the rounding.
-    let hint = (x - q).norm() * (1.0 + 1e-9) + 1e-12;
-    if hint <= radius {
-        return frame
-            .mesh
-            .closest_within(x, hint)
-            .or_else(|| Some(frame.mesh.closest(x)));
-    }
-    if let Some(c) = frame.mesh.closest_within(x, radius) {
-        return Some(c);
-    }
-    if !touching {
-        return None;
-    }
-    // Farther than the reach: inside (certain wrong side) or outside (none).
-    let c = frame
+    // A margin over the rounding.
+    let bound = (x - q).norm() * (1.0 + 1e-9) + 1e-12;
+    frame
         .mesh
-        .closest_within(x, hint)
-        .unwrap_or_else(|| frame.mesh.closest(x));
-    c.is_inside().then_some(c)
+        .closest_within(x, bound)
+        .unwrap_or_else(|| frame.mesh.closest(x))
 }
