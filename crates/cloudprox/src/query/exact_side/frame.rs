@@ -29,9 +29,9 @@ pub(crate) struct Frame<'a> {
 pub(crate) enum Standing {
     /// Farther outside than the noise can reach: it reads nothing.
     Beyond,
-    /// Within reach of the surface: the surface's point closest to the
-    /// element's mean (mesh frame).
-    Near(Point3),
+    /// Within reach of the surface: the element's mean and the surface's
+    /// point closest to it (mesh frame).
+    Near(Point3, ClosestPoint),
     /// Inside the mesh, farther from its surface than the reach.
     Deep,
 }
@@ -91,7 +91,7 @@ impl<'a> Frame<'a> {
             return Standing::Beyond;
         }
         if let Some(c) = self.mesh.closest_within(&centre, limit) {
-            Standing::Near(c.point)
+            Standing::Near(centre, c)
         } else if to_box == 0.0 && self.mesh.contains(&centre) {
             Standing::Deep
         } else {

@@ -4,6 +4,7 @@ use crate::element::{across_normal, SurfaceElement, SurfaceElements, HALF_SPACIN
 use crate::math::{Point3, Vector3};
 use crate::probability::ElementReading;
 use crate::query::exact_side::frame::{Frame, Standing};
+use crate::shape::ClosestPoint;
 use crate::Real;
 
 /// What the elements of one segmentation read against the surface.
@@ -34,10 +35,10 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
         match frame.standing(els, k) {
             Standing::Beyond => continue,
             Standing::Deep => scan.readings.push(deep_reading(frame, els, k)),
-            Standing::Near(_) if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
-            Standing::Near(start) => {
+            Standing::Near(..) if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
+            Standing::Near(centre, start) => {
                 let radius = probe_radius(frame, els, k);
-                probe_readings(frame, e, k, (radius, start), &mut scan.readings);
+                probe_readings(frame, e, k, (radius, centre, start), &mut scan.readings);
             }
         }
         let touching = scan.readings[before..].iter().any(|r| r.gap <= 0.0);
@@ -71,25 +72,35 @@ fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementRead
 /// reach (`sd > h/2 + reach s`, `h` the spacing) are left out; every reading
 /// inside the surface is kept (the element's surface is inside the solid).
 /// Each probe's surface is searched within `radius` ([`probe_radius`]: every
-/// reading within reach lies within it). Then from the mesh's point
-/// closest to the probe nearest the surface, or from `start` (its point
-/// closest to the element's mean) when no probe is within `radius`, towards
-/// the element's point nearest the surface ([`refine`]).
+/// reading within reach lies within it), and a probe is passed over without
+/// a search when the distance of the last point read outside (first the
+/// element's mean, `centre` with its closest point `start`), less the step
+/// to it, exceeds `radius` (the ball of that distance about the point holds
+/// no surface). Then from the mesh's point closest to the probe nearest the
+/// surface, or from `start` when no probe is within `radius`, towards the
+/// element's point nearest the surface ([`refine`]).
 fn probe_readings(
     frame: &Frame<'_>,
     e: &SurfaceElement,
     k: u32,
-    (radius, start): (Real, Point3),
+    (radius, centre, start): (Real, Point3, ClosestPoint),
     out: &mut Vec<ElementReading>,
 ) {
     let allowed = HALF_SPACING * e.spacing;
-    let mut best: (Real, Point3) = (Real::INFINITY, start);
+    let mut best: (Real, Point3) = (Real::INFINITY, start.point);
+    let mut reference = (centre, start);
     for &[u, v] in &e.probes {
+        let x = frame.to_mesh(&e.surface_point(u, v).0);
+        let (xr, cr) = &reference;
+        if !cr.is_inside() && cr.distance() - (x - xr).norm() > radius {
+            continue;
+        }
         let Some((r, closest)) = read_at(frame, e, k, (u, v), radius) else {
             continue;
         };
+        reference = (x, closest);
         if r.gap < best.0 {
-            best = (r.gap, closest);
+            best = (r.gap, closest.point);
         }
         if r.gap <= allowed + frame.reach * r.std {
             out.push(r);
@@ -131,6 +142,7 @@ fn refine(
         let Some((r, next)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
             return;
         };
+        let next = next.point;
         if r.gap >= gap - 1e-12 * e.spacing {
             return;
         }
@@ -153,13 +165,13 @@ fn read_at(
     k: u32,
     (u, v): (Real, Real),
     radius: Real,
-) -> Option<(ElementReading, Point3)> {
+) -> Option<(ElementReading, ClosestPoint)> {
     let (x, var_h) = e.surface_point(u, v);
     let c = frame.closest_near(&frame.to_mesh(&x), radius)?;
     let n = frame.to_cloud(&c.normal);
     let along = e.normal.dot(&n);
     let var = var_h * along * along + n.dot(&(across_normal(e) * n)) + edge_var_along(e, u, v, &n);
-    Some((reading(k, c.signed_distance, var), c.point))
+    Some((reading(k, c.signed_distance, var), c))
 }
 
 /// The reading of element `k` with gap `gap` and variance `var`.
