@@ -256,3 +256,28 @@ fn bad_input_is_an_error() {
     let e = collide_exact_cloud(&Pose::identity(), &cube, &Pose::identity(), &cloud, &bad);
     assert!(matches!(e, Err(Error::InvalidInput(_))));
 }
+
+#[test]
+fn an_open_mesh_is_read_by_its_winding_number() {
+    // The unit cube without its top face: open, so the sign comes from the
+    // winding number. A plane 2 cm below the bottom face is free; one 5 cm
+    // above it (inside the open box) collides.
+    let cube = Mesh::cuboid(0.5, 0.5, 0.5).unwrap();
+    let faces: Vec<[u32; 3]> = (0..cube.faces().len())
+        .filter(|&f| cube.face_normal_scaled(f).z <= 0.5 * cube.face_normal_scaled(f).norm())
+        .map(|f| cube.faces()[f])
+        .collect();
+    assert_eq!(faces.len(), 10);
+    let open = MeshDistance::new(&Mesh::new(cube.vertices().to_vec(), faces).unwrap()).unwrap();
+    assert_eq!(
+        open.sign_method(),
+        cloudprox::shape::SignMethod::WindingNumber
+    );
+    let req = CollisionRequest::default();
+    let at = |gap: f64| {
+        let cloud = PointCloud::from_sigma(add_noise(&plane(gap), 0.002, 5), 0.002).unwrap();
+        collide_exact_cloud(&Pose::identity(), &open, &Pose::identity(), &cloud, &req).unwrap()
+    };
+    assert_eq!(at(0.02).state, CollisionState::Free);
+    assert_eq!(at(-0.05).state, CollisionState::Collision);
+}
