@@ -13,12 +13,20 @@ poses), or moved past first contact by [0, 6] sigma (the meshes are not convex,
 so a penetration's depth is that travel, as in the real-scan experiment).
 Labels are exact (``intersecting``). Two noise draws per pose.
 
+``mesh-exact`` and ``mesh-sampled`` query A as its exact mesh against B's
+noisy cloud (``cloudprox.collide_many(mesh, cloud, poses)``): the mesh's
+surface as the separating surface (the default for a mesh side), or the
+mesh sampled into a cloud (``mesh_side="sampled"``, the former default);
+``mesh-exact-decide`` is ``mesh-exact`` with ``decide_only`` (no per-point
+probabilities).
+
 python-fcl (``pip install python-fcl``), when installed, answers the same
 poses on the exact meshes in the same run: its ``distance()`` and ``collide()``
 median times are the anchor of the speed column.
 
 Usage: ``python3 benches/realmesh.py [--poses 100] [--levels 0.005,0.02] [--seed 0]
-[--methods elements,points,nn-gap,collision-map] [--noise-scale 1] [--bounds]
+[--methods elements,points,nn-gap,collision-map,mesh-exact,mesh-exact-decide,mesh-sampled]
+[--noise-scale 1] [--bounds]
 [--save F.npz]`` (``--save``: every method's scores, states, seconds and the
 exact signed distances per level, for a closer look at where the methods err
 or flip; ``--noise-scale F``: the noise drawn, and its stated covariances
@@ -196,6 +204,9 @@ METHODS = {
     "points": "points (the paper's)",
     "nn-gap": "nn-gap",
     "collision-map": "collision map",
+    "mesh-exact": "A as its exact mesh (exact side)",
+    "mesh-exact-decide": "A as its exact mesh (exact side), decide_only",
+    "mesh-sampled": "A as its exact mesh, sampled",
 }
 
 
@@ -219,8 +230,38 @@ def method_name(method: str) -> str | None:
     return name if context is None else f"{name}, context {context:g}"
 
 
-def method_answer(method: str, draw: m.Draw, q: np.ndarray) -> m.MethodAnswer:
-    """Return ``method``'s answers (a key of :data:`METHODS`) for one draw at the poses ``q``."""
+def mesh_answer(mesh: cp.Mesh, draw: m.Draw, q: np.ndarray, side: str) -> m.MethodAnswer:
+    """Return the answers with side A as its exact ``mesh`` against B's noisy cloud.
+
+    ``side`` is ``"exact"`` (the mesh's surface as the separating surface),
+    ``"exact-decide"`` (the same, ``decide_only``: ``P`` and the state without
+    the per-point probabilities) or ``"sampled"`` (the mesh sampled into a
+    cloud and the two clouds collided). Only B's noise is drawn: the labels
+    are the exact meshes' as for every row.
+    """
+    _, room = draw.clouds()
+    decide = side.endswith("-decide")
+    side = side.removesuffix("-decide")
+    results = cp.collide_many(mesh, room, q, mesh_side=side, decide_only=decide)
+    return m.MethodAnswer(
+        np.array([r.probability for r in results]),
+        np.array([r.state for r in results]),
+        np.array([r.stats.time_seconds for r in results]),
+    )
+
+
+def method_answer(
+    method: str, draw: m.Draw, q: np.ndarray, mesh_a: cp.Mesh | None = None
+) -> m.MethodAnswer:
+    """Return ``method``'s answers (a key of :data:`METHODS`) for one draw at the poses ``q``.
+
+    ``mesh_a`` is A's exact mesh, which the ``mesh-*`` methods query instead of
+    A's cloud.
+    """
+    if method.startswith("mesh-"):
+        if mesh_a is None:
+            raise ValueError(f"{method} needs A's mesh")
+        return mesh_answer(mesh_a, draw, q, method.removeprefix("mesh-"))
     if method.startswith("elements"):
         return m.cloudprox_answer(draw, q, "quadric", "max", method)
     if method == "points":
@@ -314,7 +355,7 @@ def main() -> None:
                 )
                 for _ in range(2)
             ]
-            answers = {method_name(k): [method_answer(k, d, q) for d in draws] for k in methods}
+            answers = {method_name(k): [method_answer(k, d, q, ma) for d in draws] for k in methods}
             for name, ans in answers.items():
                 rows.setdefault((level, name), []).append(
                     (

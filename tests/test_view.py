@@ -334,7 +334,7 @@ def test_mesh_side_is_drawn_with_its_samples(tmp_path, spheres_near) -> None:
     a, _, _ = spheres_near
     box = cp.Mesh.cuboid(0.05, 0.05, 0.05)
     pose = from_translation((0.14, 0.0, 0.0))
-    result = cp.collide(box, a, pose_a=pose)
+    result = cp.collide(box, a, pose_a=pose, mesh_side="sampled")
     assert result.points_a.shape == (len(result.probabilities_a), 3)
     assert np.all(np.abs(result.points_a[:, 0] - 0.14) <= 0.05 + 1e-12)
     scene = view.collision_scene(result, box, a, pose)
@@ -344,6 +344,9 @@ def test_mesh_side_is_drawn_with_its_samples(tmp_path, spheres_near) -> None:
     )
     fig = view.to_figure(scene)
     assert any(t.type == "mesh3d" for t in fig.data)
+    # An exact mesh side (the default) has no points: the mesh alone is drawn.
+    exact = view.collision_scene(cp.collide(box, a, pose_a=pose), box, a, pose)
+    assert len(exact.meshes) == 1 and len(exact.points[0].points) == 0
 
 
 def test_bad_inputs_give_clear_errors(spheres_near, monkeypatch) -> None:

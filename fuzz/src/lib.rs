@@ -684,6 +684,7 @@ pub fn exact(data: &[u8]) {
                 Opt::Set(s) => Some(s.value()),
             },
             seed: 7,
+            ..MeshSampling::default()
         };
         // One input's work is bounded, as the readers' is by their input size:
         // a mesh sampled into more than `MAX_MESH_SAMPLE` points is left out

@@ -895,6 +895,7 @@ def collide(
     pose_b: npt.ArrayLike | None = None,
     *,
     request: CollisionRequest | None = None,
+    mesh_side: str | None = None,
     mesh_spacing: float | None = None,
     **options: Any,
 ) -> CollisionResult:
@@ -908,9 +909,19 @@ def collide(
     query.
 
     Either side may be a mesh (``Mesh``, a trimesh ``Trimesh`` or an Open3D
-    ``TriangleMesh``): an exact surface, sampled every ``mesh_spacing`` metres into
-    a cloud without sensor noise whose covariance is its own discretization
-    (``spacing^2 / 12`` across each sample's face, none along its normal).
+    ``TriangleMesh``). By default (``mesh_side="exact"``) its surface is the
+    separating surface and nothing is trained: each cloud point's probability
+    is Eq. 3 against it, ``Phi(-sd(x) / sqrt(n^T Sigma n))`` with ``sd`` the
+    signed distance to the mesh and ``n`` its gradient, and ``P`` reads the
+    cloud's surface elements against it (the elements model's ``P``; with
+    ``model="points"``, the aggregation of the per-point probabilities). The
+    result has no patches, and the mesh side no points (``points_a`` or
+    ``points_b`` is ``None``, its probabilities empty). A ``Mesh`` keeps its
+    signed distance, so repeated queries do not build it again. With
+    ``mesh_side="sampled"`` (or a ``mesh_spacing``) the mesh is sampled every
+    ``mesh_spacing`` metres into a cloud without sensor noise whose covariance
+    is its own discretization (``spacing^2 / 12`` across each sample's face,
+    none along its normal), and the two clouds are collided.
 
     Parameters
     ----------
@@ -920,10 +931,14 @@ def collide(
         Rigid poses of the clouds (own frame to world); ``None`` is the identity.
     request : CollisionRequest, optional
         The options of the query (default ``CollisionRequest()``).
+    mesh_side : {"exact", "sampled"}, optional
+        How a mesh side is read (default ``"exact"``, or ``"sampled"`` when
+        ``mesh_spacing`` is given).
     mesh_spacing : float, optional
-        Sampling spacing of a mesh side (metres; default: half the cloud's median
-        spacing, its distance to the 6th nearest neighbour). A ``Mesh`` keeps its
-        last samplings, so repeated queries do not sample it again.
+        Sampling spacing of a sampled mesh side (metres; default: half the
+        cloud's median spacing, its distance to the 6th nearest neighbour). A
+        ``Mesh`` keeps its last samplings, so repeated queries do not sample it
+        again. Given with ``mesh_side="exact"``, an error.
     **options
         Options of :class:`CollisionRequest`, overriding ``request``'s.
 
@@ -949,6 +964,7 @@ def collide_many(
     pose_b: npt.ArrayLike | None = None,
     *,
     request: CollisionRequest | None = None,
+    mesh_side: str | None = None,
     mesh_spacing: float | None = None,
     **options: Any,
 ) -> list[CollisionResult]:
@@ -962,7 +978,7 @@ def collide_many(
         Poses of ``a``.
     pose_b : array_like, shape (4, 4), optional
         Pose of ``b``; ``None`` is the identity.
-    request, mesh_spacing, **options
+    request, mesh_side, mesh_spacing, **options
         As in :func:`collide`.
 
     Returns
@@ -979,6 +995,7 @@ def collide_along(
     pose_b: npt.ArrayLike | None = None,
     *,
     request: CollisionRequest | None = None,
+    mesh_side: str | None = None,
     mesh_spacing: float | None = None,
     **options: Any,
 ) -> list[CollisionResult]:
@@ -1001,8 +1018,9 @@ def collide_along(
         Poses of ``a``, in the motion's order.
     pose_b : array_like, shape (4, 4), optional
         Pose of ``b``; ``None`` is the identity.
-    request, mesh_spacing, **options
-        As in :func:`collide`.
+    request, mesh_side, mesh_spacing, **options
+        As in :func:`collide` (with an exact mesh side, the queries are
+        :func:`collide_many`'s: nothing is trained, so nothing is warm-started).
 
     Returns
     -------

@@ -302,6 +302,9 @@ def _side_points(
             pts = np.asarray(queried, dtype=np.float64)
         elif isinstance(obj, PointCloud):
             pts = _world(obj.points, pose)
+        elif n == 0:
+            # An exact mesh side: no points (the mesh itself is drawn).
+            pts = np.zeros((0, 3))
         else:
             raise ValueError(
                 f"side {which.upper()}: the result does not record its points; give "

@@ -7,27 +7,29 @@ use pyo3::types::PyDict;
 
 use crate::convert::{pose_from, poses_from};
 use crate::error::run_detached;
+use crate::exact_side::{exact_many, exact_one, resolve, Pair};
 use crate::request::{request_from, PyCollisionRequest};
-use crate::result::{PyCollisionResult, QueriedSides};
-use crate::side::resolve_pair;
+use crate::result::PyCollisionResult;
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
 use cloudprox::query::{CollisionRequest, CollisionResult};
 
 /// The keywords of `collide`, `collide_many` and `collide_along` that are not
 /// request options.
-const QUERY_KEYWORDS: [&str; 2] = ["request", "mesh_spacing"];
+const QUERY_KEYWORDS: [&str; 3] = ["request", "mesh_side", "mesh_spacing"];
 
 /// The probabilistic collision query between cloud `a` at `pose_a` and cloud `b`
 /// at `pose_b` (`(4, 4)` transforms, `None` = identity). Either side may be a
-/// mesh instead (cloudprox `Mesh`, trimesh `Trimesh`, Open3D `TriangleMesh`): it
-/// is sampled at `mesh_spacing` (default: half the cloud's median spacing) into a
-/// cloud without sensor noise. The options are `request` (a `CollisionRequest`,
+/// mesh instead (cloudprox `Mesh`, trimesh `Trimesh`, Open3D `TriangleMesh`):
+/// by default (`mesh_side="exact"`) its surface is the separating surface
+/// ([`cloudprox::query::exact_side`]); with `mesh_side="sampled"` (or a
+/// `mesh_spacing`) it is sampled at `mesh_spacing` (default: half the cloud's
+/// median spacing) into a cloud without sensor noise. The options are `request` (a `CollisionRequest`,
 /// default: the Rust defaults); keyword options (the names of
 /// `CollisionRequest`'s constructor) are a shortcut that overrides the
 /// request's fields. The GIL is released during the query.
 #[pyfunction]
-#[pyo3(signature = (a, b, pose_a=None, pose_b=None, *, request=None, mesh_spacing=None, **options))]
+#[pyo3(signature = (a, b, pose_a=None, pose_b=None, *, request=None, mesh_side=None, mesh_spacing=None, **options))]
 pub fn collide(
     py: Python<'_>,
     a: &Bound<'_, PyAny>,
@@ -35,21 +37,22 @@ pub fn collide(
     pose_a: Option<&Bound<'_, PyAny>>,
     pose_b: Option<&Bound<'_, PyAny>>,
     request: Option<&Bound<'_, PyCollisionRequest>>,
+    mesh_side: Option<&str>,
     mesh_spacing: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyCollisionResult> {
     let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
     let pose_a = pose_from(py, pose_a, "pose_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
-    let sides = QueriedSides {
-        a: Arc::clone(&ca),
-        b: Arc::clone(&cb),
-        pose_a,
-        pose_b,
-    };
-    let result = run_detached(py, move || {
-        cloudprox::query::collide(&pose_a, &ca, &pose_b, &cb, &request)
+    let pair = resolve(py, a, b, mesh_side, mesh_spacing)?;
+    let sides = pair.sides(pose_a, pose_b);
+    let result = run_detached(py, move || match &pair {
+        Pair::Clouds(ca, cb) => cloudprox::query::collide(&pose_a, ca, &pose_b, cb, &request),
+        Pair::Exact {
+            mesh,
+            cloud,
+            mesh_is_a,
+        } => exact_one(mesh, cloud, *mesh_is_a, (&pose_a, &pose_b), &request),
     })?;
     PyCollisionResult::with_sides(py, result, sides)
 }
@@ -74,30 +77,30 @@ fn query_poses(
     poses_a: &Bound<'_, PyAny>,
     pose_b: Option<&Bound<'_, PyAny>>,
     request: Option<&Bound<'_, PyCollisionRequest>>,
-    mesh_spacing: Option<f64>,
+    (mesh_side, mesh_spacing): (Option<&str>, Option<f64>),
     options: Option<&Bound<'_, PyDict>>,
     run: ManyPoses,
 ) -> PyResult<Vec<PyCollisionResult>> {
     let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
     let poses_a = poses_from(poses_a, "poses_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = resolve_pair(py, a, b, mesh_spacing)?;
-    let (sa, sb) = (Arc::clone(&ca), Arc::clone(&cb));
+    let pair = Arc::new(resolve(py, a, b, mesh_side, mesh_spacing)?);
+    let shared = Arc::clone(&pair);
     let (results, poses_a) = run_detached(py, move || {
-        run(&poses_a, &ca, &pose_b, &cb, &request).map(|r| (r, poses_a))
+        match &*shared {
+            Pair::Clouds(ca, cb) => run(&poses_a, ca, &pose_b, cb, &request),
+            Pair::Exact {
+                mesh,
+                cloud,
+                mesh_is_a,
+            } => exact_many(mesh, cloud, *mesh_is_a, (&poses_a, &pose_b), &request),
+        }
+        .map(|r| (r, poses_a))
     })?;
     results
         .into_iter()
         .zip(poses_a)
-        .map(|(r, pose_a)| {
-            let sides = QueriedSides {
-                a: Arc::clone(&sa),
-                b: Arc::clone(&sb),
-                pose_a,
-                pose_b,
-            };
-            PyCollisionResult::with_sides(py, r, sides)
-        })
+        .map(|(r, pose_a)| PyCollisionResult::with_sides(py, r, pair.sides(pose_a, pose_b)))
         .collect()
 }
 
@@ -105,7 +108,7 @@ fn query_poses(
 /// `b` at `pose_b`, in parallel (rayon) with the GIL released. Results are in the
 /// order of `poses_a`.
 #[pyfunction]
-#[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_spacing=None, **options))]
+#[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_side=None, mesh_spacing=None, **options))]
 pub fn collide_many(
     py: Python<'_>,
     a: &Bound<'_, PyAny>,
@@ -113,6 +116,7 @@ pub fn collide_many(
     poses_a: &Bound<'_, PyAny>,
     pose_b: Option<&Bound<'_, PyAny>>,
     request: Option<&Bound<'_, PyCollisionRequest>>,
+    mesh_side: Option<&str>,
     mesh_spacing: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<PyCollisionResult>> {
@@ -124,7 +128,7 @@ pub fn collide_many(
         poses_a,
         pose_b,
         request,
-        mesh_spacing,
+        (mesh_side, mesh_spacing),
         options,
         run,
     )
@@ -135,7 +139,7 @@ pub fn collide_many(
 /// the GIL released, within a run each query's classifier starting from the
 /// previous pose's support. Results are in the order of `poses_a`.
 #[pyfunction]
-#[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_spacing=None, **options))]
+#[pyo3(signature = (a, b, poses_a, pose_b=None, *, request=None, mesh_side=None, mesh_spacing=None, **options))]
 pub fn collide_along(
     py: Python<'_>,
     a: &Bound<'_, PyAny>,
@@ -143,6 +147,7 @@ pub fn collide_along(
     poses_a: &Bound<'_, PyAny>,
     pose_b: Option<&Bound<'_, PyAny>>,
     request: Option<&Bound<'_, PyCollisionRequest>>,
+    mesh_side: Option<&str>,
     mesh_spacing: Option<f64>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<PyCollisionResult>> {
@@ -154,7 +159,7 @@ pub fn collide_along(
         poses_a,
         pose_b,
         request,
-        mesh_spacing,
+        (mesh_side, mesh_spacing),
         options,
         run,
     )
@@ -181,7 +186,7 @@ pub fn facing_pairs<'py>(
     let request = request_from(py, request, options, &QUERY_KEYWORDS)?;
     let pose_a = pose_from(py, pose_a, "pose_a")?;
     let pose_b = pose_from(py, pose_b, "pose_b")?;
-    let (ca, cb) = resolve_pair(py, a, b, None)?;
+    let (ca, cb) = crate::side::resolve_pair(py, a, b, None)?;
     let pairs = run_detached(py, move || {
         cloudprox::query::facing_pairs(&pose_a, &ca, &pose_b, &cb, &request)
     })?;

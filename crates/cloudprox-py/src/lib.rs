@@ -19,6 +19,7 @@
 //! | `scan.rs` | `scan_to_cloud`: the core's scan pipeline (noise, filter steps, cloud) |
 //! | `sensor.rs` | sensor noise models `DepthCamera`, `StereoCamera`, `Lidar` |
 //! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
+//! | `exact_side.rs` | which query a pair of sides takes: two clouds, or an exact mesh against a cloud |
 //! | `robot.rs` | `Robot`, `collide_robot`, `collide_robot_many`, `check_motion` |
 //!
 //! The Python package `cloudprox` re-exports everything (the filters, pose
@@ -35,6 +36,7 @@ mod cloud;
 mod collide;
 mod convert;
 mod error;
+mod exact_side;
 mod filter;
 mod io;
 mod mesh;

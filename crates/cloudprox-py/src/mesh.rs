@@ -1,6 +1,6 @@
 //! `Mesh`, `ExactShape` and the exact mesh-vs-mesh queries.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use cloudprox::cloud::PointCloud;
 
@@ -8,7 +8,7 @@ use cloudprox::query::exact::{
     exact_intersects_many, exact_proximity as core_exact, exact_proximity_many, ExactProximity,
     ExactShape,
 };
-use cloudprox::shape::Mesh;
+use cloudprox::shape::{Mesh, MeshDistance};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -183,6 +183,8 @@ pub struct PyMesh {
     /// The clouds this mesh was sampled into for queries, by spacing (bits):
     /// a mesh queried again at the same spacing is not sampled again.
     samples: Mutex<Vec<(u64, Arc<PointCloud>)>>,
+    /// Its signed distance for exact-side queries, built on first use.
+    distance: OnceLock<Arc<MeshDistance>>,
 }
 
 /// How many sampled clouds a mesh keeps.
@@ -193,7 +195,19 @@ impl PyMesh {
         Self {
             inner: Arc::new(mesh),
             samples: Mutex::new(Vec::new()),
+            distance: OnceLock::new(),
         }
+    }
+
+    /// The mesh's signed distance for an exact-side query (built once, without
+    /// the GIL).
+    pub(crate) fn distance(&self, py: Python<'_>) -> PyResult<Arc<MeshDistance>> {
+        if let Some(d) = self.distance.get() {
+            return Ok(Arc::clone(d));
+        }
+        let mesh = Arc::clone(&self.inner);
+        let built = Arc::new(run_detached(py, move || MeshDistance::new(&mesh))?);
+        Ok(Arc::clone(self.distance.get_or_init(|| built)))
     }
 
     /// The mesh sampled at `spacing` for a query (cached; see

@@ -397,13 +397,14 @@ pub struct PyCollisionResult {
     sides: Option<QueriedSides>,
 }
 
-/// The two sides of a query as queried (a mesh side: its samples) with their
-/// poses, kept (shared, not copied) so a result can give its points.
+/// The two sides of a query as queried (a sampled mesh side: its samples; an
+/// exact mesh side: none) with their poses, kept (shared, not copied) so a
+/// result can give its points.
 pub struct QueriedSides {
-    /// Side A's cloud in its own frame.
-    pub a: Arc<PointCloud>,
-    /// Side B's cloud in its own frame.
-    pub b: Arc<PointCloud>,
+    /// Side A's cloud in its own frame (`None` for an exact mesh).
+    pub a: Option<Arc<PointCloud>>,
+    /// Side B's cloud in its own frame (`None` for an exact mesh).
+    pub b: Option<Arc<PointCloud>>,
     /// Side A's pose.
     pub pose_a: Pose,
     /// Side B's pose.
@@ -449,6 +450,9 @@ impl PyCollisionResult {
             (&s.a, &s.pose_a)
         } else {
             (&s.b, &s.pose_b)
+        };
+        let Some(cloud) = cloud else {
+            return Ok(None);
         };
         let moved: Vec<_> = cloud.points().iter().map(|p| pose * p).collect();
         points_to_py(py, &moved).map(Some)
@@ -496,8 +500,9 @@ impl PyCollisionResult {
         nonzero_to_py(py, &self.probabilities_b)
     }
 
-    /// Side A's points as queried (a mesh side: its samples), world frame, shape
-    /// `(n_a, 3)`; `None` when the result does not record them (robot links).
+    /// Side A's points as queried (a sampled mesh side: its samples), world
+    /// frame, shape `(n_a, 3)`; `None` when the result does not record them
+    /// (robot links, an exact mesh side).
     #[getter]
     fn points_a<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
         self.world_points(py, true)

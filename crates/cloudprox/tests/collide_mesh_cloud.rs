@@ -3,7 +3,7 @@
 use crate::common;
 
 use cloudprox::prelude::*;
-use cloudprox::query::collide::{mesh_sampling_spacing, MESH_SPACING_FACTOR};
+use cloudprox::query::collide::{mesh_sampling_spacing, MeshSide, MESH_SPACING_FACTOR};
 use cloudprox::sample::{add_noise, sphere};
 use common::{RADIUS, SIGMA};
 use nalgebra::{Translation3, UnitQuaternion};
@@ -119,7 +119,19 @@ fn the_mesh_may_be_either_side() {
             ab.probability,
             ba.probability
         );
-        let direct = query(&cloud, &mesh, gap);
+        let sampled = MeshSampling {
+            side: MeshSide::Sampled,
+            ..MeshSampling::default()
+        };
+        let direct = collide_mesh_cloud(
+            &cube_pose(gap),
+            &mesh,
+            &Pose::identity(),
+            &cloud,
+            &req,
+            &sampled,
+        )
+        .unwrap();
         assert_eq!(direct.probability, ab.probability);
     }
 }

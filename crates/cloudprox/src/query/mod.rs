@@ -7,9 +7,10 @@
 
 pub mod collide;
 pub mod exact;
+pub mod exact_side;
 
 pub use collide::{
     collide, collide_along, collide_many, collide_mesh_cloud, facing_pairs, prepare,
-    CollisionRequest, CollisionResult, ContactPatch, MeshSampling, PointAggregates,
+    CollisionRequest, CollisionResult, ContactPatch, MeshSampling, MeshSide, PointAggregates,
     PointProbabilities, QueryCounters, QueryModel, QueryStats, ALONG_RUN,
 };

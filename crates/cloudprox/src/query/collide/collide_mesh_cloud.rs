@@ -4,13 +4,34 @@ use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::math::Pose;
 use crate::query::collide::{collide, CollisionRequest, CollisionResult};
-use crate::shape::Mesh;
+use crate::query::exact_side::collide_exact_cloud;
+use crate::shape::{Mesh, MeshDistance};
 use crate::Real;
 
-/// How a mesh is sampled into the cloud that stands for it in
-/// [`collide_mesh_cloud`].
+/// How [`collide_mesh_cloud`] reads the mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MeshSide {
+    /// The mesh's surface is the separating surface (the default):
+    /// [`collide_exact_cloud`], nothing sampled, nothing trained.
+    #[default]
+    Exact,
+    /// The mesh is sampled into a cloud ([`MeshSampling::spacing`],
+    /// [`MeshSampling::seed`]) and the two clouds are collided ([`collide`]).
+    Sampled,
+}
+
+crate::names::named_options!(MeshSide, "mesh_side", {
+    Exact => "exact",
+    Sampled => "sampled",
+});
+
+/// How a mesh stands in [`collide_mesh_cloud`]: exact (the default), or
+/// sampled into a cloud.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MeshSampling {
+    /// Exact or sampled (default [`MeshSide::Exact`]); the spacing and the
+    /// seed are those of [`MeshSide::Sampled`].
+    pub side: MeshSide,
     /// Sampling spacing (metres); `None` (the default) picks it from the other
     /// cloud ([`mesh_sampling_spacing`]).
     pub spacing: Option<Real>,
@@ -51,7 +72,10 @@ pub fn mesh_sampling_spacing(cloud: &PointCloud) -> Real {
 /// The probabilistic collision query between an exact mesh at `pose_mesh` and a
 /// noisy cloud at `pose_cloud`.
 ///
-/// The mesh is sampled into a cloud without sensor noise whose covariance is its
+/// By default ([`MeshSide::Exact`]) the mesh's surface is the separating
+/// surface ([`collide_exact_cloud`]; its signed distance is built here, so to
+/// query one mesh many times build a [`MeshDistance`] once and call that
+/// directly). With [`MeshSide::Sampled`], the mesh is sampled into a cloud without sensor noise whose covariance is its
 /// own discretization error ([`PointCloud::from_mesh`]), at the spacing
 /// `sampling` gives, and the two clouds are collided ([`collide`]); the result's
 /// side A is the mesh's sample. To query the same mesh many times, sample it once
@@ -71,6 +95,10 @@ pub fn collide_mesh_cloud(
 ) -> Result<CollisionResult> {
     request.validate()?;
     sampling.validate()?;
+    if sampling.side == MeshSide::Exact {
+        let distance = MeshDistance::new(mesh)?;
+        return collide_exact_cloud(pose_mesh, &distance, pose_cloud, cloud, request);
+    }
     let spacing = match sampling.spacing {
         Some(s) => s,
         None => mesh_sampling_spacing(cloud),

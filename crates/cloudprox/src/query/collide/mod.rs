@@ -41,7 +41,7 @@ pub use collide::collide;
 pub(crate) use collide::collide_with_workspace;
 pub use collide_many::{collide_along, collide_many, prepare, ALONG_RUN};
 pub use collide_mesh_cloud::{
-    collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MESH_SPACING_FACTOR,
+    collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MeshSide, MESH_SPACING_FACTOR,
 };
 pub use diagnose::facing_pairs;
 pub(crate) use elements::element_surfaces_may_reach;

@@ -1,0 +1,101 @@
+//! The cloud seen from the mesh: the relative pose, the noise's reach and the
+//! broad phase.
+
+use crate::bvh::Aabb;
+use crate::element::{Hull, SurfaceElements};
+use crate::math::{Matrix3, Point3, Pose, Vector3};
+use crate::probability::normal_quantile;
+use crate::shape::{ClosestPoint, MeshDistance};
+use crate::Real;
+
+/// One query's view of the cloud from the mesh's own frame, where every
+/// signed distance is read (so a rigid motion of both sides changes nothing).
+pub(crate) struct Frame<'a> {
+    /// The mesh's signed distance.
+    pub mesh: &'a MeshDistance,
+    /// The cloud's frame in the mesh's frame.
+    pub rel: Pose,
+    /// The rotation of `rel` as a matrix (cloud to mesh).
+    rotation: Matrix3,
+    /// The noise's reach in standard deviations: `-Phi^-1(epsilon / 2)` for
+    /// the request's `prune_epsilon`, as the two-cloud query's near rule.
+    pub reach: Real,
+    /// The mesh's bounding box in its frame.
+    bounds: Aabb,
+}
+
+/// Where an element stands against the surface after the broad phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Standing {
+    /// Farther outside than the noise can reach: it reads nothing.
+    Beyond,
+    /// Within reach of the surface: the element's mean and the surface's
+    /// point closest to it (mesh frame).
+    Near(Point3, ClosestPoint),
+    /// Inside the mesh, farther from its surface than the reach.
+    Deep,
+}
+
+impl<'a> Frame<'a> {
+    /// The frame of a cloud at `rel` in the mesh's frame, for a request's
+    /// `prune_epsilon`.
+    pub fn new(mesh: &'a MeshDistance, rel: Pose, prune_epsilon: Real) -> Self {
+        let (mins, maxs) = mesh.bounds();
+        Self {
+            mesh,
+            rel,
+            rotation: *rel.rotation.to_rotation_matrix().matrix(),
+            reach: -normal_quantile(0.5 * prune_epsilon),
+            bounds: Aabb { mins, maxs },
+        }
+    }
+
+    /// A point of the cloud's frame in the mesh's.
+    pub fn to_mesh(&self, p: &Point3) -> Point3 {
+        self.rel * p
+    }
+
+    /// A point of the mesh's frame in the cloud's.
+    pub fn to_cloud_point(&self, p: &Point3) -> Point3 {
+        self.rel.inverse_transform_point(p)
+    }
+
+    /// A direction of the mesh's frame in the cloud's.
+    pub fn to_cloud(&self, v: &Vector3) -> Vector3 {
+        self.rotation.transpose() * v
+    }
+
+    /// The mesh's closest point to `x` (mesh frame) if the surface lies
+    /// within `radius` of it or `x` is inside; `None` says `x` lies outside,
+    /// farther than `radius` (a bounded search: a point far from the surface
+    /// costs a few box tests).
+    pub fn closest_near(&self, x: &Point3, radius: Real) -> Option<ClosestPoint> {
+        if let Some(c) = self.mesh.closest_within(x, radius) {
+            return Some(c);
+        }
+        let inside = self.bounds.distance_squared_to_point(x) == 0.0 && self.mesh.contains(x);
+        inside.then(|| self.mesh.closest(x))
+    }
+
+    /// Where element `e` of `els` stands: its hull (every point of its
+    /// surface within `radius` of its mean, every standard deviation below
+    /// `sigma`) is first tested against the mesh's box, then against the
+    /// surface within its reach, `radius + margin + reach sigma`; an element
+    /// whose mean is farther inside than that is deep.
+    pub fn standing(&self, els: &SurfaceElements, e: u32) -> Standing {
+        let hull: &Hull = els.hulls().hull(e);
+        let centre = self.to_mesh(&hull.mean);
+        let limit = hull.radius + hull.margin + self.reach * hull.sigma;
+        let to_box = self.bounds.distance_squared_to_point(&centre);
+        if to_box > limit * limit {
+            return Standing::Beyond;
+        }
+        if let Some(c) = self.mesh.closest_within(&centre, limit) {
+            Standing::Near(centre, c)
+        } else if to_box == 0.0 && self.mesh.contains(&centre) {
+            Standing::Deep
+        } else {
+            Standing::Beyond
+        }
+    }
+}

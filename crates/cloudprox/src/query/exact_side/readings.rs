@@ -1,0 +1,202 @@
+//! The cloud's surface elements read against the exact surface.
+
+use crate::element::{across_normal, SurfaceElement, SurfaceElements, HALF_SPACING};
+use crate::math::{Point3, Vector3};
+use crate::probability::ElementReading;
+use crate::query::exact_side::frame::{Frame, Standing};
+use crate::shape::ClosestPoint;
+use crate::Real;
+
+/// What the elements of one segmentation read against the surface.
+pub(crate) struct ElementScan {
+    /// Every reading within the noise's reach, with the element as `own`
+    /// and as `other` alike (the exact side has no element: its surface adds
+    /// no error, so no two readings share one of its errors).
+    pub readings: Vec<ElementReading>,
+    /// The elements within reach of the surface or deep inside it, each with
+    /// whether some reading of it is at or inside the surface.
+    pub near: Vec<(u32, bool)>,
+    /// Elements whose hull was tested against the surface.
+    pub tested: usize,
+}
+
+/// The readings of every element of `els` within reach of the surface
+/// (see the [module docs](crate::query::exact_side)).
+pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> ElementScan {
+    let mut scan = ElementScan {
+        readings: Vec::new(),
+        near: Vec::new(),
+        tested: 0,
+    };
+    for (k, e) in els.elements().iter().enumerate() {
+        let k = k as u32;
+        scan.tested += 1;
+        let before = scan.readings.len();
+        match frame.standing(els, k) {
+            Standing::Beyond => continue,
+            Standing::Deep => scan.readings.push(deep_reading(frame, els, k)),
+            Standing::Near(..) if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
+            Standing::Near(centre, start) => {
+                let radius = probe_radius(frame, els, k);
+                probe_readings(frame, e, k, (radius, centre, start), &mut scan.readings);
+            }
+        }
+        let touching = scan.readings[before..].iter().any(|r| r.gap <= 0.0);
+        scan.near.push((k, touching));
+    }
+    scan
+}
+
+/// A single point's reading: its signed distance and its covariance along
+/// the distance's gradient (Eq. 3). Always within reach (the broad phase
+/// found the surface within reach of it).
+fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
+    let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
+    let n = frame.to_cloud(&c.normal);
+    reading(k, c.signed_distance, n.dot(&(e.cov_mean * n)))
+}
+
+/// An element found deep inside: its least deep point lies at most its
+/// hull's radius above its mean, still beyond the reach inside.
+fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementReading {
+    let hull = els.hulls().hull(k);
+    let sd = frame.mesh.signed_distance(&frame.to_mesh(&hull.mean));
+    reading(k, sd + hull.radius, hull.sigma * hull.sigma)
+}
+
+/// The readings at the probes of a surface element: at each, the signed
+/// distance of the fitted surface's point there to the mesh, and its
+/// variance along the distance's gradient `n`: the fitted height's along the
+/// element's normal, the mean's across it, and the position of the sampled
+/// edge where the probe lies within half a spacing of it. Readings beyond
+/// reach (`sd > h/2 + reach s`, `h` the spacing) are left out; every reading
+/// inside the surface is kept (the element's surface is inside the solid).
+/// Each probe's surface is searched within `radius` ([`probe_radius`]: every
+/// reading within reach lies within it), and a probe is passed over without
+/// a search when the distance of the last point read outside (first the
+/// element's mean, `centre` with its closest point `start`), less the step
+/// to it, exceeds `radius` (the ball of that distance about the point holds
+/// no surface). Then from the mesh's point closest to the probe nearest the
+/// surface, or from `start` when no probe is within `radius`, towards the
+/// element's point nearest the surface ([`refine`]).
+fn probe_readings(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (radius, centre, start): (Real, Point3, ClosestPoint),
+    out: &mut Vec<ElementReading>,
+) {
+    let allowed = HALF_SPACING * e.spacing;
+    let mut best: (Real, Point3) = (Real::INFINITY, start.point);
+    let mut reference = (centre, start);
+    for &[u, v] in &e.probes {
+        let x = frame.to_mesh(&e.surface_point(u, v).0);
+        let (xr, cr) = &reference;
+        if !cr.is_inside() && cr.distance() - (x - xr).norm() > radius {
+            continue;
+        }
+        let Some((r, closest)) = read_at(frame, e, k, (u, v), radius) else {
+            continue;
+        };
+        reference = (x, closest);
+        if r.gap < best.0 {
+            best = (r.gap, closest.point);
+        }
+        if r.gap <= allowed + frame.reach * r.std {
+            out.push(r);
+        }
+    }
+    refine(frame, e, k, best, out);
+}
+
+/// A search radius for an element's probes that holds every reading within
+/// reach: half a spacing plus the reach times a bound on the reading's
+/// standard deviation (the hull's bound along any direction, with the
+/// sampled edges' half spacing along two tangents).
+fn probe_radius(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> Real {
+    let hull = els.hulls().hull(k);
+    let e = &els.elements()[k as usize];
+    let half = HALF_SPACING * e.spacing;
+    half + frame.reach * (hull.sigma * hull.sigma + 2.0 * half * half).sqrt()
+}
+
+/// Steps from the probe nearest the surface towards the element's point
+/// nearest it: the surface point straight across from the mesh's closest
+/// point, where the element was sampled (a mesh's corner pressed into the
+/// surface between the probes is read there), at most [`REFINE_STEPS`]
+/// times while the gap shrinks; each step's reading within reach is kept.
+fn refine(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (mut gap, mut closest): (Real, Point3),
+    out: &mut Vec<ElementReading>,
+) {
+    let [[u0, u1], [v0, v1]] = e.extent;
+    for _ in 0..REFINE_STEPS {
+        let q = frame.to_cloud_point(&closest) - e.mean;
+        let (u, v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
+        if !((u0..=u1).contains(&u) && (v0..=v1).contains(&v) && e.covers(u, v)) {
+            return;
+        }
+        let Some((r, next)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
+            return;
+        };
+        let next = next.point;
+        if r.gap >= gap - 1e-12 * e.spacing {
+            return;
+        }
+        if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
+            out.push(r);
+        }
+        (gap, closest) = (r.gap, next);
+    }
+}
+
+/// Steps of [`refine`].
+const REFINE_STEPS: usize = 3;
+
+/// The reading of element `k`'s fitted surface at tangential coordinates
+/// `(u, v)` (see [`probe_readings`]) and the mesh's closest point to it;
+/// `None` if the surface point lies outside, farther than `radius`.
+fn read_at(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    (u, v): (Real, Real),
+    radius: Real,
+) -> Option<(ElementReading, ClosestPoint)> {
+    let (x, var_h) = e.surface_point(u, v);
+    let c = frame.closest_near(&frame.to_mesh(&x), radius)?;
+    let n = frame.to_cloud(&c.normal);
+    let along = e.normal.dot(&n);
+    let var = var_h * along * along + n.dot(&(across_normal(e) * n)) + edge_var_along(e, u, v, &n);
+    Some((reading(k, c.signed_distance, var), c))
+}
+
+/// The reading of element `k` with gap `gap` and variance `var`.
+fn reading(k: u32, gap: Real, var: Real) -> ElementReading {
+    ElementReading {
+        own: k,
+        other: k,
+        gap,
+        std: var.max(0.0).sqrt(),
+        beside: false,
+    }
+}
+
+/// The variance that the position of the element's sampled edges adds along
+/// `dir` at tangential coordinates `(u, v)`: within half a spacing of an
+/// edge, the edge is known to half a spacing along the tangent across it,
+/// which moves the surface's end by `t . dir` of that (as the two-cloud
+/// readings count it for a probe's own element).
+fn edge_var_along(e: &SurfaceElement, u: Real, v: Real, dir: &Vector3) -> Real {
+    let half = HALF_SPACING * e.spacing;
+    let [[u0, u1], [v0, v1]] = e.extent;
+    [(u - u0).min(u1 - u), (v - v0).min(v1 - v)]
+        .iter()
+        .zip(&e.tangents)
+        .filter(|(to_edge, _)| **to_edge <= half)
+        .map(|(_, t)| (t.dot(dir) * half).powi(2))
+        .sum()
+}

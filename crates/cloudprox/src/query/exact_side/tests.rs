@@ -1,0 +1,83 @@
+//! The readings against an exact surface, against the noise that made them.
+
+use super::frame::Frame;
+use super::readings::element_readings;
+use crate::cloud::PointCloud;
+use crate::math::{Point3, Pose};
+use crate::sample::add_noise;
+use crate::shape::{Mesh, MeshDistance};
+use crate::Real;
+
+/// A flat 30 x 30 grid at 1 cm pitch, `gap` below the unit cube's bottom face.
+fn plane(gap: Real) -> Vec<Point3> {
+    (0..900)
+        .map(|i| {
+            let (u, v) = (
+                (i % 30) as Real * 0.01 - 0.145,
+                (i / 30) as Real * 0.01 - 0.145,
+            );
+            Point3::new(u, v, -0.5 - gap)
+        })
+        .collect()
+}
+
+#[test]
+fn readings_are_the_gap_with_its_fit_error() {
+    // Over 120 noise draws, each reading's standardized residual against the
+    // exact gap (the plane is parallel to the face, so the gap is the same
+    // at every probe) has mean 0 and spread 1: the gaps are unbiased and
+    // their standard deviations are the fit's.
+    let cube = MeshDistance::new(&Mesh::cuboid(0.5, 0.5, 0.5).unwrap()).unwrap();
+    let (sigma, gap) = (0.002, 0.0003);
+    let frame = Frame::new(&cube, Pose::identity(), 1e-3);
+    let mut z: Vec<Real> = Vec::new();
+    for seed in 0..120 {
+        let cloud = PointCloud::from_sigma(add_noise(&plane(gap), sigma, seed), sigma).unwrap();
+        let els = cloud.elements();
+        let scan = element_readings(&frame, els);
+        assert!(!scan.readings.is_empty());
+        // One reading per element: its most critical probe is what P reads.
+        for (k, _) in &scan.near {
+            let e = &els.elements()[*k as usize];
+            if e.is_point() {
+                continue;
+            }
+            // The fit's standard error at the mean: at least sigma / sqrt(m)
+            // (a plane's), more with the quadric's curvature terms.
+            let (_, var0) = e.surface_point(0.0, 0.0);
+            let se = sigma / Real::from(e.count).sqrt();
+            assert!(
+                (0.999..2.5).contains(&(var0.sqrt() / se)),
+                "{} vs {se}",
+                var0.sqrt()
+            );
+            for r in scan.readings.iter().filter(|r| r.own == *k) {
+                z.push((gap - r.gap) / r.std);
+            }
+        }
+    }
+    let n = z.len() as Real;
+    let mean = z.iter().sum::<Real>() / n;
+    let sd = (z.iter().map(|x| (x - mean).powi(2)).sum::<Real>() / n).sqrt();
+    assert!(mean.abs() < 0.25, "mean {mean} over {n}");
+    assert!((0.8..1.25).contains(&sd), "sd {sd} over {n}");
+}
+
+#[test]
+fn a_cloud_beyond_reach_reads_nothing() {
+    let cube = MeshDistance::new(&Mesh::cuboid(0.5, 0.5, 0.5).unwrap()).unwrap();
+    let cloud = PointCloud::from_sigma(add_noise(&plane(0.05), 0.002, 1), 0.002).unwrap();
+    let scan = element_readings(&Frame::new(&cube, Pose::identity(), 1e-3), cloud.elements());
+    // (The hull of the 30 cm wide element reaches the face: it is tested,
+    // and its probes are beyond reach.)
+    assert!(scan.readings.is_empty());
+    // Deep inside the cube (40 cm above the bottom face): every element
+    // reads a certain crossing.
+    let inside = PointCloud::from_sigma(add_noise(&plane(-0.4), 0.002, 1), 0.002).unwrap();
+    let scan = element_readings(
+        &Frame::new(&cube, Pose::identity(), 1e-3),
+        inside.elements(),
+    );
+    assert!(!scan.readings.is_empty());
+    assert!(scan.readings.iter().all(|r| r.gap < -10.0 * r.std));
+}
