@@ -182,6 +182,8 @@ fn reading(k: u32, gap: Real, var: Real) -> ElementReading {
         gap,
         std: var.max(0.0).sqrt(),
         beside: false,
+        // One contact: the exact side has no near regions to read apart.
+        contact: 0,
     }
 }
 
