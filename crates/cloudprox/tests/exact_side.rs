@@ -105,6 +105,7 @@ fn per_point_probabilities_are_eq_3() {
             gap: d[k as usize],
             std: sz,
             beside: false,
+            contact: 0,
         })
         .collect();
     assert!((r.probability - contact_probability(&readings)).abs() < 1e-12);
