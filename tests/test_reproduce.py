@@ -390,6 +390,12 @@ def test_quick_run_writes_every_output(quick_run: Path) -> None:
         "spheres",
         "reconstruct",
     }
+    # The real scan's calibration per method: ECE, Brier, worst bin, reliability table.
+    for row in (m for m in summary["metrics"] if m["level"] == "kinect"):
+        assert 0.0 <= row["ece"] <= 1.0 and 0.0 <= row["brier"] <= 1.0, row["method"]
+        assert 0.0 <= row["worst_bin"] <= 1.0, row["method"]
+        assert sum(b[2] for b in row["reliability"]) == row["n"], row["method"]
+    assert "## Reliability on `kinect`" in (quick_run / "summary.md").read_text()
     # The frame's valid pixels of its 640 x 480 depth image.
     assert 0 < summary["kinect"]["frame_points"] <= 640 * 480
     lines = (quick_run / "results.csv").read_text().splitlines()

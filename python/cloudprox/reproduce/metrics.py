@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -85,10 +86,15 @@ class Metrics:
         ``nan`` marks a query answered but not timed on its own).
     n : int
         Number of answers (poses times draws).
-    ece, brier : float
-        Expected calibration error and Brier score of the score read as a
-        probability (clipped to ``[0, 1]``; see :func:`calibration`), NaN when
-        a score is NaN.
+    ece, brier, log_loss, worst_bin : float
+        Expected calibration error, Brier score, log-loss and worst reliability
+        bin (holding 20 or more answers, :meth:`Calibration.worst_bin`) of the
+        score read as a probability (clipped to ``[0, 1]``; see
+        :func:`calibration`), NaN when a score is NaN.
+    reliability : tuple
+        The reliability table behind them (:attr:`Calibration.table`: one row
+        ``(low, high, count, mean P, observed frequency)`` per non-empty bin),
+        empty when a score is NaN.
     """
 
     auc_all: float
@@ -103,6 +109,9 @@ class Metrics:
     n: int
     ece: float = float("nan")
     brier: float = float("nan")
+    log_loss: float = float("nan")
+    worst_bin: float = float("nan")
+    reliability: tuple[tuple[float, float, int, float, float], ...] = ()
 
 
 def _share(mask: npt.NDArray[np.bool_], among: npt.NDArray[np.bool_]) -> float:
@@ -151,11 +160,17 @@ def compute_metrics(
     )
 
 
-def _calibration_scores(score: FloatArray, label: npt.NDArray[np.bool_]) -> dict[str, float]:
+def _calibration_scores(score: FloatArray, label: npt.NDArray[np.bool_]) -> dict[str, Any]:
     if not np.all(np.isfinite(score)):
         return {}
     cal = calibration(np.clip(score, 0.0, 1.0), label)
-    return {"ece": cal.ece, "brier": cal.brier}
+    return {
+        "ece": cal.ece,
+        "brier": cal.brier,
+        "log_loss": cal.log_loss,
+        "worst_bin": cal.worst_bin(),
+        "reliability": cal.table,
+    }
 
 
 #: The reliability table's bins of ``P``: ten of equal width, as ECE is defined.

@@ -267,14 +267,15 @@ def check_claims(summary: Summary) -> list[Claim]:
 
 def _table(summary: Summary) -> str:
     head = (
-        "| level | method | ECE | Brier | AUC all | AUC near | Spearman | decided acc. | "
-        "undecided | hard flips | FP > 3σ | FN < -3σ | median ms |"
+        "| level | method | ECE | Brier | worst bin | AUC all | AUC near | Spearman | "
+        "decided acc. | undecided | hard flips | FP > 3σ | FN < -3σ | median ms |"
     )
-    lines = [head, "|" + "---|" * 13]
+    lines = [head, "|" + "---|" * 14]
     fmt = lambda x, p=".3f": "–" if not math.isfinite(x) else format(x, p)  # noqa: E731
     for (level, name), mt in summary.metrics.items():
         lines.append(
-            f"| {level} | {name} | {fmt(mt.ece)} | {fmt(mt.brier)} | {fmt(mt.auc_all)} | "
+            f"| {level} | {name} | {fmt(mt.ece)} | {fmt(mt.brier)} | {fmt(mt.worst_bin)} | "
+            f"{fmt(mt.auc_all)} | "
             f"{fmt(mt.auc_near)} | {fmt(mt.spearman)} | "
             f"{fmt(mt.decided_accuracy)} | {fmt(mt.undecided, '.1%')} | "
             f"{fmt(mt.hard_flip, '.1%')} | "
@@ -301,6 +302,27 @@ def _scan_text(summary: Summary) -> str:
     )
 
 
+def _reliability_text(summary: Summary, level: str) -> str:
+    """Return the reliability tables of ``level``'s methods side by side ("" without any)."""
+    rows = {name: mt.reliability for (lv, name), mt in summary.metrics.items() if lv == level}
+    rows = {k: v for k, v in rows.items() if v}
+    if not rows:
+        return ""
+    bins = sorted({(lo, hi) for table in rows.values() for lo, hi, *_ in table})
+    cells = {k: {(lo, hi): (n, p, f) for lo, hi, n, p, f in v} for k, v in rows.items()}
+    lines = [
+        f"## Reliability on `{level}`\n",
+        "Per bin of the score read as P: answers, mean P / share that truly collides "
+        "(worst bin: the largest difference over bins of 20 or more answers).\n",
+        "| P | " + " | ".join(rows) + " |",
+        "|" + "---|" * (len(rows) + 1),
+    ]
+    for b in bins:
+        row = ["{}: {:.2f} / {:.2f}".format(*cells[k][b]) if b in cells[k] else "" for k in rows]
+        lines.append(f"| [{b[0]:.1f}, {b[1]:.1f}) | " + " | ".join(row) + " |")
+    return "\n".join(lines) + "\n\n"
+
+
 def _markdown(summary: Summary) -> str:
     c = summary.config
     sig = ", ".join(f"{k}: σ = {1e3 * v:.1f} mm" for k, v in summary.sigmas.items())
@@ -315,7 +337,9 @@ def _markdown(summary: Summary) -> str:
         f"Near = exact |signed distance| <= {NEAR_SIGMA:g} σ. Run time {summary.seconds:.0f} s.\n\n"
         + _scan_text(summary)
         + "".join(f"Note: {x}.\n\n" for x in summary.notes)
-        + f"{_table(summary)}\n\n## Headline claims\n\n"
+        + f"{_table(summary)}\n\n"
+        + _reliability_text(summary, KINECT)
+        + "## Headline claims\n\n"
         f"| level | claim | holds | measured |\n|---|---|---|---|\n{claims}\n"
     )
 
