@@ -31,7 +31,7 @@ pub struct ElementReading {
 /// How far apart, in the standard deviations of their difference, two
 /// element pairs' gaps may read and still be taken for readings of one
 /// contact ([`contact_probability`]).
-pub(crate) const CONTACT_WINDOW: Real = 2.0;
+const CONTACT_WINDOW: Real = 2.0;
 
 /// The probability that the two sampled surfaces cross, from the facing
 /// pairs' readings ([`ElementReading`]): the largest over the contacts
@@ -115,13 +115,13 @@ fn one_contact(mut order: Vec<&ElementReading>) -> Real {
     // (Ties by the element pair, named alike from either side: swapping A
     // and B reads the same readings.)
     order[1..].sort_by(|x, y| x.std.total_cmp(&y.std).then(pair_key(x).cmp(&pair_key(y))));
-    inverse_variance_mean(&disjoint_within(&order, CONTACT_WINDOW))
+    inverse_variance_mean(&disjoint_within(&order))
 }
 
 /// The readings of `order` (the contact's own first) that agree with the
-/// first within `window` standard deviations of their difference, each
+/// first within `CONTACT_WINDOW` standard deviations of their difference, each
 /// element taken once, in `order`'s order.
-fn disjoint_within<'a>(order: &[&'a ElementReading], window: Real) -> Vec<&'a ElementReading> {
+fn disjoint_within<'a>(order: &[&'a ElementReading]) -> Vec<&'a ElementReading> {
     let (g0, s0) = (order[0].gap, order[0].std);
     let (mut used_own, mut used_other): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     let mut out = Vec::new();
@@ -130,7 +130,7 @@ fn disjoint_within<'a>(order: &[&'a ElementReading], window: Real) -> Vec<&'a El
         if s.is_nan() || s <= 0.0 || used_own.contains(&r.own) || used_other.contains(&r.other) {
             continue;
         }
-        if (g - g0).abs() > window * (s * s + s0 * s0).sqrt() {
+        if (g - g0).abs() > CONTACT_WINDOW * (s * s + s0 * s0).sqrt() {
             continue;
         }
         used_own.push(r.own);
