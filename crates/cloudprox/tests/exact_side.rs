@@ -104,6 +104,7 @@ fn per_point_probabilities_are_eq_3() {
             other: k,
             gap: d[k as usize],
             std: sz,
+            fit_std: sz,
             beside: false,
             contact: 0,
         })

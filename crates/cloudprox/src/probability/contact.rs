@@ -20,47 +20,45 @@ pub struct ElementReading {
     pub gap: Real,
     /// Its standard deviation.
     pub std: Real,
+    /// The part of `std` from the two fitted surfaces alone, without where
+    /// their sampled edges are: what differs by noise between readings of one
+    /// pair of elements ([`contact_probability`]).
+    pub fit_std: Real,
     /// Whether the probe lies beside the facing element (the gap read between
-    /// two surfaces' ends) rather than over it.
+    /// two surfaces' ends), or the reading is a clearance measured across the
+    /// probe's own end (closer to its element's tangent plane than to its
+    /// normal), rather than one surface over the other.
     pub beside: bool,
     /// The contact the reading belongs to (a query's connected near region):
-    /// readings of different contacts are never pooled.
+    /// readings of different contacts are read apart.
     pub contact: u32,
 }
-
-/// How far apart, in the standard deviations of their difference, two
-/// element pairs' gaps may read and still be taken for readings of one
-/// contact ([`contact_probability`]).
-const CONTACT_WINDOW: Real = 2.0;
 
 /// The probability that the two sampled surfaces cross, from the facing
 /// pairs' readings ([`ElementReading`]): the largest over the contacts
 /// (`contact`) of each contact's crossing probability.
 ///
-/// At one contact each element pair is read once, by its most critical
-/// reading (the smallest `gap / std`) among those read over the facing
-/// element, or among its readings beside it where it has none over it (two
-/// surfaces' ends say less of a crossing than one surface over the other).
-/// The most critical of these read over a surface places the contact (one
-/// beside only where none is over). Readings are then taken once per element
-/// (an element's surface error is one random field: two readings sharing an
-/// element are not independent): the contact's own reading first, then the
-/// most precise.
+/// At one contact each element pair is read once ([`pair_reading`]), among
+/// its readings over the facing element, or among those beside it (or
+/// reading a clearance across the probe's own end, see
+/// [`ElementReading::beside`]) where it has none over it: two surfaces' ends
+/// say less of a crossing than one surface over the other. The contact's `P` is
+/// `Phi(-g / s)` of its most critical pair (the smallest `g / s`), a pair
+/// read over a surface before one read beside.
 ///
-/// The readings whose gaps agree with the contact's within `CONTACT_WINDOW`
-/// (2) standard deviations of their difference read the same contact: they
-/// are independent estimates of the gap there, and their inverse-variance
-/// mean `g` with standard deviation `s = (sum 1/s_k^2)^(-1/2)` gives
-/// `P = Phi(-g / s)`. (A small element's imprecise reading at the contact
-/// keeps its elements' other readings out: its surface is read as its own, so
-/// a face split into a large and a small element is as uncertain as the
-/// small one where it meets the other surface.)
+/// The readings of one pair share the two fitted surfaces, so the most
+/// critical of them reads the minimum of one correlated noisy field, which
+/// is biased towards a crossing (on parallel plates by 1.25 standard
+/// deviations at the contact); the pair's most precise reading is not. The
+/// pairs of a contact read different places of it: the most critical pair is
+/// where the surfaces come closest (on two spheres the pairs' gaps rise away
+/// from the closest approach faster than the noise), and pooling it with the
+/// others reads a gap that is too large.
 ///
-/// The largest single tail `max_k Phi(-g_k / s_k)` reads the minimum of many
-/// noisy readings, which is biased towards a crossing wherever several
-/// elements face each other; the standardized residuals of the single
-/// readings against exact geometry are standard normal, so the readings
-/// themselves are honest and the aggregation is what must not overstate.
+/// The rule takes two facing surfaces whose fits agree with being parallel
+/// within their noise for parallel: a relative tilt smaller than a few times
+/// the fits' slope error is not resolved, and a corner that it alone brings
+/// through the other surface is read at the gap where the fits are best.
 /// 0 without readings.
 pub fn contact_probability(readings: &[ElementReading]) -> Real {
     let mut contacts: Vec<u32> = readings.iter().map(|r| r.contact).collect();
@@ -90,66 +88,64 @@ fn z(r: &ElementReading) -> Real {
     }
 }
 
+/// How many standard deviations of their two readings an element pair's most
+/// critical reading must lie below its most precise one to be read instead
+/// ([`pair_reading`]).
+const VARIATION_SDS: Real = 3.0;
+
 /// The crossing probability of one contact's readings
 /// ([`contact_probability`]).
-fn one_contact(mut order: Vec<&ElementReading>) -> Real {
-    // One reading per element pair: over before beside, then most critical.
-    order.sort_by(|x, y| {
-        (x.own, x.other, x.beside)
-            .cmp(&(y.own, y.other, y.beside))
-            .then(z(x).total_cmp(&z(y)))
-    });
-    order.dedup_by(|x, y| (x.own, x.other) == (y.own, y.other));
-    // The contact is placed by the most critical reading over a surface, by
-    // one beside only where there is none over.
-    order.sort_by(|x, y| x.beside.cmp(&y.beside).then(z(x).total_cmp(&z(y))));
-    let Some(first) = order.first() else {
-        return 0.0;
+fn one_contact(readings: Vec<&ElementReading>) -> Real {
+    pairs(readings)
+        .into_iter()
+        .min_by(|x, y| {
+            x.beside
+                .cmp(&y.beside)
+                .then(z(x).total_cmp(&z(y)))
+                .then(pair_key(x).cmp(&pair_key(y)))
+        })
+        .map_or(0.0, |r| wrong_side(r.gap, r.std))
+}
+
+/// Each element pair's reading ([`pair_reading`]): over the facing element
+/// where the pair has such readings, beside it where it has none.
+fn pairs(mut order: Vec<&ElementReading>) -> Vec<&ElementReading> {
+    order.sort_by_key(|r| (r.own, r.other, r.beside));
+    order
+        .chunk_by(|x, y| (x.own, x.other) == (y.own, y.other))
+        .filter_map(|pair| {
+            let over = pair.partition_point(|r| !r.beside);
+            pair_reading(if over > 0 { &pair[..over] } else { pair })
+        })
+        .collect()
+}
+
+/// The reading of one element pair from its readings at different probes
+/// (`None` without any): the most precise, unless the most critical lies more
+/// than `VARIATION_SDS` standard deviations of the two fits below it.
+///
+/// The readings of one pair share the two fitted surfaces: they differ by the
+/// fits' slope and curvature errors, which grow towards the elements' edges,
+/// and by how the true gap varies over the pair. The most critical of many
+/// such readings is biased towards a crossing (on two parallel plates, by 1.25
+/// standard deviations at the contact); the most precise reads the gap where
+/// the fits are best. Where the gap truly varies across the pair by more than
+/// the fits' noise (a pair straddling a crossing, a tilted or curved contact,
+/// a face ending at an angle over another), the most critical reading is
+/// where the surfaces come closest. (Where a sampled surface ends is uncertain
+/// by more than its fit, but alike for the readings near that end: it does
+/// not make one of them look closer than another by chance.)
+fn pair_reading<'a>(readings: &[&'a ElementReading]) -> Option<&'a ElementReading> {
+    let by = |key: fn(&ElementReading) -> Real| {
+        readings
+            .iter()
+            .copied()
+            .min_by(|x, y| key(x).total_cmp(&key(y)))
     };
-    if first.std.is_nan() || first.std <= 0.0 {
-        return wrong_side(first.gap, first.std);
-    }
-    // The contact's own reading first, then the most precise: readings far
-    // from the contact agree with it only loosely, and must not keep out a
-    // more precise reading of the same elements nearer to it.
-    // (Ties by the element pair, named alike from either side: swapping A
-    // and B reads the same readings.)
-    order[1..].sort_by(|x, y| x.std.total_cmp(&y.std).then(pair_key(x).cmp(&pair_key(y))));
-    inverse_variance_mean(&disjoint_within(&order))
-}
-
-/// The readings of `order` (the contact's own first) that agree with the
-/// first within `CONTACT_WINDOW` standard deviations of their difference, each
-/// element taken once, in `order`'s order.
-fn disjoint_within<'a>(order: &[&'a ElementReading]) -> Vec<&'a ElementReading> {
-    let (g0, s0) = (order[0].gap, order[0].std);
-    let (mut used_own, mut used_other): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
-    let mut out = Vec::new();
-    for &r in order {
-        let (g, s) = (r.gap, r.std);
-        if s.is_nan() || s <= 0.0 || used_own.contains(&r.own) || used_other.contains(&r.other) {
-            continue;
-        }
-        if (g - g0).abs() > CONTACT_WINDOW * (s * s + s0 * s0).sqrt() {
-            continue;
-        }
-        used_own.push(r.own);
-        used_other.push(r.other);
-        out.push(r);
-    }
-    out
-}
-
-/// `Phi(-g / s)` of the readings' inverse-variance mean `g` and its standard
-/// deviation `s` (at least one reading).
-fn inverse_variance_mean(readings: &[&ElementReading]) -> Real {
-    let (mut weights, mut weighted) = (0.0, 0.0);
-    for r in readings {
-        let w = 1.0 / (r.std * r.std);
-        weights += w;
-        weighted += w * r.gap;
-    }
-    wrong_side(weighted / weights, weights.recip().sqrt())
+    let (precise, critical) = (by(|r| r.std)?, by(z)?);
+    let spread = precise.fit_std.hypot(critical.fit_std);
+    let varies = precise.gap - critical.gap > VARIATION_SDS * spread || !spread.is_finite();
+    Some(if varies { critical } else { precise })
 }
 
 #[cfg(test)]
@@ -167,28 +163,73 @@ mod tests {
                 other: k,
                 gap,
                 std: s,
+                fit_std: s,
                 beside: false,
                 contact: 0,
             })
             .collect()
     }
 
+    /// One reading of the pair `(own, other)`.
+    fn reading(own: u32, other: u32, gap: Real, std: Real) -> ElementReading {
+        ElementReading {
+            own,
+            other,
+            gap,
+            std,
+            fit_std: std,
+            beside: false,
+            contact: 0,
+        }
+    }
+
     #[test]
-    fn agreeing_independent_readings_are_pooled_by_inverse_variance() {
-        // Nine readings of one gap, 1 mm each: the mean of nine has a third
-        // of the deviation.
-        let p = contact_probability(&flat(3, 1e-3, 1e-3));
+    fn the_most_critical_pair_places_the_contact() {
+        // Nine pairs of a contact: the closest (gap 1 mm, 1 mm) is P, the
+        // others read farther places of it.
+        let mut r = flat(3, 4e-3, 1e-3);
+        r[4].gap = 1e-3;
+        let p = contact_probability(&r);
+        assert!((p - normal_cdf(-1.0)).abs() < 1e-12, "P {p}");
+    }
+
+    #[test]
+    fn a_pair_is_read_where_its_fits_are_most_precise() {
+        // One pair at four probes: the most critical (gap 0.5 mm, 1 mm)
+        // lies within the noise of the most precise (1 mm, 0.5 mm), which
+        // reads the pair.
+        let r = [
+            reading(0, 0, 1e-3, 0.5e-3),
+            reading(0, 0, 0.5e-3, 1e-3),
+            reading(0, 0, 2e-3, 1e-3),
+            reading(0, 0, 1.5e-3, 0.8e-3),
+        ];
+        let p = contact_probability(&r);
+        assert!((p - normal_cdf(-2.0)).abs() < 1e-12, "P {p}");
+        // A critical reading more than 3 sd of the two below the precise one
+        // is a place where the surfaces truly come closer: it reads the pair.
+        let deep = -3.5e-3;
+        let r = [reading(0, 0, 1e-3, 0.5e-3), reading(0, 0, deep, 1e-3)];
+        let p = contact_probability(&r);
+        assert!((p - normal_cdf(3.5)).abs() < 1e-12, "P {p}");
+        assert!(1e-3 - deep > VARIATION_SDS * (0.5e-3f64).hypot(1e-3));
+    }
+
+    #[test]
+    fn readings_over_a_surface_come_before_those_beside_it() {
+        // A pair read beside (an end, 0.1 mm, 1 mm) and another over a
+        // surface (3 mm, 1 mm): the one over reads the contact.
+        let mut r = vec![reading(0, 0, 1e-4, 1e-3), reading(1, 1, 3e-3, 1e-3)];
+        r[0].beside = true;
+        let p = contact_probability(&r);
         assert!((p - normal_cdf(-3.0)).abs() < 1e-12, "P {p}");
-        // A reading beyond the window (5 sd of the difference) is another
-        // place of the contact, not read with it.
-        let mut r = flat(1, 1e-3, 1e-3);
-        r.push(ElementReading {
-            own: 7,
-            other: 7,
-            gap: 1e-3 + 5.0 * 2f64.sqrt() * 1e-3,
-            ..r[0]
-        });
-        assert!((contact_probability(&r) - normal_cdf(-1.0)).abs() < 1e-12);
+        // Within one pair too: its readings over the facing element count.
+        r[1] = reading(0, 0, 3e-3, 1e-3);
+        assert_eq!(contact_probability(&r), p);
+        // Only beside: they read it.
+        r.truncate(1);
+        let p = contact_probability(&r);
+        assert!((p - normal_cdf(-0.1)).abs() < 1e-12, "P {p}");
     }
 
     #[test]
@@ -209,22 +250,11 @@ mod tests {
     }
 
     #[test]
-    fn readings_sharing_an_element_count_once() {
-        // Ten readings of one element of A against ten of B: one element's
-        // error, so the pooled deviation is not shrunk by ten.
+    fn swapping_the_sides_names_reads_the_same() {
         let readings: Vec<ElementReading> = (0..10u32)
-            .map(|k| ElementReading {
-                own: 0,
-                other: k,
-                gap: 1e-3,
-                std: 1e-3,
-                beside: false,
-                contact: 0,
-            })
+            .map(|k| reading(k % 3, k, 1e-3 + 1e-4 * Real::from(k), 1e-3))
             .collect();
         let p = contact_probability(&readings);
-        assert!((p - normal_cdf(-1.0)).abs() < 1e-12, "P {p}");
-        // Swapping the sides' names reads the same.
         let swapped: Vec<ElementReading> = readings
             .iter()
             .map(|r| ElementReading {
@@ -234,5 +264,6 @@ mod tests {
             })
             .collect();
         assert_eq!(contact_probability(&swapped), p);
+        assert!((p - normal_cdf(-1.0)).abs() < 1e-12, "P {p}");
     }
 }

@@ -236,6 +236,20 @@ impl<'a> Posed<'a> {
         (u1 - u0).max(v1 - v0) / self.e.spacing
     }
 
+    /// Whether a clearance `gap` along `dir` is read across the element's own
+    /// end rather than across its surface: `gap > 0` and `dir` closer to the
+    /// tangent plane than to the normal (never for a single point). Such a
+    /// reading says where the sampled surface ends, which is known only to
+    /// half a spacing, and the surface it ends at says more (a table's side
+    /// face under a piano, where the table's top reads the gap); read across
+    /// an end, a crossing (the surface has passed through the other) counts
+    /// as any other (see [`crate::probability::contact_probability`]).
+    fn clearance_across_its_end(&self, gap: Real, dir: &Vector3) -> bool {
+        gap > 0.0
+            && !self.e.is_point()
+            && self.normal.dot(dir).abs() < std::f64::consts::FRAC_1_SQRT_2
+    }
+
     /// A bound on the variance along any direction.
     fn var_bound(&self, var: Real) -> Real {
         var + self.across.trace()
@@ -536,7 +550,8 @@ pub(crate) fn element_crossing_probabilities(
                 other: f.other as u32,
                 gap: r.gap,
                 std: r.std,
-                beside: f.key.0,
+                fit_std: r.fit_std,
+                beside: f.key.0 || po[f.own].clearance_across_its_end(r.gap, &r.direction),
                 contact: 0,
             });
         }
@@ -553,6 +568,8 @@ struct PairReading {
     gap: Real,
     /// Its standard deviation.
     std: Real,
+    /// The part of `std` from the two fitted surfaces alone.
+    fit_std: Real,
     /// `Phi(-gap / std)`.
     probability: Real,
     /// Whether the pair lies within the noise's reach (else it counts 0).
@@ -615,15 +632,16 @@ fn read_pair(
     } else {
         0.0
     };
-    let var_own = (own_e.var_along(f.var_x, &u) + own_e.edge_var_along(&f.x, &u)).max(0.0);
-    let var_other = (other_e.var_along(f.var_y, &u) + other_edge).max(0.0);
-    let sd = (var_own + var_other).sqrt();
+    let fit = (own_e.var_along(f.var_x, &u) + other_e.var_along(f.var_y, &u)).max(0.0);
+    let edges = own_e.edge_var_along(&f.x, &u) + other_edge;
+    let sd = (fit + edges).max(0.0).sqrt();
     let span = (f.y - f.x).norm();
     let reach = f.allowed + reach_sds * sd;
     Some(PairReading {
         direction: u,
         gap,
         std: sd,
+        fit_std: fit.sqrt(),
         probability: wrong_side(gap, sd),
         within_reach: span <= reach,
         steep,

@@ -53,7 +53,8 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
 fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
     let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
     let n = frame.to_cloud(&c.normal);
-    reading(k, c.signed_distance, n.dot(&(e.cov_mean * n)))
+    let var = n.dot(&(e.cov_mean * n));
+    reading(k, c.signed_distance, var, var)
 }
 
 /// An element found deep inside: its least deep point lies at most its
@@ -61,7 +62,8 @@ fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReadin
 fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementReading {
     let hull = els.hulls().hull(k);
     let sd = frame.mesh.signed_distance(&frame.to_mesh(&hull.mean));
-    reading(k, sd + hull.radius, hull.sigma * hull.sigma)
+    let var = hull.sigma * hull.sigma;
+    reading(k, sd + hull.radius, var, var)
 }
 
 /// The readings at the probes of a surface element: at each, the signed
@@ -170,17 +172,20 @@ fn read_at(
     let c = frame.closest_near(&frame.to_mesh(&x), radius)?;
     let n = frame.to_cloud(&c.normal);
     let along = e.normal.dot(&n);
-    let var = var_h * along * along + n.dot(&(across_normal(e) * n)) + edge_var_along(e, u, v, &n);
-    Some((reading(k, c.signed_distance, var), c))
+    let fit = var_h * along * along + n.dot(&(across_normal(e) * n));
+    let edge = edge_var_along(e, u, v, &n);
+    Some((reading(k, c.signed_distance, fit + edge, fit), c))
 }
 
-/// The reading of element `k` with gap `gap` and variance `var`.
-fn reading(k: u32, gap: Real, var: Real) -> ElementReading {
+/// The reading of element `k` with gap `gap` and variance `var`, `fit` of it
+/// from the element's fitted surface.
+fn reading(k: u32, gap: Real, var: Real, fit: Real) -> ElementReading {
     ElementReading {
         own: k,
         other: k,
         gap,
         std: var.max(0.0).sqrt(),
+        fit_std: fit.max(0.0).sqrt(),
         beside: false,
         // One contact: the exact side has no near regions to read apart.
         contact: 0,
