@@ -38,7 +38,7 @@ pub struct ElementReading {
 /// pairs' readings ([`ElementReading`]): the largest over the contacts
 /// (`contact`) of each contact's crossing probability.
 ///
-/// At one contact each element pair is read once ([`pair_reading`]), among
+/// At one contact each element pair is read once (see below), among
 /// its readings over the facing element, or among those beside it (or
 /// reading a clearance across the probe's own end, see
 /// [`ElementReading::beside`]) where it has none over it: two surfaces' ends
@@ -49,7 +49,11 @@ pub struct ElementReading {
 /// The readings of one pair share the two fitted surfaces, so the most
 /// critical of them reads the minimum of one correlated noisy field, which
 /// is biased towards a crossing (on parallel plates by 1.25 standard
-/// deviations at the contact); the pair's most precise reading is not. The
+/// deviations at the contact); the pair's most precise reading is not. So a
+/// pair is read at its most precise reading, unless its most critical lies
+/// more than 3 standard deviations of the two fits (`fit_std`) below it: the
+/// gap then truly varies across the pair, and the most critical reading is
+/// where the surfaces come closest. The
 /// pairs of a contact read different places of it: the most critical pair is
 /// where the surfaces come closest (on two spheres the pairs' gaps rise away
 /// from the closest approach faster than the noise), and pooling it with the

@@ -89,7 +89,11 @@ fn probe_readings(
     out: &mut Vec<ElementReading>,
 ) {
     let allowed = HALF_SPACING * e.spacing;
-    let mut best: (Real, Point3) = (Real::INFINITY, start.point);
+    let mut best = Nearest {
+        gap: Real::INFINITY,
+        at: None,
+        closest: start,
+    };
     let mut reference = (centre, start);
     for &[u, v] in &e.probes {
         let x = frame.to_mesh(&e.surface_point(u, v).0);
@@ -101,14 +105,27 @@ fn probe_readings(
             continue;
         };
         reference = (x, closest);
-        if r.gap < best.0 {
-            best = (r.gap, closest.point);
+        if r.gap < best.gap {
+            best = Nearest {
+                gap: r.gap,
+                at: Some((u, v)),
+                closest,
+            };
         }
         if r.gap <= allowed + frame.reach * r.std {
             out.push(r);
         }
     }
-    refine(frame, e, k, best, out);
+    let best = refine(frame, e, k, best, out);
+    descend(frame, e, k, &best, out);
+}
+
+/// The element's surface point read nearest the surface so far: its gap, its
+/// tangential coordinates (`None` before any) and the mesh's closest point.
+struct Nearest {
+    gap: Real,
+    at: Option<(Real, Real)>,
+    closest: ClosestPoint,
 }
 
 /// A search radius for an element's probes that holds every reading within
@@ -131,29 +148,86 @@ fn refine(
     frame: &Frame<'_>,
     e: &SurfaceElement,
     k: u32,
-    (mut gap, mut closest): (Real, Point3),
+    mut best: Nearest,
     out: &mut Vec<ElementReading>,
-) {
-    let [[u0, u1], [v0, v1]] = e.extent;
+) -> Nearest {
     for _ in 0..REFINE_STEPS {
-        let q = frame.to_cloud_point(&closest) - e.mean;
+        let q = frame.to_cloud_point(&best.closest.point) - e.mean;
         let (u, v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
-        if !((u0..=u1).contains(&u) && (v0..=v1).contains(&v) && e.covers(u, v)) {
-            return;
+        if !sampled_at(e, u, v) {
+            break;
         }
         let Some((r, next)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
+            break;
+        };
+        if r.gap >= best.gap - 1e-12 * e.spacing {
+            break;
+        }
+        best = Nearest {
+            gap: r.gap,
+            at: Some((u, v)),
+            closest: next,
+        };
+        if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
+            out.push(r);
+        }
+    }
+    best
+}
+
+/// Whether `(u, v)` lies within the element's extent, where it was sampled.
+fn sampled_at(e: &SurfaceElement, u: Real, v: Real) -> bool {
+    let [[u0, u1], [v0, v1]] = e.extent;
+    (u0..=u1).contains(&u) && (v0..=v1).contains(&v) && e.covers(u, v)
+}
+
+/// From the element's surface point nearest the surface (where [`refine`]
+/// stopped), steps along the element's surface into the solid: along the
+/// part of the closest point's inward normal within the element's tangent
+/// plane, half a spacing and then twice as far each step, at most
+/// [`DESCEND_STEPS`] times while the gap falls, where the element was
+/// sampled; each step's reading within reach is kept. Where the element's
+/// surface passes through a thin part of the solid (a bar through a floor
+/// tens of centimetres from the element's probes), the closest points lead
+/// only to the part's wall, and the surface goes on inside it.
+fn descend(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    best: &Nearest,
+    out: &mut Vec<ElementReading>,
+) {
+    let Some((mut u, mut v)) = best.at else {
+        return;
+    };
+    let inward = -frame.to_cloud(&best.closest.normal);
+    let (du, dv) = (inward.dot(&e.tangents[0]), inward.dot(&e.tangents[1]));
+    let along = du.hypot(dv);
+    if along <= 1e-6 || !along.is_finite() {
+        return;
+    }
+    let (du, dv) = (du / along, dv / along);
+    let (mut gap, mut step) = (best.gap, HALF_SPACING * e.spacing);
+    for _ in 0..DESCEND_STEPS {
+        let (nu, nv) = (u + du * step, v + dv * step);
+        if !sampled_at(e, nu, nv) {
+            return;
+        }
+        let Some((r, _)) = read_at(frame, e, k, (nu, nv), Real::INFINITY) else {
             return;
         };
-        let next = next.point;
         if r.gap >= gap - 1e-12 * e.spacing {
             return;
         }
         if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
             out.push(r);
         }
-        (gap, closest) = (r.gap, next);
+        (u, v, gap, step) = (nu, nv, r.gap, 2.0 * step);
     }
 }
+
+/// Steps of [`descend`].
+const DESCEND_STEPS: usize = 6;
 
 /// Steps of [`refine`].
 const REFINE_STEPS: usize = 3;
