@@ -223,6 +223,13 @@ impl SurfaceElement {
         )
     }
 
+    /// Whether `(u, v)` lies within the element's extent and where it was
+    /// sampled ([`SurfaceElement::covers`]).
+    pub fn sampled_over(&self, u: Real, v: Real) -> bool {
+        let [[u0, u1], [v0, v1]] = self.extent;
+        (u0..=u1).contains(&u) && (v0..=v1).contains(&v) && self.covers(u, v)
+    }
+
     /// Whether the surface was sampled at tangential coordinates `(u, v)`: some
     /// point of the element lies within one sampling spacing of it in the
     /// tangent plane. The extent's rectangle is only a summary (a square face

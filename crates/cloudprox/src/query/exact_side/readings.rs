@@ -154,7 +154,7 @@ fn refine(
     for _ in 0..REFINE_STEPS {
         let q = frame.to_cloud_point(&best.closest.point) - e.mean;
         let (u, v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
-        if !sampled_at(e, u, v) {
+        if !e.sampled_over(u, v) {
             break;
         }
         let Some((r, next)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
@@ -173,12 +173,6 @@ fn refine(
         }
     }
     best
-}
-
-/// Whether `(u, v)` lies within the element's extent, where it was sampled.
-fn sampled_at(e: &SurfaceElement, u: Real, v: Real) -> bool {
-    let [[u0, u1], [v0, v1]] = e.extent;
-    (u0..=u1).contains(&u) && (v0..=v1).contains(&v) && e.covers(u, v)
 }
 
 /// From the element's surface point nearest the surface (where [`refine`]
@@ -210,7 +204,7 @@ fn descend(
     let (mut gap, mut step) = (best.gap, HALF_SPACING * e.spacing);
     for _ in 0..DESCEND_STEPS {
         let (nu, nv) = (u + du * step, v + dv * step);
-        if !sampled_at(e, nu, nv) {
+        if !e.sampled_over(nu, nv) {
             return;
         }
         let Some((r, _)) = read_at(frame, e, k, (nu, nv), Real::INFINITY) else {
