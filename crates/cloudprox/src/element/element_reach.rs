@@ -262,6 +262,40 @@ impl ElementHulls {
     pub(crate) fn hull(&self, e: u32) -> &Hull {
         &self.hulls[e as usize]
     }
+
+    /// Whether some leaf of the hierarchy comes within `limit(sigma, margin)`
+    /// of `bounds` (same frame), `sigma` and `margin` the node's largest over
+    /// all its elements: a one-sided descent, whose `false` proves that every
+    /// element's surface lies farther than its own limit from the box (the
+    /// limit must grow with both arguments). Returns the answer and the
+    /// number of nodes tested.
+    pub(crate) fn near_box(
+        &self,
+        bounds: &Aabb,
+        limit: impl Fn(Real, Real) -> Real,
+        stack: &mut Vec<u32>,
+    ) -> (bool, usize) {
+        let b = &self.all;
+        let mut visited = 0;
+        stack.clear();
+        stack.push(0);
+        while let Some(id) = stack.pop() {
+            visited += 1;
+            let i = id as usize;
+            let l = limit(b.sigma[i], b.margin[i]);
+            if !b.any[i] || b.boxes[i].distance_squared(bounds) > l * l {
+                continue;
+            }
+            match self.tree.nodes()[i].children {
+                None => return (true, visited),
+                Some([l, r]) => {
+                    stack.push(r);
+                    stack.push(l);
+                }
+            }
+        }
+        (false, visited)
+    }
 }
 
 /// Whether two elements' surfaces (A's hull `a`, posed as `corners`, `mean`,
