@@ -14,8 +14,8 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   the exact scene meshes (the anchor) and against the collision map's occupied
   voxels as boxes (sensor resolution and 2 cm), the links posed beforehand (not
   timed). Each model also with ``decide_only=True`` (what a planner's chance
-  constraint asks). Far: uniformly random configurations whose exact clearance
-  exceeds 5 sigma (the scan's median sigma); near contact: the agreement set
+  constraint asks). Uniform: every uniformly random configuration; far: those
+  whose exact clearance exceeds 5 sigma (the scan's median sigma); near contact: the agreement set
   below, free and within 5 sigma; penetrating: the agreement set's colliding
   configurations. With ``--repeat N`` each configuration is queried N times
   and its fastest call kept (the median is then over the configurations'
@@ -375,6 +375,7 @@ def main() -> None:
     rows = []
     penetrating = near_q[near_d < 0]
     cases = (
+        ("uniform random", qs),
         ("far (> 5 sigma)", far),
         ("near contact (free, <= 5 sigma)", free_near),
         ("penetrating", penetrating),
@@ -431,6 +432,24 @@ def main() -> None:
             + f" | {us(t_ex)} | "
             + " | ".join(us(t_maps[k]) for k in map_names)
             + f" | {np.median(t_cp[first]) / np.median(t_ex):.1f}x |"
+        )
+
+    print("\ncloudprox's time per configuration, one thread: median / mean / max:\n")
+    print(
+        "| configurations | "
+        + " | ".join(f"{label(m, s)}{', decide-only' if d else ''}" for m, s, d in modes)
+        + " |"
+    )
+    print("|---|" + "---|" * len(modes))
+    for name, _, t_cp, _, _ in rows:
+        print(
+            f"| {name} | "
+            + " | ".join(
+                f"{us(t_cp[md])} / {us(np.array([t_cp[md].mean()]))} / "
+                f"{us(np.array([t_cp[md].max()]))}"
+                for md in modes
+            )
+            + " |"
         )
 
     # What a planner calling `collide_robot` once per configuration waits for:

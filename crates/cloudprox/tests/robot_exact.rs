@@ -258,13 +258,24 @@ fn the_broad_phase_changes_the_cost_not_the_answer() {
             ..with
         };
         let mut skipped = 0;
-        for q in [
+        // Turned links near the wall, grazing it or a few sigma off.
+        let turned = (0..30).map(|i| {
+            let t = f64::from(i);
+            [
+                0.3 * (0.7 * t).sin(),
+                0.5 * (1.3 * t).cos(),
+                0.05 + 0.05 * (0.9 * t).sin(),
+                0.0,
+            ]
+        });
+        let configurations = [
             [0.0, 0.0, 0.0, 0.0],
             [0.0, 0.0, 0.06, 0.0],
             [0.0, 0.0, 0.075, 0.0],
             [0.2, -0.1, 0.1, 0.0],
             [1.5, 0.0, 0.1, 0.0],
-        ] {
+        ];
+        for q in configurations.into_iter().chain(turned) {
             let a = query(&robot, &q, &cloud, &with);
             let b = query(&robot, &q, &cloud, &without);
             assert_eq!(b.stats.counters.links_queried, 6);
@@ -340,4 +351,32 @@ fn exact_links_reject_what_they_cannot_read() {
     assert!(e.to_string().contains("surface"), "{e}");
     surface.mesh_side = MeshSide::Sampled;
     assert!(collide_robot(&robot, &[0.0, 0.0], &Pose::identity(), &cloud, &surface).is_ok());
+}
+
+#[test]
+fn a_tilted_box_near_the_reach_is_skipped_only_where_it_reads_nothing() {
+    let (robot, cloud) = (paddle(), floor(10));
+    for model in MODELS {
+        let with = request(MeshSide::Exact, model);
+        let without = RobotRequest {
+            broad_phase: false,
+            ..with
+        };
+        let (mut skipped, mut read) = (0, 0);
+        for i in 0..40 {
+            let tilt = 0.1 * f64::from(i % 8);
+            // The lowest corner from 2 sigma below the plane to 37 above.
+            let low = 0.05 * tilt.sin() + HALF_Z * tilt.cos();
+            let q = [low + SIGMA * f64::from(i - 2), tilt];
+            let a = query(&robot, &q, &cloud, &with);
+            let b = query(&robot, &q, &cloud, &without);
+            assert_eq!(a.probability, b.probability, "{model:?} {q:?}");
+            skipped += usize::from(a.stats.counters.links_queried == 0);
+            read += usize::from(b.probability > 0.0);
+        }
+        assert!(
+            skipped > 0 && read > 0,
+            "{model:?}: {skipped} skipped, {read} read"
+        );
+    }
 }

@@ -38,11 +38,13 @@ pub struct RobotRequest {
     /// [`crate::query::collide_mesh_cloud`] does.
     pub mesh_spacing: Option<Real>,
     /// Skip links that cannot reach the cloud (default `true`), reading
-    /// `P = 0` without a query. Exact links: the link's bounding box (in the
-    /// world frame) is beyond the noise's reach of every leaf of the cloud's
-    /// hierarchy over its points (points model) or over its element hulls
-    /// (elements model), so the exact-side query would read nothing; no
-    /// signed distance is evaluated. Sampled links, points model: the link's
+    /// `P = 0` without a query. Exact links: the link's bounding box, moved
+    /// into the cloud's frame, descends the cloud's hierarchy over its points
+    /// (points model) or over its element hulls (elements model), and the
+    /// points or element surfaces of the leaves within the noise's reach are
+    /// tested against the box in the link's frame; when none is within
+    /// reach, the exact-side query would read nothing. No signed distance is
+    /// evaluated. Sampled links, points model: the link's
     /// bounding box is beyond the noise's reach of every node of the cloud's
     /// hierarchy, so no pair of points is near by the query's near rule.
     /// Sampled links, elements model: no element surface of the link may
@@ -465,10 +467,14 @@ fn link_near(
     counters: &mut RobotCounters,
 ) -> bool {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
-    let world = geometry.aabb.transformed(pose);
     let samples = match scene.sides {
         LinkSides::Exact => {
-            let (near, visited) = exact_side_may_reach(&world, cloud, collide, &mut ws.stack);
+            let (near, visited) = exact_side_may_reach(
+                (&geometry.aabb, pose),
+                cloud,
+                (collide, scene.reach),
+                &mut ws.stack,
+            );
             counters.broad_phase_nodes += visited;
             return near;
         }
@@ -493,7 +499,7 @@ fn link_near(
             may
         }),
         QueryModel::Points => near_cloud(
-            &world,
+            &geometry.aabb.transformed(pose),
             samples.spacing_max[l],
             cloud,
             scene.reach,

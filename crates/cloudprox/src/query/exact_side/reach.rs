@@ -3,38 +3,48 @@
 
 use crate::bvh::Aabb;
 use crate::cloud::PointCloud;
-use crate::probability::normal_quantile;
+use crate::math::Pose;
 use crate::query::collide::{CollisionRequest, QueryModel};
 use crate::Real;
 
-/// Whether a mesh inside `bounds` (the cloud's frame) may come within the
-/// noise's reach of `cloud`: `false` proves that the exact-side query of any
-/// mesh inside the box reads `P = 0` (nothing within reach, nothing inside).
-/// Returns the answer and the number of hierarchy nodes tested.
+/// Whether a mesh inside the box `local` of its own frame, at `pose` in the
+/// cloud's frame, may come within the noise's reach (`reach` standard
+/// deviations, `-Phi^-1(epsilon / 2)` for the request's `prune_epsilon`) of
+/// `cloud`: `false` proves that the exact-side query of any mesh inside the
+/// box reads `P = 0` (nothing within reach, nothing inside). Returns the
+/// answer and the number of hierarchy nodes tested.
 ///
-/// With [`QueryModel::Points`], a point's probability is read only within
-/// `reach sigma_i` of the surface (or inside it): the hierarchy over the
-/// points, each node at `reach sigma_node`. With
-/// [`QueryModel::Elements`], an element reads only where its surface comes
-/// within half a spacing `m` plus `reach sqrt(sigma^2 + 2 m^2)` of the mesh
-/// (the bound of its probes' search): the hierarchy over the element hulls
-/// of each segmentation, each node at its largest `sigma` and `m`.
+/// The box, moved into the cloud's frame, descends the cloud's hierarchy;
+/// at each leaf within reach, its points or elements are tested against the
+/// box in the mesh's frame. With [`QueryModel::Points`], a point's
+/// probability is read only within `reach sigma_i` of the surface (or
+/// inside it): the hierarchy over the points, each node at `reach` times its
+/// largest `sigma`. With [`QueryModel::Elements`], an element reads only
+/// where its surface comes within half a spacing `m` plus
+/// `reach sqrt(sigma^2 + 2 m^2)` of the mesh (the bound of its probes'
+/// search): the hierarchy over the element hulls of each segmentation, each
+/// node at its largest `sigma` and `m`, each element's surface against the
+/// box along separating axes.
 pub(crate) fn exact_side_may_reach(
-    bounds: &Aabb,
+    (local, pose): (&Aabb, &Pose),
     cloud: &PointCloud,
-    request: &CollisionRequest,
+    (request, reach): (&CollisionRequest, Real),
     stack: &mut Vec<u32>,
 ) -> (bool, usize) {
-    let reach = -normal_quantile(0.5 * request.prune_epsilon);
+    let world = local.transformed(pose);
+    let to_local = pose.inverse();
     match request.model {
-        QueryModel::Points => points_near_box(bounds, cloud, reach, stack),
+        QueryModel::Points => points_near_box((&world, local, &to_local), cloud, reach, stack),
         QueryModel::Elements => {
             let limit =
                 |sigma: Real, half: Real| half + reach * (sigma * sigma + 2.0 * half * half).sqrt();
             let mut visited = 0;
             let near = (0..request.segmentations).any(|s| {
                 let hulls = cloud.segmentation_after(s).hulls();
-                let (near, v) = hulls.near_box(bounds, limit, stack);
+                let leaf = |h: &crate::element::Hull| {
+                    h.box_gap(&to_local, local) <= limit(h.sigma, h.margin)
+                };
+                let (near, v) = hulls.near_box(&world, limit, leaf, stack);
                 visited += v;
                 near
             });
@@ -43,26 +53,38 @@ pub(crate) fn exact_side_may_reach(
     }
 }
 
-/// Whether a leaf of the cloud's point hierarchy lies within `reach` times
-/// the node's largest standard deviation of `bounds`.
+/// Whether a point of the cloud lies within `reach` times its largest
+/// standard deviation of the box (`world` in the cloud's frame, `local` in
+/// the mesh's, `to_local` from the one to the other): the hierarchy's nodes
+/// against `world`, each leaf's points against `local`.
 fn points_near_box(
-    bounds: &Aabb,
+    (world, local, to_local): (&Aabb, &Aabb, &Pose),
     cloud: &PointCloud,
     reach: Real,
     stack: &mut Vec<u32>,
 ) -> (bool, usize) {
-    let nodes = cloud.bvh().nodes();
+    let bvh = cloud.bvh();
+    let (points, sigma) = (cloud.points(), cloud.sigma_max());
     let mut visited = 0;
     stack.clear();
     stack.push(0);
     while let Some(id) = stack.pop() {
         visited += 1;
-        let node = &nodes[id as usize];
-        if node.aabb.distance(bounds) > reach * node.sigma_max {
+        let node = &bvh.nodes()[id as usize];
+        if node.aabb.distance(world) > reach * node.sigma_max {
             continue;
         }
         match node.children {
-            None => return (true, visited),
+            None => {
+                let near = bvh.node_points(id).iter().any(|&i| {
+                    let x = to_local * points[i as usize];
+                    let r = reach * sigma[i as usize];
+                    local.distance_squared_to_point(&x) <= r * r
+                });
+                if near {
+                    return (true, visited);
+                }
+            }
             Some([l, r]) => {
                 stack.push(r);
                 stack.push(l);
