@@ -43,14 +43,17 @@ pub struct RobotRequest {
     /// (points model) or over its element hulls (elements model), and the
     /// points or element surfaces of the leaves within the noise's reach are
     /// tested against the box in the link's frame; when none is within
-    /// reach, the exact-side query would read nothing. No signed distance is
-    /// evaluated. Sampled links, points model: the link's
+    /// reach, the exact-side query would read nothing (but single points
+    /// farther than their noise's reach, each below `prune_epsilon / 2`, as
+    /// the exact side's per-point probabilities leave them). No signed
+    /// distance is evaluated. Sampled links, points model: the link's
     /// bounding box is beyond the noise's reach of every node of the cloud's
     /// hierarchy, so no pair of points is near by the query's near rule.
     /// Sampled links, elements model: no element surface of the link may
     /// reach one of the cloud through the hierarchies over both clouds'
-    /// element hulls (the elements query's own first test). Either way the
-    /// broad phase changes the cost, not the answer.
+    /// element hulls (the elements query's own first test). The broad phase
+    /// changes the cost, not the answer (exact links: not by more than
+    /// `prune_epsilon / 2` per link).
     pub broad_phase: bool,
     /// Check self-collision between non-adjacent links (default `true`).
     pub self_collision: bool,

@@ -11,7 +11,9 @@ use crate::Real;
 /// cloud's frame, may come within the noise's reach (`reach` standard
 /// deviations, `-Phi^-1(epsilon / 2)` for the request's `prune_epsilon`) of
 /// `cloud`: `false` proves that the exact-side query of any mesh inside the
-/// box reads `P = 0` (nothing within reach, nothing inside). Returns the
+/// box reads nothing within reach and nothing inside: `P = 0`, but for the
+/// readings of single points farther than the reach (each below
+/// `epsilon / 2`, as the per-point probabilities leave them). Returns the
 /// answer and the number of hierarchy nodes tested.
 ///
 /// The box, moved into the cloud's frame, descends the cloud's hierarchy;
@@ -24,7 +26,11 @@ use crate::Real;
 /// `reach sqrt(sigma^2 + 2 m^2)` of the mesh (the bound of its probes'
 /// search): the hierarchy over the element hulls of each segmentation, each
 /// node at its largest `sigma` and `m`, each element's surface against the
-/// box along separating axes.
+/// box along separating axes. A single point is read at its own Eq. 3 gap,
+/// which beyond `reach sigma` gives less than `epsilon / 2`, however sparse
+/// its sampling (the exact side keeps such a reading within half its
+/// spacing: a scan's stray points, spaced tens of centimetres apart, would
+/// otherwise keep every link near).
 pub(crate) fn exact_side_may_reach(
     (local, pose): (&Aabb, &Pose),
     cloud: &PointCloud,
@@ -42,7 +48,12 @@ pub(crate) fn exact_side_may_reach(
             let near = (0..request.segmentations).any(|s| {
                 let hulls = cloud.segmentation_after(s).hulls();
                 let leaf = |h: &crate::element::Hull| {
-                    h.box_gap(&to_local, local) <= limit(h.sigma, h.margin)
+                    let own = if h.point {
+                        reach * h.sigma
+                    } else {
+                        limit(h.sigma, h.margin)
+                    };
+                    h.box_gap(&to_local, local) <= own
                 };
                 let (near, v) = hulls.near_box(&world, limit, leaf, stack);
                 visited += v;
