@@ -5,15 +5,17 @@ mushroom) seen by the simulated Kinect at 1.63 times its image size (522 x 391:
 about 100 000 points, Nguyen et al. 2012 noise). In one run:
 
 * **Cost per configuration**, one thread (``RAYON_NUM_THREADS=1``): cloudprox's
-  ``collide_robot`` with each model (surface elements, and points, the default;
-  its own ``stats.time_seconds``: forward kinematics, broad phase and
-  queries, self-collision off) against python-fcl's ``collide()`` of
+  ``collide_robot`` with each model (surface elements, the default, and points)
+  and each mesh side (``--mesh-side``: the links' exact surfaces, the default,
+  and their sampled clouds; both unless one is named), its own
+  ``stats.time_seconds`` (forward kinematics, broad phase and queries,
+  self-collision off), against python-fcl's ``collide()`` of
   the robot's exact link meshes (a ``DynamicAABBTreeCollisionManager``) against
   the exact scene meshes (the anchor) and against the collision map's occupied
   voxels as boxes (sensor resolution and 2 cm), the links posed beforehand (not
   timed). Each model also with ``decide_only=True`` (what a planner's chance
-  constraint asks). Far: uniformly random configurations whose exact clearance
-  exceeds 5 sigma (the scan's median sigma); near contact: the agreement set
+  constraint asks). Uniform: every uniformly random configuration; far: those
+  whose exact clearance exceeds 5 sigma (the scan's median sigma); near contact: the agreement set
   below, free and within 5 sigma; penetrating: the agreement set's colliding
   configurations. With ``--repeat N`` each configuration is queried N times
   and its fastest call kept (the median is then over the configurations'
@@ -39,8 +41,11 @@ about 100 000 points, Nguyen et al. 2012 noise). In one run:
   collisions deeper than 3 sigma, for both models; the collision maps' booleans
   alike.
 
+The time to build the links' signed distances (the exact sides, built when the
+robot is loaded) is printed first.
+
 Usage: ``python3 benches/robot.py [--configurations 2000] [--near 1000] [--motions 60]
-[--repeat 1] [--seed 0]``
+[--repeat 1] [--mesh-side both|exact|sampled] [--seed 0]``
 """
 
 from __future__ import annotations
@@ -69,8 +74,34 @@ import cloudprox as cp
 #: Image scale of the simulated camera: 1.63^2 x the 37 539 points of the planning scan.
 SCALE = 1.63
 ARM = slice(0, 7)
-#: cloudprox's query models: the surface elements first, then the points model (the default).
+#: cloudprox's query models: the surface elements first (the default), then the points model.
 MODELS = ("elements", "points")
+#: How the links stand in cloudprox's queries: their exact surfaces (the default) or samples.
+MESH_SIDES = ("exact", "sampled")
+
+
+def variants(sides: tuple[str, ...]) -> list[tuple[str, str]]:
+    """Return the ``(model, mesh_side)`` pairs measured, the elements model first."""
+    return [(model, side) for side in sides for model in MODELS]
+
+
+def label(model: str, side: str) -> str:
+    """Return a variant's name in the tables."""
+    return f"{model}, {side}"
+
+
+def distance_build_seconds(robot: cp.Robot) -> tuple[float, float, int]:
+    """Seconds to build every link's signed distance (total, largest) and the faces."""
+    total, largest, faces = 0.0, 0.0, 0
+    for n in robot.link_names:
+        mesh = robot.link_mesh(n)
+        if mesh is None:
+            continue
+        t = time.perf_counter()
+        d = cp.MeshDistance(mesh)
+        dt = time.perf_counter() - t
+        total, largest, faces = total + dt, max(largest, dt), faces + d.num_faces
+    return total, largest, faces
 
 
 def setup(seed: int) -> tuple[cp.Robot, dict[str, cp.Mesh], cp.PointCloud, float, float]:
@@ -186,7 +217,10 @@ def motion_ends(
 
 
 def motion_rows(
-    robot: cp.Robot, cloud: cp.PointCloud, ends: list[tuple[np.ndarray, np.ndarray]]
+    robot: cp.Robot,
+    cloud: cp.PointCloud,
+    ends: list[tuple[np.ndarray, np.ndarray]],
+    sides: tuple[str, ...],
 ) -> None:
     """Print the motion table: ``check_motion`` with and without ``warm_start``."""
     print(
@@ -198,7 +232,7 @@ def motion_rows(
         "| median motion cold / warm (ms) | largest worst-`P` difference |"
     )
     print("|---|---|---|---|---|---|---|")
-    for model in MODELS:
+    for model, side in variants(sides):
         seconds: dict[bool, list[float]] = {True: [], False: []}
         worst: dict[bool, list[float]] = {True: [], False: []}
         states = 0
@@ -213,6 +247,7 @@ def motion_rows(
                     cloud,
                     self_collision=False,
                     model=model,
+                    mesh_side=side,
                     max_probability=1.0,
                     warm_start=warm,
                 )
@@ -222,7 +257,8 @@ def motion_rows(
         cold, warm_s = sum(seconds[False]), sum(seconds[True])
         diff = float(np.max(np.abs(np.subtract(worst[True], worst[False]))))
         print(
-            f"| {model} | {states} | {cold:.2f} | {warm_s:.2f} | {warm_s / cold:.2f}x | "
+            f"| {label(model, side)} | {states} | {cold:.2f} | {warm_s:.2f} | "
+            f"{warm_s / cold:.2f}x | "
             f"{np.median(seconds[False]) * 1e3:.0f} / {np.median(seconds[True]) * 1e3:.0f} | "
             f"{diff:.1e} |"
         )
@@ -244,11 +280,20 @@ def map_booleans(checker: FclChecker, qs: np.ndarray) -> np.ndarray:
     return np.array([checker.collides(q) for q in qs])
 
 
-def many_seconds(threads: int, configurations: int, seed: int) -> float:
+def many_seconds(threads: int, configurations: int, seed: int, side: str) -> float:
     """Wall time of ``collide_robot_many`` on random configurations, in a fresh process."""
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     out = subprocess.run(
-        [sys.executable, __file__, "--many-only", str(configurations), "--seed", str(seed)],
+        [
+            sys.executable,
+            __file__,
+            "--many-only",
+            str(configurations),
+            "--seed",
+            str(seed),
+            "--mesh-side",
+            side,
+        ],
         env=env,
         check=True,
         capture_output=True,
@@ -257,13 +302,13 @@ def many_seconds(threads: int, configurations: int, seed: int) -> float:
     return float(json.loads(out.stdout.strip().splitlines()[-1])["seconds"])
 
 
-def many_only(configurations: int, seed: int) -> None:
+def many_only(configurations: int, seed: int, side: str) -> None:
     """Time ``collide_robot_many`` (for :func:`many_seconds`); print JSON."""
     robot, _, cloud, _, _ = setup(seed)
     qs = random_configurations(robot, configurations, np.random.default_rng(seed + 1))
-    cp.collide_robot_many(robot, qs[:10], cloud)  # link samples, scan hierarchy
+    cp.collide_robot_many(robot, qs[:10], cloud, mesh_side=side)  # link samples, scan hierarchy
     t0 = time.perf_counter()
-    cp.collide_robot_many(robot, qs, cloud, self_collision=False)
+    cp.collide_robot_many(robot, qs, cloud, self_collision=False, mesh_side=side)
     print(json.dumps({"seconds": time.perf_counter() - t0}))
 
 
@@ -283,17 +328,29 @@ def main() -> None:
     ap.add_argument(
         "--repeat", type=int, default=1, help="calls per configuration; the fastest is kept"
     )
+    ap.add_argument(
+        "--mesh-side",
+        choices=("both", *MESH_SIDES),
+        default="both",
+        help="how cloudprox's links stand: exact surfaces, samples, or both (default)",
+    )
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--many-only", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.repeat < 1:
         ap.error(f"--repeat must be at least 1, got {args.repeat}")
+    sides = MESH_SIDES if args.mesh_side == "both" else (args.mesh_side,)
     if args.many_only:
-        many_only(args.many_only, args.seed)
+        many_only(args.many_only, args.seed, sides[0])
         return
     t_start = time.perf_counter()
     rng = np.random.default_rng(args.seed)
     robot, meshes, cloud, resolution, sigma = setup(args.seed)
+    total, largest, faces = distance_build_seconds(robot)
+    log(
+        f"links' signed distances ({faces} faces): built in {total * 1e3:.1f} ms, "
+        f"the largest link {largest * 1e3:.1f} ms"
+    )
     points = np.asarray(cloud.points)
     exact = FclChecker(robot, [fcl_object(m) for m in meshes.values()])
     maps = {
@@ -313,29 +370,36 @@ def main() -> None:
     log(f"{len(near_q)} configurations near the scene")
     free_near = near_q[(near_d > 0) & (near_d <= 5 * sigma)]
 
-    for model in MODELS:  # link samples, scan hierarchy and elements: built once
-        cp.collide_robot(robot, qs[0], cloud, model=model)
+    for model, side in variants(sides):  # link samples, scan hierarchy, elements: built once
+        cp.collide_robot(robot, qs[0], cloud, model=model, mesh_side=side)
     rows = []
     penetrating = near_q[near_d < 0]
     cases = (
+        ("uniform random", qs),
         ("far (> 5 sigma)", far),
         ("near contact (free, <= 5 sigma)", free_near),
         ("penetrating", penetrating),
     )
     for name, sel in cases:
         t_cp = {
-            (model, decide): np.array(
+            (model, side, decide): np.array(
                 [
                     min(
                         cp.collide_robot(
-                            robot, q, cloud, self_collision=False, model=model, decide_only=decide
+                            robot,
+                            q,
+                            cloud,
+                            self_collision=False,
+                            model=model,
+                            mesh_side=side,
+                            decide_only=decide,
                         ).stats.time_seconds
                         for _ in range(args.repeat)
                     )
                     for q in sel
                 ]
             )
-            for model in MODELS
+            for model, side in variants(sides)
             for decide in (False, True)
         }
         t_ex = fcl_call_times(exact, sel)
@@ -348,15 +412,17 @@ def main() -> None:
         + ":\n"
     )
     map_names = list(maps)
-    modes = [(m, d) for m in MODELS for d in (False, True)]
+    modes = [(m, s, d) for m, s in variants(sides) for d in (False, True)]
+    first = (*variants(sides)[0], False)
     print(
         "| configurations | n | "
         + " | ".join(
-            f"cloudprox `collide_robot`, {m}{', decide-only' if d else ''}" for m, d in modes
+            f"cloudprox `collide_robot`, {label(m, s)}{', decide-only' if d else ''}"
+            for m, s, d in modes
         )
         + " | python-fcl exact meshes | "
         + " | ".join(f"python-fcl {k} boxes" for k in map_names)
-        + " | cloudprox (elements) / fcl exact |"
+        + f" | cloudprox ({label(*first[:2])}) / fcl exact |"
     )
     print("|---|---|" + "---|" * (len(modes) + 1 + len(map_names)) + "---|")
     for name, n, t_cp, t_ex, t_maps in rows:
@@ -365,20 +431,38 @@ def main() -> None:
             + " | ".join(us(t_cp[md]) for md in modes)
             + f" | {us(t_ex)} | "
             + " | ".join(us(t_maps[k]) for k in map_names)
-            + f" | {np.median(t_cp[(MODELS[0], False)]) / np.median(t_ex):.1f}x |"
+            + f" | {np.median(t_cp[first]) / np.median(t_ex):.1f}x |"
+        )
+
+    print("\ncloudprox's time per configuration, one thread: median / mean / max:\n")
+    print(
+        "| configurations | "
+        + " | ".join(f"{label(m, s)}{', decide-only' if d else ''}" for m, s, d in modes)
+        + " |"
+    )
+    print("|---|" + "---|" * len(modes))
+    for name, _, t_cp, _, _ in rows:
+        print(
+            f"| {name} | "
+            + " | ".join(
+                f"{us(t_cp[md])} / {us(np.array([t_cp[md].mean()]))} / "
+                f"{us(np.array([t_cp[md].max()]))}"
+                for md in modes
+            )
+            + " |"
         )
 
     # What a planner calling `collide_robot` once per configuration waits for:
     # the call's wall time, the Python call and the lookup of the link samples
     # included (far configurations: where the query itself takes microseconds).
     walls = {}
-    for model in MODELS:
+    for model, side in variants(sides):
         w = []
         for q in far:
             t = time.perf_counter()
-            cp.collide_robot(robot, q, cloud, self_collision=False, model=model)
+            cp.collide_robot(robot, q, cloud, self_collision=False, model=model, mesh_side=side)
             w.append(time.perf_counter() - t)
-        walls[model] = np.asarray(w)
+        walls[label(model, side)] = np.asarray(w)
     print(
         "\nOne `collide_robot` call's wall time, far configurations (median): "
         + ", ".join(f"{m} {us(w)}" for m, w in walls.items())
@@ -386,31 +470,37 @@ def main() -> None:
 
     if args.motions:
         centres = near_q[: args.motions]
-        motion_rows(robot, cloud, motion_ends(robot, centres, sigma, rng))
+        motion_rows(robot, cloud, motion_ends(robot, centres, sigma, rng), sides)
 
-    seconds = {k: many_seconds(k, args.many, args.seed) for k in (1, 2)}
-    print(
-        f"\n`collide_robot_many`, {args.many} random configurations: "
-        f"1 thread {seconds[1]:.2f} s, 2 threads {seconds[2]:.2f} s "
-        f"(speed-up {seconds[1] / seconds[2]:.2f}x on 2 cores)"
-    )
+    for side in sides:
+        seconds = {k: many_seconds(k, args.many, args.seed, side) for k in (1, 2)}
+        print(
+            f"\n`collide_robot_many`, {side} links, {args.many} random configurations: "
+            f"1 thread {seconds[1]:.2f} s, 2 threads {seconds[2]:.2f} s "
+            f"(speed-up {seconds[1] / seconds[2]:.2f}x on 2 cores)"
+        )
 
     answers = {
-        f"cloudprox ({model}{', decide-only' if decide else ''})": np.asarray(
+        f"cloudprox ({label(model, side)}{', decide-only' if decide else ''})": np.asarray(
             cp.collide_robot_many(
-                robot, near_q, cloud, self_collision=False, model=model, decide_only=decide
+                robot,
+                near_q,
+                cloud,
+                self_collision=False,
+                model=model,
+                mesh_side=side,
+                decide_only=decide,
             ).states
         )
-        for model in MODELS
+        for model, side in variants(sides)
         for decide in (False, True)
     }
-    states = answers[f"cloudprox ({MODELS[0]})"]
-    label = near_d <= 0.0
+    colliding = near_d <= 0.0
     for k, c in maps.items():
         answers[k] = np.where(map_booleans(c, near_q), "collision", "free")
     print(
         f"\nAgreement with the exact scene, {len(near_q)} configurations "
-        f"({int(label.sum())} colliding), sigma {sigma * 1e3:.2f} mm:\n"
+        f"({int(colliding.sum())} colliding), sigma {sigma * 1e3:.2f} mm:\n"
     )
     print(
         "| checker | decided accuracy | undecided | false collisions > 3 sigma "
@@ -419,7 +509,7 @@ def main() -> None:
     beyond, deep = near_d > 3 * sigma, near_d < -3 * sigma
     for name, st in answers.items():
         decided = st != "contact"  # cloudprox's undecided state
-        acc = float(np.mean((st[decided] == "collision") == label[decided]))
+        acc = float(np.mean((st[decided] == "collision") == colliding[decided]))
         fp = int(np.sum(st[beyond] == "collision"))
         fn = int(np.sum(st[deep] == "free"))
         print(
@@ -430,20 +520,22 @@ def main() -> None:
     from scipy.spatial import cKDTree
 
     tree = cKDTree(points)
-    missed = np.flatnonzero(deep & (states == "free"))
-    unseen = sum(
-        1
-        for i in missed
-        if not np.any(
-            np.isfinite(tree.query(exact.contacts(near_q[i]), distance_upper_bound=0.01)[0])
+    for model, side in variants(sides):
+        states = answers[f"cloudprox ({label(model, side)})"]
+        missed = np.flatnonzero(deep & (states == "free"))
+        unseen = sum(
+            1
+            for i in missed
+            if not np.any(
+                np.isfinite(tree.query(exact.contacts(near_q[i]), distance_upper_bound=0.01)[0])
+            )
         )
-    )
-    also = ", ".join(f"{sum(answers[k][i] == 'free' for i in missed)} by the {k}" for k in maps)
-    print(
-        f"\ncloudprox's missed collisions deeper than 3 sigma: {len(missed)}; of these, "
-        f"{unseen} meet the exact scene where no scan point lies within 1 cm (a surface "
-        f"the camera does not see); missed too: {also}."
-    )
+        also = ", ".join(f"{sum(answers[k][i] == 'free' for i in missed)} by the {k}" for k in maps)
+        print(
+            f"\ncloudprox ({label(model, side)})'s missed collisions deeper than 3 sigma: "
+            f"{len(missed)}; of these, {unseen} meet the exact scene where no scan point lies "
+            f"within 1 cm (a surface the camera does not see); missed too: {also}."
+        )
     log(f"({time.perf_counter() - t_start:.0f} s)")
 
 

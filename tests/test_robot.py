@@ -119,7 +119,8 @@ def test_a_link_pushed_into_a_wall_collides(arm: cp.Robot) -> None:
     cloud = wall_cloud()
     free = cp.collide_robot(arm, [0, 0, 0, 0], cloud)
     assert free.state == "free"
-    hit = cp.collide_robot(arm, [0, 0, 0.1, 0], cloud)
+    # Sampled links: their queries train surfaces, which give patches.
+    hit = cp.collide_robot(arm, [0, 0, 0.1, 0], cloud, mesh_side="sampled")
     assert hit.state == "collision"
     links = hit.links
     assert list(links) == ["base", "link1", "link2", "link3", "link4", "tool"]
@@ -146,18 +147,18 @@ def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
     cloud = wall_cloud(x0=0.27, seed=5)  # cuts link2; link3, link4 and the tool within reach
     # The paper's model: it queries every link within reach (the elements'
     # reach test leaves the links whose element surfaces cannot touch).
+    # Sampled links, whose broad phase reaches the links behind link2.
     q = [0.0, 0.0, 0.0, 0.0]
-    full = cp.collide_robot(arm, q, cloud, model="points")
-    fast = cp.collide_robot(arm, q, cloud, decide_only=True, model="points")
+    opts = {"model": "points", "mesh_side": "sampled"}
+    full = cp.collide_robot(arm, q, cloud, **opts)
+    fast = cp.collide_robot(arm, q, cloud, decide_only=True, **opts)
     assert full.state == fast.state == "collision"
     assert fast.probability >= 0.9 and full.links["link2"].probability >= 0.9
     after = [fast.links[n] for n in ("link3", "link4", "tool")]
     assert all(np.isnan(x.probability) and not x.queried and x.result is None for x in after)
     assert fast.stats.links_after_decision == 3 and full.stats.links_after_decision == 0
     assert all(full.links[n].queried for n in ("link3", "link4", "tool"))
-    batch = cp.collide_robot_many(
-        arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True, model="points"
-    )
+    batch = cp.collide_robot_many(arm, [q, [1.5, 0.0, 0.0, 0.0]], cloud, decide_only=True, **opts)
     assert list(batch.states) == ["collision", "free"]
     assert np.isnan(batch.link_probabilities[0, 3:6]).all()  # link3, link4, tool
     assert not np.isnan(batch.link_probabilities[1]).any()
@@ -166,7 +167,7 @@ def test_decide_only_leaves_the_links_after_a_decision(arm: cp.Robot) -> None:
 def test_collide_robot_equals_the_per_link_collide_calls(arm: cp.Robot) -> None:
     cloud = wall_cloud(seed=4)
     q = [0.05, 0.02, 0.07, 0.0]
-    r = cp.collide_robot(arm, q, cloud, broad_phase=False)
+    r = cp.collide_robot(arm, q, cloud, broad_phase=False, mesh_side="sampled")
     poses = arm.link_poses(q)
     for name, link in r.links.items():
         mesh = arm.link_mesh(name)
@@ -239,7 +240,13 @@ def test_check_motion_warm_start_saves_iterations_not_answers(arm: cp.Robot) -> 
     post = cp.PointCloud(cp.synthetic.add_noise(pts, SIGMA, seed=3), sigma=SIGMA)
     q0, q1 = np.array([-0.3, 0, 0, 0]), np.array([0.3, 0, 0, 0])
     # Warm starts are the paper's classifier's (the per-point model).
-    opts = {"max_probability": 1.0, "self_collision": False, "model": "points"}
+    # Sampled links (exact links train nothing).
+    opts = {
+        "max_probability": 1.0,
+        "self_collision": False,
+        "model": "points",
+        "mesh_side": "sampled",
+    }
     warm = cp.check_motion(arm, q0, q1, post, **opts)
     cold = cp.check_motion(arm, q0, q1, post, warm_start=False, **opts)
     assert warm.states_checked == cold.states_checked == warm.states_total
@@ -249,7 +256,9 @@ def test_check_motion_warm_start_saves_iterations_not_answers(arm: cp.Robot) -> 
     n = cold.states_total - 1
     s = np.arange(n + 1) / n  # the states' t = i / n
     states = [
-        cp.collide_robot(arm, q0 + t * (q1 - q0), post, self_collision=False, model="points")
+        cp.collide_robot(
+            arm, q0 + t * (q1 - q0), post, self_collision=False, model="points", mesh_side="sampled"
+        )
         for t in s
     ]
     assert cold.probability == max(r.probability for r in states)
@@ -478,4 +487,4 @@ def test_readme_robot_cli(
     monkeypatch.chdir(readme_folder)
     monkeypatch.setenv("COLUMNS", "200")
     assert main(argv[1:]) == 0
-    assert "P = 0   state: free" in capsys.readouterr().out
+    assert "P = 0.0425771   state: free" in capsys.readouterr().out

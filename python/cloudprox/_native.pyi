@@ -1812,7 +1812,11 @@ class LinkCollision:
         """Whether the link was queried (it passed the broad phase, before any decision)."""
     @property
     def result(self) -> CollisionResult | None:
-        """The link's full query result (side A: the link's sample), ``None`` when skipped."""
+        """The link's full query result, ``None`` when skipped.
+
+        Side A is the link: its exact surface (no points) for exact links, its
+        sample for sampled ones.
+        """
 
 @final
 class RobotCollisionResult:
@@ -1861,7 +1865,7 @@ class RobotStats:
         """Node pairs visited by the per-link queries, summed."""
     @property
     def solver_iterations(self) -> int:
-        """Interior-point iterations of the per-link queries' classifiers, summed."""
+        """Interior-point iterations of the per-link queries' classifiers, summed (0 for exact links)."""
     @property
     def time_seconds(self) -> float:
         """Wall time of the query (seconds)."""
@@ -1935,21 +1939,30 @@ def collide_robot(
 ) -> RobotCollisionResult:
     """Query the robot at configuration ``q`` (root at ``base_pose``) against a cloud.
 
-    Each link with geometry is sampled once per spacing (``mesh_spacing``, default
-    half the cloud's median spacing) into a cloud without sensor noise. A broad
-    phase (``broad_phase=True``) skips links that cannot reach the cloud: with the
-    points model, the link's bounding box is beyond the noise's reach of every node
-    of the cloud's hierarchy; with the elements model, no element surface of the
-    link comes within the noise's reach of one of the cloud (the hierarchies over
-    both clouds' element hulls). Their query would read 0. Every
-    other link is queried as :func:`collide` does; with ``decide_only=True`` the
+    Each link with geometry stands, by default (``mesh_side="exact"``), as its exact
+    surface: its signed distance, built when the robot was loaded, is the separating
+    surface, as :func:`collide` reads a mesh (nothing sampled, nothing trained;
+    ``solver_iterations`` stays 0). With ``mesh_side="sampled"`` (the default when a
+    ``mesh_spacing`` is given) each link is sampled once per spacing (``mesh_spacing``,
+    default half the cloud's median spacing) into a cloud without sensor noise. A
+    broad phase (``broad_phase=True``) skips links that cannot reach the cloud,
+    before any signed distance or sample is read: for exact links, the link's
+    bounding box is beyond the noise's reach of every leaf of the cloud's hierarchy
+    (over its points with the points model, over its element hulls with the
+    elements model); for sampled links, with the points model, the link's bounding
+    box is beyond the noise's reach of every node of the cloud's hierarchy, with the
+    elements model, no element surface of the link comes within the noise's reach
+    of one of the cloud (the hierarchies over both clouds' element hulls). Their
+    query would read 0. Every other link is queried as :func:`collide` does (the
+    link as side ``a``); with ``decide_only=True`` the
     links after the first whose probability reaches ``threshold_collision`` are
     left (probability NaN, ``stats.links_after_decision``): the state is
     collision whatever they hold. Self-collision between non-adjacent links
     (exact meshes, ``self_collision=True``) is reported apart.
     ``request`` is a :class:`CollisionRequest` (the link queries' options);
     ``options`` are the keyword options of :class:`CollisionRequest`
-    (overriding ``request``'s) plus ``mesh_spacing``, ``broad_phase`` and
+    (overriding ``request``'s) plus ``mesh_side`` (``"exact"`` or ``"sampled"``),
+    ``mesh_spacing`` (with sampled links only), ``broad_phase`` and
     ``self_collision``; unknown names raise :class:`InvalidInputError`. The GIL
     is released.
     """
@@ -1985,7 +1998,7 @@ def check_motion(
     self-collision). ``options``: those of :func:`collide_robot` plus
     ``resolution``, ``max_probability`` and ``warm_start`` (default ``True``: each
     state's classifier starts from the samples that supported the previous state's
-    surfaces, which saves solver iterations (``solver_iterations``) and finds the
+    surfaces (sampled links only: exact links train nothing), which saves solver iterations (``solver_iterations``) and finds the
     same surfaces to the solver's tolerance, ``P`` within about 1e-5, so only a
     state that close to ``max_probability`` can be judged otherwise; ``False``
     makes each state's answer exactly :func:`collide_robot`'s).

@@ -464,7 +464,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         raise CliError(str(e)) from None
     if side.cloud is None:
         raise CliError(f"{args.scan}: the scan must be a point cloud, not a mesh")
-    options: dict[str, Any] = {"mesh_spacing": args.mesh_spacing}
+    options: dict[str, Any] = {"mesh_side": args.mesh_side, "mesh_spacing": args.mesh_spacing}
     _check_view_arguments(args)
     if args.q is None and (args.html is not None or args.rerun is not None):
         raise CliError("--html and --rerun show one configuration: give --q, not --q-file")
@@ -1159,10 +1159,19 @@ def build_parser() -> argparse.ArgumentParser:
         "--filter", action="append", default=[], metavar="STEP", help="filter step (as collide)"
     )
     rob.add_argument(
+        "--mesh-side",
+        choices=["exact", "sampled"],
+        default=None,
+        help=(
+            "how the links stand: their exact surfaces (the default) or their meshes "
+            "sampled into clouds (the default with --mesh-spacing)"
+        ),
+    )
+    rob.add_argument(
         "--mesh-spacing",
         type=float,
         default=None,
-        help="sampling spacing of the links (m; default half the scan's spacing)",
+        help="sampling spacing of sampled links (m; default half the scan's spacing)",
     )
     rob.add_argument("--json", action="store_true", help="print the result as JSON")
     _add_view_arguments(rob)

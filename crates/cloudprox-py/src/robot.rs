@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
+use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
     collide_robot_many as core_collide_robot_many, LinkCollision, MotionRequest, Robot,
@@ -22,7 +23,13 @@ use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, PyContactPatch};
 
 /// The keywords of `collide_robot` that are not request options.
-const ROBOT_KEYWORDS: [&str; 4] = ["request", "mesh_spacing", "broad_phase", "self_collision"];
+const ROBOT_KEYWORDS: [&str; 5] = [
+    "request",
+    "mesh_side",
+    "mesh_spacing",
+    "broad_phase",
+    "self_collision",
+];
 /// The keywords of `check_motion` beyond those of `collide_robot`.
 const MOTION_KEYWORDS: [&str; 3] = ["resolution", "max_probability", "warm_start"];
 
@@ -47,6 +54,7 @@ fn motion_request(
 ) -> PyResult<MotionRequest> {
     let mut out = MotionRequest::default();
     let collide_options = PyDict::new(py);
+    let mut mesh_side: Option<String> = None;
     if let Some(options) = options {
         for (k, v) in options.iter() {
             let key: String = k.extract()?;
@@ -54,6 +62,7 @@ fn motion_request(
                 continue;
             }
             match key.as_str() {
+                "mesh_side" => mesh_side = Some(extract(py, &v, &key, "a str")?),
                 "mesh_spacing" => {
                     out.robot.mesh_spacing = Some(extract(py, &v, &key, "a float")?);
                 }
@@ -74,9 +83,22 @@ fn motion_request(
     if motion {
         also_valid.extend(MOTION_KEYWORDS);
     }
+    out.robot.mesh_side = link_side(py, mesh_side.as_deref(), out.robot.mesh_spacing)?;
     out.robot.collide = request_from(py, request, Some(&collide_options), &also_valid)?;
     out.robot.validate().or_py(py)?;
     Ok(out)
+}
+
+/// How the links stand: `mesh_side` by name, or (not given) exact unless a
+/// `mesh_spacing` is given, which samples them, as `collide` reads a mesh.
+fn link_side(py: Python<'_>, name: Option<&str>, spacing: Option<f64>) -> PyResult<MeshSide> {
+    match name {
+        None if spacing.is_some() => Ok(MeshSide::Sampled),
+        None => Ok(MeshSide::Exact),
+        Some(name) => name
+            .parse::<MeshSide>()
+            .map_err(|e| invalid_input(py, e.to_string())),
+    }
 }
 
 /// A float64 array of shape `(dof,)` as a vector (its length is checked by the core).
@@ -392,8 +414,9 @@ impl PyLinkCollision {
         self.inner.queried
     }
 
-    /// The full query result of the link (side A is the link's sample), or
-    /// `None` when the broad phase skipped it.
+    /// The full query result of the link (side A is the link: its exact
+    /// surface, or its sample for sampled links), or `None` when the broad
+    /// phase skipped it.
     #[getter]
     fn result(&self, py: Python<'_>) -> PyResult<Option<PyCollisionResult>> {
         self.inner
@@ -435,7 +458,8 @@ stats_class! {
         self_pairs_checked: usize,
         /// Node pairs visited by the per-link queries, summed.
         node_pairs_visited: usize,
-        /// Interior-point iterations of the per-link queries' classifiers, summed.
+        /// Interior-point iterations of the per-link queries' classifiers,
+        /// summed (0 for exact links).
         solver_iterations: u64,
     }
 }

@@ -38,6 +38,7 @@ mod io_stl;
 mod io_xyz;
 mod module_layers;
 mod robot_collide;
+mod robot_exact;
 mod robot_model;
 mod scan_pipeline;
 mod shape_exact;

@@ -1,10 +1,14 @@
 //! The robot against environment clouds: contact, broad phase, invariance,
 //! per-link equivalence, batches, motions, self-collision and the self-filter.
+//! Tests of what sampled links do (their regions, their classifiers' hints,
+//! their broad phase) ask for `MeshSide::Sampled`; exact links have their own
+//! tests in `robot_exact.rs`.
 
 use crate::robot_common;
 
 use cloudprox::prelude::*;
 use cloudprox::query::collide::mesh_sampling_spacing;
+use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion, collide_robot, collide_robot_many, MotionRequest, RobotRequest,
     LINK_SAMPLING_SEED,
@@ -24,7 +28,10 @@ fn a_link_pushed_into_a_wall_collides_and_the_rest_is_free() {
     // Wall x = 0.40 around the arm's tip (z = 0.3); link3's sphere reaches
     // x = 0.33 + j3.
     let cloud = wall(0.40, 0.3, 0.1, SIGMA, 1);
-    let req = RobotRequest::default();
+    let req = RobotRequest {
+        mesh_side: MeshSide::Sampled,
+        ..RobotRequest::default()
+    };
     let free = collide_robot(
         &robot,
         &[0.0, 0.0, 0.0, 0.0],
@@ -87,6 +94,7 @@ fn broad_phase_changes_the_cost_not_the_answer() {
                 model,
                 ..CollisionRequest::default()
             },
+            mesh_side: MeshSide::Sampled,
             ..RobotRequest::default()
         };
         let without = RobotRequest {
@@ -160,6 +168,7 @@ fn robot_result_equals_the_per_link_collide_calls() {
     let q = [0.05, 0.02, 0.07, 0.0];
     let req = RobotRequest {
         broad_phase: false,
+        mesh_side: MeshSide::Sampled,
         ..RobotRequest::default()
     };
     let r = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
@@ -527,7 +536,10 @@ fn a_decide_only_query_leaves_the_links_after_one_that_collides() {
     let q = [0.0, 0.0, 0.0, 0.0];
     // The points model: its broad phase leaves links within the points'
     // noise reach that the decision then skips.
-    let mut req = RobotRequest::default();
+    let mut req = RobotRequest {
+        mesh_side: MeshSide::Sampled,
+        ..RobotRequest::default()
+    };
     req.collide.model = QueryModel::Points;
     let full = collide_robot(&robot, &q, &Pose::identity(), &cloud, &req).unwrap();
     req.collide.decide_only = true;
@@ -593,6 +605,7 @@ fn check_motion_answers_as_its_states_queried_one_by_one() {
             ..MotionRequest::default()
         };
         req.robot.collide.model = model;
+        req.robot.mesh_side = MeshSide::Sampled;
         req.robot.self_collision = false;
         let warm = check_motion(&robot, &q0, &q1, &Pose::identity(), &cloud, &req).unwrap();
         let cold_req = MotionRequest {

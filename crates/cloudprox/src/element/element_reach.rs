@@ -61,6 +61,36 @@ pub(crate) struct Hull {
 }
 
 impl Hull {
+    /// A lower bound on the distance between the hull's surface (the convex
+    /// hull of its corners, `sag` either side along its normal) and the box
+    /// `local` of another frame, `to_local` taking the hull's frame there: the
+    /// largest gap along the box's three axes and along the hull's normal
+    /// (each a separating axis of two convex sets; 0 or less when they may
+    /// meet).
+    pub(crate) fn box_gap(&self, to_local: &Pose, local: &Aabb) -> Real {
+        let corners = self.corners_moved(to_local);
+        let n = to_local.rotation * self.normal;
+        let mut gap = Real::NEG_INFINITY;
+        for k in 0..3 {
+            let (lo, hi) = corners
+                .iter()
+                .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), c| {
+                    (lo.min(c[k]), hi.max(c[k]))
+                });
+            let widen = self.sag * n[k].abs();
+            gap = gap.max((lo - widen - local.maxs[k]).max(local.mins[k] - hi - widen));
+        }
+        let (lo, hi) = corners
+            .iter()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), c| {
+                let t = c.coords.dot(&n);
+                (lo.min(t), hi.max(t))
+            });
+        let centre = local.center().coords.dot(&n);
+        let half = local.half_extents().dot(&n.abs());
+        gap.max((lo - self.sag - centre - half).max(centre - half - hi - self.sag))
+    }
+
     /// The corners moved by `pose`. A plain loop: an array `map`'s closure
     /// is left out of line by some builds (four of criterion's microsecond
     /// cases 12-23% slower when it was, with no change to this code).
@@ -261,6 +291,46 @@ impl ElementHulls {
     /// The hull of element `e`.
     pub(crate) fn hull(&self, e: u32) -> &Hull {
         &self.hulls[e as usize]
+    }
+
+    /// Whether some element passes `leaf` among those whose node comes within
+    /// `limit(sigma, margin)` of `bounds` (same frame), `sigma` and `margin`
+    /// the node's largest over its elements: a one-sided descent, whose
+    /// `false` proves that every element either lies in a node farther than
+    /// its own limit from the box (the limit must grow with both arguments)
+    /// or fails `leaf`. Returns the answer and the number of nodes tested.
+    pub(crate) fn near_box(
+        &self,
+        bounds: &Aabb,
+        limit: impl Fn(Real, Real) -> Real,
+        mut leaf: impl FnMut(&Hull) -> bool,
+        stack: &mut Vec<u32>,
+    ) -> (bool, usize) {
+        let b = &self.all;
+        let mut visited = 0;
+        stack.clear();
+        stack.push(0);
+        while let Some(id) = stack.pop() {
+            visited += 1;
+            let i = id as usize;
+            let l = limit(b.sigma[i], b.margin[i]);
+            if !b.any[i] || b.boxes[i].distance_squared(bounds) > l * l {
+                continue;
+            }
+            match self.tree.nodes()[i].children {
+                None => {
+                    let points = self.tree.node_points(id);
+                    if points.iter().any(|&e| leaf(&self.hulls[e as usize])) {
+                        return (true, visited);
+                    }
+                }
+                Some([l, r]) => {
+                    stack.push(r);
+                    stack.push(l);
+                }
+            }
+        }
+        (false, visited)
     }
 }
 

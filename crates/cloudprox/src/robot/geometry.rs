@@ -1,5 +1,6 @@
-//! Link collision geometry: URDF primitives as meshes, mesh files, the cloud
-//! that stands for a link in a query, and the exact shape for self-collision.
+//! Link collision geometry: URDF primitives as meshes, mesh files, the
+//! signed distance or the cloud that stands for a link in a query, and the
+//! exact shape for self-collision.
 
 use std::sync::Arc;
 
@@ -8,7 +9,7 @@ use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::math::Point3;
 use crate::query::exact::ExactShape;
-use crate::shape::Mesh;
+use crate::shape::{Mesh, MeshDistance};
 use crate::Real;
 
 /// Segments around the axis of URDF cylinders, spheres and capsules (the
@@ -110,6 +111,10 @@ pub struct LinkGeometry {
     pub mesh: Mesh,
     /// The parts prepared for exact queries (self-collision).
     pub exact: ExactShape,
+    /// The signed distance of the merged mesh: the link's surface in a query
+    /// with an exact mesh side (built once, when the robot is loaded; shared by
+    /// the clones).
+    pub distance: Arc<MeshDistance>,
     /// Bounding box of the parts in the link frame.
     pub aabb: Aabb,
     /// Largest distance of a vertex from the link frame's origin.
@@ -120,11 +125,13 @@ impl LinkGeometry {
     /// Prepares the parts of one link (`link` names it in errors).
     ///
     /// # Errors
-    /// [`Error::InvalidInput`] naming the link if parry rejects a part.
+    /// [`Error::InvalidInput`] naming the link if parry rejects a part or
+    /// every face of the parts is degenerate.
     pub fn new(link: &str, parts: Vec<Mesh>) -> Result<Self> {
+        let named = |e: Error| Error::invalid(format!("link '{link}': {e}"));
         let mesh = Mesh::merged(&parts)?;
-        let exact =
-            ExactShape::new(&parts).map_err(|e| Error::invalid(format!("link '{link}': {e}")))?;
+        let exact = ExactShape::new(&parts).map_err(named)?;
+        let distance = Arc::new(MeshDistance::new(&mesh).map_err(named)?);
         let aabb = mesh.aabb();
         let radius = mesh
             .vertices()
@@ -135,6 +142,7 @@ impl LinkGeometry {
             parts,
             mesh,
             exact,
+            distance,
             aabb,
             radius,
         })

@@ -1,10 +1,7 @@
 //! Checking a straight joint-space motion against an environment cloud.
 
-use super::geometry::samples_at;
 use super::model::Robot;
-use super::query::{
-    check_base, collide_robot_prepared, link_spacing, RobotRequest, RobotWorkspace,
-};
+use super::query::{check_base, collide_robot_prepared, LinkSides, RobotRequest, RobotWorkspace};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::math::Pose;
@@ -167,7 +164,7 @@ pub fn check_motion(
         )));
     }
     let steps = steps_f as usize;
-    let samples = samples_at(robot, link_spacing(&request.robot, cloud)?)?;
+    let sides = LinkSides::new(robot, &request.robot, cloud)?;
     let mut ws = if request.warm_start {
         RobotWorkspace::warm_started()
     } else {
@@ -182,7 +179,7 @@ pub fn check_motion(
         for (k, v) in q.iter_mut().enumerate() {
             *v = q0[k] + t * dq[k];
         }
-        let r = collide_robot_prepared(robot, &samples, &q, base, cloud, &request.robot, &mut ws);
+        let r = collide_robot_prepared(robot, &sides, &q, base, cloud, &request.robot, &mut ws);
         solver_iterations += r.stats.counters.solver_iterations;
         if r.probability >= worst {
             worst = r.probability;

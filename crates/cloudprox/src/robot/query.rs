@@ -1,10 +1,11 @@
 //! A robot at a configuration against an environment cloud; self-collision.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::geometry::{samples_at, LinkSamples};
+use super::geometry::{samples_at, LinkGeometry, LinkSamples};
 use super::model::Robot;
 use crate::bvh::{Aabb, BvhWorkspace};
 use crate::cloud::PointCloud;
@@ -13,26 +14,46 @@ use crate::math::Pose;
 use crate::probability::{normal_quantile, Aggregation, CollisionState};
 use crate::query::collide::{
     collide_with_workspace, element_surfaces_may_reach, mesh_sampling_spacing, prepare,
-    CollisionRequest, CollisionResult, QueryModel, WarmStart,
+    CollisionRequest, CollisionResult, MeshSide, QueryModel, WarmStart,
 };
 use crate::query::exact::intersects;
+use crate::query::exact_side::{collide_exact_cloud, exact_side_may_reach};
 use crate::Real;
 
 /// Options of [`collide_robot`]: the per-link query's options and the robot's own.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RobotRequest {
-    /// The query of each link against the cloud ([`crate::query::collide()`]).
+    /// The query of each link against the cloud (its options as
+    /// [`crate::query::collide()`] reads them).
     pub collide: CollisionRequest,
-    /// Sampling spacing of the link meshes (metres); `None`: half the cloud's
-    /// median spacing, as [`crate::query::collide_mesh_cloud`] does.
+    /// How each link stands in its query (default [`MeshSide::Exact`]): its
+    /// exact surface, the link's cached signed distance
+    /// ([`LinkGeometry::distance`]) read by
+    /// [`collide_exact_cloud`](crate::query::exact_side::collide_exact_cloud),
+    /// nothing sampled or trained; or ([`MeshSide::Sampled`]) its mesh
+    /// sampled into a cloud, collided by [`crate::query::collide()`].
+    pub mesh_side: MeshSide,
+    /// Sampling spacing of the link meshes (metres), with
+    /// [`MeshSide::Sampled`] only; `None`: half the cloud's median spacing, as
+    /// [`crate::query::collide_mesh_cloud`] does.
     pub mesh_spacing: Option<Real>,
     /// Skip links that cannot reach the cloud (default `true`), reading
-    /// `P = 0` without a query. Points model: the link's bounding box is beyond
-    /// the noise's reach of every node of the cloud's hierarchy, so no pair of
-    /// points is near by the query's near rule. Elements model: no element
-    /// surface of the link may reach one of the cloud through the hierarchies
-    /// over both clouds' element hulls (the elements query's own first test).
-    /// Either way the broad phase changes the cost, not the answer.
+    /// `P = 0` without a query. Exact links: the link's bounding box, moved
+    /// into the cloud's frame, descends the cloud's hierarchy over its points
+    /// (points model) or over its element hulls (elements model), and the
+    /// points or element surfaces of the leaves within the noise's reach are
+    /// tested against the box in the link's frame; when none is within
+    /// reach, the exact-side query would read nothing (but single points
+    /// farther than their noise's reach, each below `prune_epsilon / 2`, as
+    /// the exact side's per-point probabilities leave them). No signed
+    /// distance is evaluated. Sampled links, points model: the link's
+    /// bounding box is beyond the noise's reach of every node of the cloud's
+    /// hierarchy, so no pair of points is near by the query's near rule.
+    /// Sampled links, elements model: no element surface of the link may
+    /// reach one of the cloud through the hierarchies over both clouds'
+    /// element hulls (the elements query's own first test). The broad phase
+    /// changes the cost, not the answer (exact links: not by more than
+    /// `prune_epsilon / 2` per link).
     pub broad_phase: bool,
     /// Check self-collision between non-adjacent links (default `true`).
     pub self_collision: bool,
@@ -42,6 +63,7 @@ impl Default for RobotRequest {
     fn default() -> Self {
         Self {
             collide: CollisionRequest::default(),
+            mesh_side: MeshSide::default(),
             mesh_spacing: None,
             broad_phase: true,
             self_collision: true,
@@ -53,7 +75,10 @@ impl RobotRequest {
     /// Checks every field's domain.
     ///
     /// # Errors
-    /// As [`CollisionRequest::validate`]; a mesh spacing that is not finite and positive.
+    /// As [`CollisionRequest::validate`]; a mesh spacing that is not finite
+    /// and positive, or given with [`MeshSide::Exact`] (nothing is sampled);
+    /// the `surface` aggregation with the points model and an exact side (it
+    /// reads a trained surface around each point).
     pub fn validate(&self) -> Result<()> {
         self.collide.validate()?;
         if let Some(s) = self.mesh_spacing {
@@ -61,6 +86,22 @@ impl RobotRequest {
                 return Err(Error::invalid(format!(
                     "mesh_spacing must be finite and > 0, got {s}"
                 )));
+            }
+        }
+        if self.mesh_side == MeshSide::Exact {
+            if self.mesh_spacing.is_some() {
+                return Err(Error::invalid(
+                    "mesh_spacing samples the link meshes: it needs mesh_side 'sampled'",
+                ));
+            }
+            if self.collide.model == QueryModel::Points
+                && self.collide.aggregation == Aggregation::Surface
+            {
+                return Err(Error::invalid(
+                    "aggregation 'surface' reads a trained surface around each point: \
+                     not available with exact links (use mesh_side 'sampled', or 'max', \
+                     'union' or 'independent')",
+                ));
             }
         }
         Ok(())
@@ -79,8 +120,9 @@ pub struct LinkCollision {
     pub state: CollisionState,
     /// Whether the link was queried (it passed the broad phase).
     pub queried: bool,
-    /// The full query result, when queried (side A is the link's sample, in
-    /// the link's frame; regions in the world frame).
+    /// The full query result, when queried (side A is the link: its exact
+    /// surface, no points, with [`MeshSide::Exact`]; its sample, in the link's
+    /// frame, with [`MeshSide::Sampled`]; regions in the world frame).
     pub result: Option<CollisionResult>,
 }
 
@@ -105,13 +147,15 @@ pub struct RobotCounters {
     /// Links left unqueried because an earlier link's probability had reached
     /// the collision threshold (`decide_only` only).
     pub links_after_decision: usize,
-    /// Hierarchy nodes of the cloud visited by the broad phase.
+    /// Hierarchy nodes (or node pairs) visited by the broad phase.
     pub broad_phase_nodes: usize,
     /// Link pairs tested for self-collision.
     pub self_pairs_checked: usize,
-    /// Node pairs visited by the per-link queries, summed.
+    /// Node pairs visited by the per-link queries, summed (for exact links,
+    /// the cloud's elements tested against the link's surface).
     pub node_pairs_visited: usize,
-    /// Interior-point iterations of the per-link queries' classifiers, summed.
+    /// Interior-point iterations of the per-link queries' classifiers, summed
+    /// (0 for exact links: nothing is trained).
     pub solver_iterations: u64,
 }
 
@@ -265,10 +309,59 @@ impl RobotWorkspace {
     }
 }
 
-/// [`collide_robot`] with prepared samples and a workspace; `q` checked.
+/// What stands for the links in a query.
+#[derive(Debug)]
+pub(crate) enum LinkSides {
+    /// Their exact surfaces ([`LinkGeometry::distance`]).
+    Exact,
+    /// Their samples at one spacing.
+    Sampled(Arc<LinkSamples>),
+}
+
+impl LinkSides {
+    /// The sides `request` asks for against `cloud` (samples cached on the robot).
+    pub(crate) fn new(robot: &Robot, request: &RobotRequest, cloud: &PointCloud) -> Result<Self> {
+        match request.mesh_side {
+            MeshSide::Exact => Ok(LinkSides::Exact),
+            MeshSide::Sampled => Ok(LinkSides::Sampled(samples_at(
+                robot,
+                link_spacing(request, cloud)?,
+            )?)),
+        }
+    }
+
+    /// Builds what every query of the sides against `cloud` reads, so that
+    /// parallel queries do not race to build it.
+    pub(crate) fn prepare(&self, cloud: &PointCloud, request: &CollisionRequest) {
+        prepare(cloud, request);
+        match self {
+            LinkSides::Exact => {
+                for s in 0..request.segmentations {
+                    let _ = cloud.segmentation_after(s).hulls();
+                }
+            }
+            LinkSides::Sampled(samples) => {
+                for link_cloud in samples.clouds.iter().flatten() {
+                    prepare(link_cloud, request);
+                }
+            }
+        }
+    }
+}
+
+/// One robot query's fixed inputs.
+struct Scene<'a> {
+    sides: &'a LinkSides,
+    cloud: &'a PointCloud,
+    request: &'a RobotRequest,
+    /// The noise's reach in standard deviations (`-Phi^-1(epsilon / 2)`).
+    reach: Real,
+}
+
+/// [`collide_robot`] with prepared link sides and a workspace; `q` checked.
 pub(crate) fn collide_robot_prepared(
     robot: &Robot,
-    samples: &LinkSamples,
+    sides: &LinkSides,
     q: &[Real],
     base: &Pose,
     cloud: &PointCloud,
@@ -277,15 +370,19 @@ pub(crate) fn collide_robot_prepared(
 ) -> RobotCollisionResult {
     let start = Instant::now();
     let poses = robot.link_poses_unchecked(q, base);
-    let k = -normal_quantile(0.5 * request.collide.prune_epsilon);
+    let scene = Scene {
+        sides,
+        cloud,
+        request,
+        reach: -normal_quantile(0.5 * request.collide.prune_epsilon),
+    };
     let mut stats = RobotStats::default();
     let mut links = Vec::new();
-    let broad_phase = request.broad_phase;
     // Every aggregation is at least the largest link probability: once a link
     // reaches the collision threshold, a decide_only query is decided.
     let mut decided = false;
-    for (l, link_cloud) in samples.clouds.iter().enumerate() {
-        let Some(link_cloud) = link_cloud else {
+    for (l, link) in robot.links.iter().enumerate() {
+        let Some(geometry) = &link.geometry else {
             continue;
         };
         stats.counters.links_with_geometry += 1;
@@ -294,86 +391,11 @@ pub(crate) fn collide_robot_prepared(
             links.push(after_decision(l));
             continue;
         }
-        let near = !broad_phase
-            || match request.collide.model {
-                // The elements model's own first test: the hierarchies over both
-                // clouds' element hulls (the query reads P = 0 when it fails).
-                // With several segmentations, any of them that may reach.
-                QueryModel::Elements => (0..request.collide.segmentations).any(|s| {
-                    let (may, visited) = element_surfaces_may_reach(
-                        link_cloud.segmentation_after(s),
-                        &poses[l],
-                        cloud.segmentation_after(s),
-                        k,
-                        &mut ws.bvh,
-                    );
-                    stats.counters.broad_phase_nodes += visited;
-                    may
-                }),
-                QueryModel::Points => {
-                    let local = robot.links[l]
-                        .geometry
-                        .as_ref()
-                        .map_or_else(Aabb::empty, |g| g.aabb);
-                    let world = local.transformed(&poses[l]);
-                    near_cloud(
-                        &world,
-                        samples.spacing_max[l],
-                        cloud,
-                        k,
-                        &mut stats.counters.broad_phase_nodes,
-                        &mut ws.stack,
-                    )
-                }
-            };
-        if !near {
-            links.push(LinkCollision {
-                link: l,
-                probability: 0.0,
-                state: request.collide.thresholds.state(0.0),
-                queried: false,
-                result: None,
-            });
-            continue;
-        }
-        stats.counters.links_queried += 1;
-        // The request was validated by the caller; a query error cannot occur.
-        let warm = ws.warm.as_mut().map(|w| {
-            if w.len() <= l {
-                w.resize_with(l + 1, WarmStart::default);
-            }
-            &mut w[l]
-        });
-        match collide_with_workspace(
-            &poses[l],
-            link_cloud,
-            &Pose::identity(),
-            cloud,
-            &request.collide,
-            &mut ws.bvh,
-            warm,
-        ) {
-            Ok(r) => {
-                stats.counters.node_pairs_visited += r.stats.counters.node_pairs_visited;
-                stats.counters.solver_iterations += r.stats.counters.solver_iterations;
-                decided = request.collide.decide_only
-                    && r.probability >= request.collide.thresholds.collision;
-                links.push(LinkCollision {
-                    link: l,
-                    probability: r.probability,
-                    state: r.state,
-                    queried: true,
-                    result: Some(r),
-                });
-            }
-            Err(_) => links.push(LinkCollision {
-                link: l,
-                probability: 1.0,
-                state: CollisionState::Collision,
-                queried: true,
-                result: None,
-            }),
-        }
+        let entry = query_link(&scene, (l, geometry, &poses[l]), ws, &mut stats.counters);
+        decided = request.collide.decide_only
+            && entry.queried
+            && entry.probability >= request.collide.thresholds.collision;
+        links.push(entry);
     }
     let p: Vec<Real> = links
         .iter()
@@ -397,15 +419,146 @@ pub(crate) fn collide_robot_prepared(
     }
 }
 
+/// One link (its index, geometry and world pose) against the cloud: skipped
+/// by the broad phase, or queried.
+fn query_link(
+    scene: &Scene<'_>,
+    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    ws: &mut RobotWorkspace,
+    counters: &mut RobotCounters,
+) -> LinkCollision {
+    let request = scene.request;
+    if request.broad_phase && !link_near(scene, (l, geometry, pose), ws, counters) {
+        return LinkCollision {
+            link: l,
+            probability: 0.0,
+            state: request.collide.thresholds.state(0.0),
+            queried: false,
+            result: None,
+        };
+    }
+    counters.links_queried += 1;
+    match link_query(scene, (l, geometry, pose), ws) {
+        Ok(r) => {
+            counters.node_pairs_visited += r.stats.counters.node_pairs_visited;
+            counters.solver_iterations += r.stats.counters.solver_iterations;
+            LinkCollision {
+                link: l,
+                probability: r.probability,
+                state: r.state,
+                queried: true,
+                result: Some(r),
+            }
+        }
+        // The request was validated by the caller; a query error cannot occur.
+        Err(_) => LinkCollision {
+            link: l,
+            probability: 1.0,
+            state: CollisionState::Collision,
+            queried: true,
+            result: None,
+        },
+    }
+}
+
+/// Whether the link may reach the cloud (the broad phase, see
+/// [`RobotRequest::broad_phase`]); counts the visited nodes.
+fn link_near(
+    scene: &Scene<'_>,
+    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    ws: &mut RobotWorkspace,
+    counters: &mut RobotCounters,
+) -> bool {
+    let (cloud, collide) = (scene.cloud, &scene.request.collide);
+    let samples = match scene.sides {
+        LinkSides::Exact => {
+            let (near, visited) = exact_side_may_reach(
+                (&geometry.aabb, pose),
+                cloud,
+                (collide, scene.reach),
+                &mut ws.stack,
+            );
+            counters.broad_phase_nodes += visited;
+            return near;
+        }
+        LinkSides::Sampled(samples) => samples,
+    };
+    let Some(link_cloud) = &samples.clouds[l] else {
+        return false;
+    };
+    match collide.model {
+        // The elements model's own first test: the hierarchies over both
+        // clouds' element hulls (the query reads P = 0 when it fails). With
+        // several segmentations, any of them that may reach.
+        QueryModel::Elements => (0..collide.segmentations).any(|s| {
+            let (may, visited) = element_surfaces_may_reach(
+                link_cloud.segmentation_after(s),
+                pose,
+                cloud.segmentation_after(s),
+                scene.reach,
+                &mut ws.bvh,
+            );
+            counters.broad_phase_nodes += visited;
+            may
+        }),
+        QueryModel::Points => near_cloud(
+            &geometry.aabb.transformed(pose),
+            samples.spacing_max[l],
+            cloud,
+            scene.reach,
+            &mut counters.broad_phase_nodes,
+            &mut ws.stack,
+        ),
+    }
+}
+
+/// The query of one link that passed the broad phase.
+fn link_query(
+    scene: &Scene<'_>,
+    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    ws: &mut RobotWorkspace,
+) -> Result<CollisionResult> {
+    let (cloud, collide) = (scene.cloud, &scene.request.collide);
+    let samples = match scene.sides {
+        LinkSides::Exact => {
+            return collide_exact_cloud(pose, &geometry.distance, &Pose::identity(), cloud, collide)
+        }
+        LinkSides::Sampled(samples) => samples,
+    };
+    let link_cloud = samples.clouds[l]
+        .as_ref()
+        .ok_or_else(|| Error::invalid("a link with geometry has no sample"))?;
+    let warm = ws.warm.as_mut().map(|w| {
+        if w.len() <= l {
+            w.resize_with(l + 1, WarmStart::default);
+        }
+        &mut w[l]
+    });
+    collide_with_workspace(
+        pose,
+        link_cloud,
+        &Pose::identity(),
+        cloud,
+        collide,
+        &mut ws.bvh,
+        warm,
+    )
+}
+
 /// The robot at configuration `q`, its root link at `base`, against the
 /// environment cloud `cloud` (world frame).
 ///
-/// Each link with geometry stands as the cloud sampled from its mesh (no
-/// sensor noise, its own discretization covariance; sampled once per spacing
-/// and cached on the robot). A broad phase skips the links beyond the noise's
-/// reach of the cloud (see [`RobotRequest::broad_phase`]); every other link is
-/// queried by [`crate::query::collide()`] at its pose. Self-collision between
-/// non-adjacent links is checked on the exact meshes and reported apart.
+/// Each link with geometry stands, by default ([`MeshSide::Exact`]), as its
+/// exact surface: its signed distance, built when the robot was loaded
+/// ([`LinkGeometry::distance`]), queried by
+/// [`collide_exact_cloud`](crate::query::exact_side::collide_exact_cloud) at
+/// its pose. With [`MeshSide::Sampled`] it stands as the cloud sampled from
+/// its mesh (no sensor noise, its own discretization covariance; sampled once
+/// per spacing and cached on the robot), queried by
+/// [`crate::query::collide()`]. A broad phase first skips the links beyond
+/// the noise's reach of the cloud (see [`RobotRequest::broad_phase`]).
+/// Self-collision between non-adjacent links is checked on the exact meshes
+/// and reported apart.
 ///
 /// # Errors
 /// As [`Robot::check_configuration`] for `q`; an invalid request; a
@@ -420,10 +573,10 @@ pub fn collide_robot(
     request.validate()?;
     robot.check_configuration(q)?;
     check_base(base)?;
-    let samples = samples_at(robot, link_spacing(request, cloud)?)?;
+    let sides = LinkSides::new(robot, request, cloud)?;
     let mut ws = RobotWorkspace::default();
     Ok(collide_robot_prepared(
-        robot, &samples, q, base, cloud, request, &mut ws,
+        robot, &sides, q, base, cloud, request, &mut ws,
     ))
 }
 
@@ -457,15 +610,12 @@ pub fn collide_robot_many(
             other => other,
         })?;
     }
-    let samples = samples_at(robot, link_spacing(request, cloud)?)?;
-    prepare(cloud, &request.collide);
-    for link_cloud in samples.clouds.iter().flatten() {
-        prepare(link_cloud, &request.collide);
-    }
+    let sides = LinkSides::new(robot, request, cloud)?;
+    sides.prepare(cloud, &request.collide);
     Ok(qs
         .par_iter()
         .map_init(RobotWorkspace::default, |ws, q| {
-            collide_robot_prepared(robot, &samples, q, base, cloud, request, ws)
+            collide_robot_prepared(robot, &sides, q, base, cloud, request, ws)
         })
         .collect())
 }

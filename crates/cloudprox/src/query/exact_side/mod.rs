@@ -21,11 +21,14 @@
 //!   phase: which elements can come within the noise's reach of the surface);
 //! - `readings.rs`: the elements' readings against the surface;
 //! - `points.rs`: the per-point probabilities (Eq. 3);
+//! - `reach.rs`: whether a box around the mesh can reach the cloud at all
+//!   (a robot's broad phase, before any signed distance);
 //! - `query.rs`: the entry points.
 
 mod frame;
 mod points;
 mod query;
+mod reach;
 mod readings;
 #[cfg(test)]
 mod tests;
@@ -33,3 +36,4 @@ mod tests;
 pub use query::{
     collide_cloud_exact, collide_cloud_exact_many, collide_exact_cloud, collide_exact_cloud_many,
 };
+pub(crate) use reach::exact_side_may_reach;
