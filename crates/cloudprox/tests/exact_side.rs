@@ -339,3 +339,76 @@ fn a_thin_bar_through_a_wide_floor_collides() {
         }
     }
 }
+
+/// A tilted link-like box (4 x 4 x 20 cm) pressed 12 mm into a wide noisy
+/// floor (1.2 m square at 1 cm, sigma 1 mm) by one corner, over a hole in
+/// the floor's sampling (a shadow, 6 mm about the corner): the floor's
+/// elements are tens of centimetres across, their probes lie farther from
+/// the box than their search radius, and the closest points from an
+/// element's mean lead to the box's side. Read across from the box's
+/// deepest vertex (at the hole's edge there): a collision; lifted 2 cm
+/// clear, free.
+#[test]
+fn a_corner_pressed_into_a_wide_floor_beside_a_hole_collides() {
+    let link = MeshDistance::new(&Mesh::cuboid(0.02, 0.02, 0.1).unwrap()).unwrap();
+    let turn = UnitQuaternion::from_euler_angles(0.5, 0.35, 0.2);
+    // The box's lowest corner after the turn, put at (0.137, -0.251, -6 mm).
+    let lowest = [-1.0, 1.0]
+        .iter()
+        .flat_map(|&x| [-1.0, 1.0].map(move |y| (x, y)))
+        .flat_map(|(x, y)| {
+            [-1.0, 1.0].map(move |z| turn * Point3::new(0.02 * x, 0.02 * y, 0.1 * z))
+        })
+        .min_by(|a, b| a.z.total_cmp(&b.z))
+        .unwrap();
+    let corner = Point3::new(0.137, -0.251, -0.012);
+    let at = |lift: f64| {
+        Pose::from_parts(
+            Translation3::from(corner - lowest + Vector3::new(0.0, 0.0, lift)),
+            turn,
+        )
+    };
+    let floor: Vec<Point3> = (0..121 * 121)
+        .flat_map(|i| {
+            let (u, v) = (
+                f64::from(i % 121) * 0.01 - 0.6,
+                f64::from(i / 121) * 0.01 - 0.6,
+            );
+            [Point3::new(u, v, 0.0), Point3::new(u, v, -0.02)]
+        })
+        .filter(|p| (p.x - corner.x).hypot(p.y - corner.y) > 0.006)
+        .collect();
+    let inside = floor
+        .iter()
+        .filter(|p| link.signed_distance(&(at(0.0).inverse() * **p)) < 0.0)
+        .count();
+    assert!(inside >= 3, "{inside} floor points inside the box");
+    let sigma = 0.001;
+    for seed in 0..4u64 {
+        let cloud = PointCloud::from_sigma(add_noise(&floor, sigma, 70 + seed), sigma).unwrap();
+        let query = |pose: &Pose| {
+            collide_exact_cloud(
+                pose,
+                &link,
+                &Pose::identity(),
+                &cloud,
+                &CollisionRequest::default(),
+            )
+            .unwrap()
+        };
+        let r = query(&at(0.0));
+        assert_eq!(
+            r.state,
+            CollisionState::Collision,
+            "seed {seed}: P {}",
+            r.probability
+        );
+        let r = query(&at(0.02));
+        assert_eq!(
+            r.state,
+            CollisionState::Free,
+            "seed {seed} clear: P {}",
+            r.probability
+        );
+    }
+}

@@ -223,6 +223,18 @@ impl SurfaceElement {
         )
     }
 
+    /// The sampled point's tangential coordinates nearest `(u, v)` (`None`
+    /// for a single point).
+    pub fn nearest_sampled(&self, u: Real, v: Real) -> Option<(Real, Real)> {
+        self.footprint
+            .iter()
+            .map(|p| (Real::from(p.2), Real::from(p.3)))
+            .min_by(|a, b| {
+                let d = |p: &(Real, Real)| (p.0 - u).powi(2) + (p.1 - v).powi(2);
+                d(a).total_cmp(&d(b))
+            })
+    }
+
     /// Whether `(u, v)` lies within the element's extent and where it was
     /// sampled ([`SurfaceElement::covers`]).
     pub fn sampled_over(&self, u: Real, v: Real) -> bool {

@@ -223,6 +223,9 @@ pub struct MeshDistance {
     /// The hierarchical winding number's fans (the fallback when every ray
     /// grazes), made on first use.
     fans: Arc<OnceLock<BoundaryFans>>,
+    /// The convex hull's vertices (every vertex when the hull is flat),
+    /// made on first use ([`MeshDistance::support`]).
+    hull: Arc<OnceLock<Vec<Point3>>>,
     positions: Arc<Vec<Point3>>,
     num_faces: usize,
 }
@@ -314,6 +317,7 @@ impl MeshDistance {
             pseudo,
             caps,
             fans: Arc::new(fans),
+            hull: Arc::new(OnceLock::new()),
             positions: Arc::new(rep.positions),
             num_faces: mesh.faces().len(),
         })
@@ -334,6 +338,27 @@ impl MeshDistance {
     /// The number of faces of the mesh.
     pub fn num_faces(&self) -> usize {
         self.num_faces
+    }
+
+    /// The mesh's support point along `dir`: a vertex farthest along it
+    /// (the first of the convex hull's vertices to attain the largest
+    /// `p . dir`).
+    pub fn support(&self, dir: &Vector3) -> Point3 {
+        let hull = self.hull.get_or_init(|| {
+            parry3d_f64::transformation::try_convex_hull(&self.positions)
+                .map_or_else(|_| self.positions.to_vec(), |(points, _)| points)
+        });
+        hull.iter()
+            .copied()
+            .fold((Real::NEG_INFINITY, Point3::origin()), |best, p| {
+                let h = p.coords.dot(dir);
+                if h > best.0 {
+                    (h, p)
+                } else {
+                    best
+                }
+            })
+            .1
     }
 
     /// The lower and upper corners of the mesh's bounding box.

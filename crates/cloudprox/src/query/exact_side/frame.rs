@@ -60,6 +60,11 @@ impl<'a> Frame<'a> {
         self.rel.inverse_transform_point(p)
     }
 
+    /// A direction of the cloud's frame in the mesh's.
+    pub fn to_mesh_direction(&self, v: &Vector3) -> Vector3 {
+        self.rotation * v
+    }
+
     /// A direction of the mesh's frame in the cloud's.
     pub fn to_cloud(&self, v: &Vector3) -> Vector3 {
         self.rotation.transpose() * v

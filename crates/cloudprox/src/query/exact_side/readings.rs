@@ -116,8 +116,56 @@ fn probe_readings(
             out.push(r);
         }
     }
+    let best = support_reading(frame, e, k, start, best, out);
     let best = refine(frame, e, k, best, out);
     descend(frame, e, k, &best, out);
+}
+
+/// The element's surface read across from the mesh's support point towards
+/// it (the vertex deepest on the element's side, from the side of the
+/// element's plane that `start`, the mesh's point closest to the element's
+/// mean, lies on), where the element was sampled (else at its nearest
+/// sampled point); the reading is kept
+/// within reach and becomes the nearest one when it is. A mesh pressed into
+/// a wide element between its probes, farther than the search radius from
+/// each (a robot link on a scanned floor, tens of centimetres across), is
+/// found there: the closest points from the element's mean lead to the
+/// mesh's side, not to where it goes through.
+fn support_reading(
+    frame: &Frame<'_>,
+    e: &SurfaceElement,
+    k: u32,
+    start: ClosestPoint,
+    best: Nearest,
+    out: &mut Vec<ElementReading>,
+) -> Nearest {
+    let normal = frame.to_mesh_direction(&e.normal);
+    let above = (start.point - frame.to_mesh(&e.mean)).dot(&normal) >= 0.0;
+    let deepest = frame.mesh.support(&(if above { -normal } else { normal }));
+    let q = frame.to_cloud_point(&deepest) - e.mean;
+    let (mut u, mut v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
+    if !e.sampled_over(u, v) {
+        // A hole in the sampling (a shadow): the nearest sampled point.
+        let Some(at) = e.nearest_sampled(u, v) else {
+            return best;
+        };
+        (u, v) = at;
+    }
+    let Some((r, closest)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
+        return best;
+    };
+    if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
+        out.push(r);
+    }
+    if r.gap < best.gap {
+        Nearest {
+            gap: r.gap,
+            at: Some((u, v)),
+            closest,
+        }
+    } else {
+        best
+    }
 }
 
 /// The element's surface point read nearest the surface so far: its gap, its
