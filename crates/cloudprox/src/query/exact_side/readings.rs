@@ -124,8 +124,9 @@ fn probe_readings(
 /// The element's surface read across from the mesh's support point towards
 /// it (the vertex deepest on the element's side, from the side of the
 /// element's plane that `start`, the mesh's point closest to the element's
-/// mean, lies on), where the element was sampled (else at its nearest
-/// sampled point); the reading is kept
+/// mean, lies on), where it lies over the element's extent: where the
+/// element was sampled, else at the nearest sampled point (a hole in the
+/// sampling, a shadow); the reading is kept
 /// within reach and becomes the nearest one when it is. A mesh pressed into
 /// a wide element between its probes, farther than the search radius from
 /// each (a robot link on a scanned floor, tens of centimetres across), is
@@ -144,7 +145,11 @@ fn support_reading(
     let deepest = frame.mesh.support(&(if above { -normal } else { normal }));
     let q = frame.to_cloud_point(&deepest) - e.mean;
     let (mut u, mut v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
-    if !e.sampled_over(u, v) {
+    let [[u0, u1], [v0, v1]] = e.extent;
+    if !((u0..=u1).contains(&u) && (v0..=v1).contains(&v)) {
+        return best;
+    }
+    if !e.covers(u, v) {
         // A hole in the sampling (a shadow): the nearest sampled point.
         let Some(at) = e.nearest_sampled(u, v) else {
             return best;
