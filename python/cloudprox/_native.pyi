@@ -883,9 +883,9 @@ def facing_pairs(
     and its standard deviation, metres), ``probability`` (its wrong-side
     probability), ``within_reach``, ``beside`` (the probe lies past the other
     element's extent), ``probe_edge``, ``count``, ``other_count``, ``size``,
-    ``other_size`` and ``own_std``. ``benches/calibration.py`` compares
-    ``gap`` with the exact gap: ``(g_true - gap) / std`` should be standard
-    normal.
+    ``other_size`` and ``own_std``. ``benches/analytic.py`` and
+    ``benches/realmesh.py --residuals`` compare ``gap`` with the exact gap:
+    ``(g_true - gap) / std`` should be standard normal.
     """
 
 def collide(
