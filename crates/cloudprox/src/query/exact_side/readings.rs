@@ -116,9 +116,13 @@ fn probe_readings(
             out.push(r);
         }
     }
-    let best = support_reading(frame, e, k, start, best, out);
-    let best = refine(frame, e, k, best, out);
-    descend(frame, e, k, &best, out);
+    // Two searches: from the probe nearest the surface, and from across the
+    // mesh's deepest vertex.
+    let seeds = [Some(best), support_reading(frame, e, k, start, out)];
+    for seed in seeds.into_iter().flatten() {
+        let nearest = refine(frame, e, k, seed, out);
+        descend(frame, e, k, &nearest, out);
+    }
 }
 
 /// The element's surface read across from the mesh's support point towards
@@ -126,20 +130,19 @@ fn probe_readings(
 /// element's plane that `start`, the mesh's point closest to the element's
 /// mean, lies on), where it lies over the element's extent: where the
 /// element was sampled, else at the nearest sampled point (a hole in the
-/// sampling, a shadow); the reading is kept
-/// within reach and becomes the nearest one when it is. A mesh pressed into
-/// a wide element between its probes, farther than the search radius from
-/// each (a robot link on a scanned floor, tens of centimetres across), is
-/// found there: the closest points from the element's mean lead to the
-/// mesh's side, not to where it goes through.
+/// sampling, a shadow); the reading is kept within reach, and the search
+/// goes on from it (`None` where the vertex lies beside the extent). A mesh
+/// pressed into a wide element between its probes, farther than the search
+/// radius from each (a robot link on a scanned floor, tens of centimetres
+/// across), is found there: the closest points from the element's mean lead
+/// to the mesh's side, not to where it goes through.
 fn support_reading(
     frame: &Frame<'_>,
     e: &SurfaceElement,
     k: u32,
     start: ClosestPoint,
-    best: Nearest,
     out: &mut Vec<ElementReading>,
-) -> Nearest {
+) -> Option<Nearest> {
     let normal = frame.to_mesh_direction(&e.normal);
     let above = (start.point - frame.to_mesh(&e.mean)).dot(&normal) >= 0.0;
     let deepest = frame.mesh.support(&(if above { -normal } else { normal }));
@@ -147,30 +150,21 @@ fn support_reading(
     let (mut u, mut v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
     let [[u0, u1], [v0, v1]] = e.extent;
     if !((u0..=u1).contains(&u) && (v0..=v1).contains(&v)) {
-        return best;
+        return None;
     }
     if !e.covers(u, v) {
         // A hole in the sampling (a shadow): the nearest sampled point.
-        let Some(at) = e.nearest_sampled(u, v) else {
-            return best;
-        };
-        (u, v) = at;
+        (u, v) = e.nearest_sampled(u, v)?;
     }
-    let Some((r, closest)) = read_at(frame, e, k, (u, v), Real::INFINITY) else {
-        return best;
-    };
+    let (r, closest) = read_at(frame, e, k, (u, v), Real::INFINITY)?;
     if r.gap <= HALF_SPACING * e.spacing + frame.reach * r.std {
         out.push(r);
     }
-    if r.gap < best.gap {
-        Nearest {
-            gap: r.gap,
-            at: Some((u, v)),
-            closest,
-        }
-    } else {
-        best
-    }
+    Some(Nearest {
+        gap: r.gap,
+        at: Some((u, v)),
+        closest,
+    })
 }
 
 /// The element's surface point read nearest the surface so far: its gap, its
