@@ -9,11 +9,28 @@ developer's fast run is ``python3 -m pytest -m "not network and not slow"``;
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import cloudprox as cp
 from tests.helpers import N_POINTS, RADIUS, SIGMA
+from tests.robots import ARM_URDF
+
+
+@pytest.fixture(scope="module")
+def arm_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The test arm's URDF (``tests.robots.ARM_URDF``) in a file."""
+    path = tmp_path_factory.mktemp("arm") / "arm.urdf"
+    path.write_text(ARM_URDF)
+    return path
+
+
+@pytest.fixture(scope="module")
+def arm(arm_path: Path) -> cp.Robot:
+    """The test arm, loaded from its file."""
+    return cp.Robot.from_urdf(arm_path)
 
 
 @pytest.fixture(scope="session")

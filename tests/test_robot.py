@@ -26,18 +26,6 @@ SIGMA = 0.002
 
 
 @pytest.fixture(scope="module")
-def arm_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("arm") / "arm.urdf"
-    path.write_text(ARM_URDF)
-    return path
-
-
-@pytest.fixture(scope="module")
-def arm(arm_path: Path) -> cp.Robot:
-    return cp.Robot.from_urdf(arm_path)
-
-
-@pytest.fixture(scope="module")
 def panda() -> tuple[cp.Robot, Path]:
     path = panda_urdf_or_skip()
     return cp.Robot.from_urdf(path), path

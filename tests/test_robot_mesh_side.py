@@ -9,21 +9,9 @@ import numpy as np
 import pytest
 
 import cloudprox as cp
-from tests.robots import ARM_URDF, wall
+from tests.robots import wall
 
 SIGMA = 0.002
-
-
-@pytest.fixture(scope="module")
-def arm_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("arm") / "arm.urdf"
-    path.write_text(ARM_URDF)
-    return path
-
-
-@pytest.fixture(scope="module")
-def arm(arm_path: Path) -> cp.Robot:
-    return cp.Robot.from_urdf(arm_path)
 
 
 @pytest.fixture(scope="module")

@@ -305,31 +305,25 @@ fn a_thin_bar_through_a_wide_floor_collides() {
     let sigma = 0.001;
     for seed in 0..4u64 {
         let cloud = PointCloud::from_sigma(add_noise(&floor, sigma, 50 + seed), sigma).unwrap();
-        for (x, y) in [(0.0, 0.0), (0.137, -0.251), (-0.33, 0.41)] {
-            let through = Pose::translation(x, y, 0.0);
-            let r = collide_exact_cloud(
-                &through,
+        let query = |pose: &Pose| {
+            collide_exact_cloud(
+                pose,
                 &bar,
                 &Pose::identity(),
                 &cloud,
                 &CollisionRequest::default(),
             )
-            .unwrap();
+            .unwrap()
+        };
+        for (x, y) in [(0.0, 0.0), (0.137, -0.251), (-0.33, 0.41)] {
+            let r = query(&Pose::translation(x, y, 0.0));
             assert_eq!(
                 r.state,
                 CollisionState::Collision,
                 "seed {seed} at ({x}, {y}): P {}",
                 r.probability
             );
-            let clear = Pose::translation(x, y, 0.23);
-            let r = collide_exact_cloud(
-                &clear,
-                &bar,
-                &Pose::identity(),
-                &cloud,
-                &CollisionRequest::default(),
-            )
-            .unwrap();
+            let r = query(&Pose::translation(x, y, 0.23));
             assert_eq!(
                 r.state,
                 CollisionState::Free,

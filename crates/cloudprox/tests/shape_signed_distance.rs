@@ -639,3 +639,24 @@ proptest! {
         prop_assert!((got - analytic).abs() < 1e-12, "{} vs {}", got, analytic);
     }
 }
+
+/// The support point is a vertex farthest along the direction: a cuboid's
+/// corner on its diagonals, turned meshes included.
+#[test]
+fn the_support_point_is_the_farthest_vertex() {
+    let mesh = Mesh::cuboid(0.1, 0.2, 0.3).unwrap();
+    let d = MeshDistance::new(&mesh).unwrap();
+    for (dir, corner) in [
+        (Vector3::new(1.0, 1.0, 1.0), Point3::new(0.1, 0.2, 0.3)),
+        (Vector3::new(-1.0, 0.5, -2.0), Point3::new(-0.1, 0.2, -0.3)),
+        (Vector3::new(0.3, -0.1, 0.01), Point3::new(0.1, -0.2, 0.3)),
+    ] {
+        assert!((d.support(&dir) - corner).norm() < 1e-12, "{dir:?}");
+        let best = mesh
+            .vertices()
+            .iter()
+            .map(|v| v.coords.dot(&dir))
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!((d.support(&dir).coords.dot(&dir) - best).abs() < 1e-12);
+    }
+}

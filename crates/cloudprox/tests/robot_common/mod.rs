@@ -138,3 +138,17 @@ pub fn temp_dir(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+/// Asserts that two robot results give the same `P`, and each link the same
+/// probability and state (`what` names the case in a failure).
+pub fn assert_same_answer(
+    a: &cloudprox::robot::RobotCollisionResult,
+    b: &cloudprox::robot::RobotCollisionResult,
+    what: &str,
+) {
+    assert_eq!(a.probability, b.probability, "{what}");
+    for (x, y) in a.links.iter().zip(&b.links) {
+        assert_eq!(x.probability, y.probability, "{what} link {}", x.link);
+        assert_eq!(x.state, y.state, "{what} link {}", x.link);
+    }
+}
