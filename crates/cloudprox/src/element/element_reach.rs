@@ -198,13 +198,14 @@ pub(crate) struct ElementHulls {
 }
 
 /// Per node of an [`ElementHulls`] hierarchy: the box of some of its elements'
-/// corners, the largest `sigma` and the largest `margin` among them, and
+/// corners, the largest `sigma`, `margin` and `radius` among them, and
 /// whether it has any.
 #[derive(Debug, Clone)]
 struct NodeBounds {
     boxes: Vec<Aabb>,
     sigma: Vec<Real>,
     margin: Vec<Real>,
+    radius: Vec<Real>,
     any: Vec<bool>,
 }
 
@@ -216,6 +217,7 @@ impl NodeBounds {
             boxes: vec![Aabb::empty(); n],
             sigma: vec![0.0; n],
             margin: vec![0.0; n],
+            radius: vec![0.0; n],
             any: vec![false; n],
         };
         for id in (0..n).rev() {
@@ -224,6 +226,7 @@ impl NodeBounds {
                 out.boxes[id] = out.boxes[l].merged(&out.boxes[r]);
                 out.sigma[id] = out.sigma[l].max(out.sigma[r]);
                 out.margin[id] = out.margin[l].max(out.margin[r]);
+                out.radius[id] = out.radius[l].max(out.radius[r]);
                 out.any[id] = out.any[l] || out.any[r];
                 continue;
             }
@@ -238,6 +241,7 @@ impl NodeBounds {
                 }
                 out.sigma[id] = out.sigma[id].max(h.sigma);
                 out.margin[id] = out.margin[id].max(h.margin);
+                out.radius[id] = out.radius[id].max(h.radius);
                 out.any[id] = true;
             }
         }
@@ -291,6 +295,44 @@ impl ElementHulls {
     /// The hull of element `e`.
     pub(crate) fn hull(&self, e: u32) -> &Hull {
         &self.hulls[e as usize]
+    }
+
+    /// Every element whose mean may lie within `radius + margin + reach sigma`
+    /// of `bounds` (same frame; each element's own hull values), in
+    /// increasing order, into `out` (cleared first): the hierarchy over the
+    /// means, each node at its largest `radius`, `margin` and `sigma`. A
+    /// superset of the elements that pass that test one by one. Returns the
+    /// number of nodes tested.
+    pub(crate) fn means_near_box(
+        &self,
+        bounds: &Aabb,
+        reach: Real,
+        out: &mut Vec<u32>,
+        stack: &mut Vec<u32>,
+    ) -> usize {
+        let b = &self.all;
+        let mut visited = 0;
+        out.clear();
+        stack.clear();
+        stack.push(0);
+        while let Some(id) = stack.pop() {
+            visited += 1;
+            let i = id as usize;
+            let node = &self.tree.nodes()[i];
+            let l = b.radius[i] + b.margin[i] + reach * b.sigma[i];
+            if node.aabb.distance_squared(bounds) > l * l {
+                continue;
+            }
+            match node.children {
+                None => out.extend_from_slice(self.tree.node_points(id)),
+                Some([l, r]) => {
+                    stack.push(r);
+                    stack.push(l);
+                }
+            }
+        }
+        out.sort_unstable();
+        visited
     }
 
     /// Whether some element passes `leaf` among those whose node comes within

@@ -82,6 +82,17 @@ impl<'a> Frame<'a> {
         inside.then(|| self.mesh.closest(x))
     }
 
+    /// The elements of `els` whose mean may lie within `radius + margin +
+    /// reach sigma` of the mesh's box (the first test of [`Frame::standing`]),
+    /// in increasing order, into `out`: the mesh's box moved into the cloud's
+    /// frame (a box holding it) descends the hierarchy over the elements'
+    /// means, so a query costs what lies near the mesh, not the cloud's size.
+    pub fn candidates(&self, els: &SurfaceElements, out: &mut Vec<u32>) {
+        let in_cloud = self.bounds.transformed(&self.rel.inverse());
+        els.hulls()
+            .means_near_box(&in_cloud, self.reach, out, &mut Vec::new());
+    }
+
     /// Where element `e` of `els` stands: its hull (every point of its
     /// surface within `radius` of its mean, every standard deviation below
     /// `sigma`) is first tested against the mesh's box, then against the

@@ -21,15 +21,19 @@ pub(crate) struct ElementScan {
 }
 
 /// The readings of every element of `els` within reach of the surface
-/// (see the [module docs](crate::query::exact_side)).
+/// (see the [module docs](crate::query::exact_side)), in the order of the
+/// elements: those the hierarchy finds near the mesh's box
+/// ([`Frame::candidates`]), each then as [`Frame::standing`] places it.
 pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> ElementScan {
     let mut scan = ElementScan {
         readings: Vec::new(),
         near: Vec::new(),
         tested: 0,
     };
-    for (k, e) in els.elements().iter().enumerate() {
-        let k = k as u32;
+    let mut candidates = Vec::new();
+    frame.candidates(els, &mut candidates);
+    for k in candidates {
+        let e = &els.elements()[k as usize];
         scan.tested += 1;
         let before = scan.readings.len();
         match frame.standing(els, k) {
