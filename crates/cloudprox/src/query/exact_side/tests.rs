@@ -81,3 +81,47 @@ fn a_cloud_beyond_reach_reads_nothing() {
     assert!(!scan.readings.is_empty());
     assert!(scan.readings.iter().all(|r| r.gap < -10.0 * r.std));
 }
+
+#[test]
+fn the_hierarchy_finds_every_element_the_one_by_one_test_keeps() {
+    // Fast path against brute force: over random poses of a small box about
+    // a noisy plane, every element that `standing` does not place beyond
+    // reach is among the hierarchy's candidates (and they come in order).
+    use super::frame::Standing;
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    let boxy = MeshDistance::new(&Mesh::cuboid(0.03, 0.02, 0.01).unwrap()).unwrap();
+    let cloud = PointCloud::from_sigma(add_noise(&plane(0.0), 0.002, 3), 0.002).unwrap();
+    let els = cloud.elements();
+    let mut rng = 7_u64;
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (rng >> 11) as Real / (1_u64 << 53) as Real
+    };
+    let mut found = 0;
+    for _ in 0..200 {
+        let t = Translation3::new(
+            0.3 * next() - 0.15,
+            0.3 * next() - 0.15,
+            -0.5 + 0.06 * next() - 0.03,
+        );
+        let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+        let turn = UnitQuaternion::from_scaled_axis(axis * 3.0);
+        // The cloud in the box's frame.
+        let frame = Frame::new(&boxy, Pose::from_parts(t, turn).inverse(), 1e-3);
+        let mut candidates = Vec::new();
+        frame.candidates(els, &mut candidates);
+        assert!(candidates.windows(2).all(|w| w[0] < w[1]));
+        for k in 0..els.elements().len() as u32 {
+            if frame.standing(els, k) != Standing::Beyond {
+                found += 1;
+                assert!(candidates.binary_search(&k).is_ok(), "element {k} missed");
+            }
+        }
+    }
+    assert!(
+        found > 50,
+        "only {found} elements near the box over all poses"
+    );
+}
