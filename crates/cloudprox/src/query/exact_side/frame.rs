@@ -70,6 +70,13 @@ impl<'a> Frame<'a> {
         self.rotation.transpose() * v
     }
 
+    /// Whether `x` (mesh frame) lies farther than `radius` from the mesh's
+    /// bounding box, so farther than `radius` outside the mesh: a test of
+    /// three coordinates before any search.
+    pub fn beyond_box(&self, x: &Point3, radius: Real) -> bool {
+        self.bounds.distance_squared_to_point(x) > radius * radius
+    }
+
     /// The mesh's closest point to `x` (mesh frame) if the surface lies
     /// within `radius` of it or `x` is inside; `None` says `x` lies outside,
     /// farther than `radius` (a bounded search: a point far from the surface

@@ -16,7 +16,9 @@ use crate::Real;
 ///
 /// Only points within the noise's reach of the surface (`reach` times the
 /// point's largest standard deviation) or inside are read exactly; the
-/// others have `p < epsilon / 2`, stored as 0. An element's points lie
+/// others have `p < epsilon / 2`, stored as 0. A point farther than its
+/// reach from the mesh's bounding box is passed over first (a wide floor's
+/// element near a small link holds thousands of such points). An element's points lie
 /// together: each search is bounded by the previous point's closest point
 /// (the surface lies at most that far), and a point is passed over without
 /// one when the previous point's distance `d`, less the step between them,
@@ -36,6 +38,9 @@ pub(crate) fn point_probabilities(
         for (i, p, cov) in els.members(e) {
             let x = frame.to_mesh(p);
             let radius = frame.reach * sigma[i as usize];
+            if frame.beyond_box(&x, radius) {
+                continue;
+            }
             if let Some((xr, cr)) = &last {
                 if !cr.is_inside() && cr.distance() - (x - xr).norm() > radius {
                     continue;
