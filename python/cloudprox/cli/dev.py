@@ -152,7 +152,7 @@ def _ray_many(address: str | None) -> Any:
     from cloudprox import distributed
 
     try:
-        ray = distributed.ensure_ray(address or None)
+        ray: Any = distributed.ensure_ray(address or None)
     except ImportError as e:
         raise CliError(str(e)) from None
     cpus = ray.cluster_resources().get("CPU", 0)

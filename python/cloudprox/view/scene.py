@@ -352,7 +352,7 @@ def collision_scene(
     layers, meshes = [], []
     for k, (obj, pose) in enumerate(((a, pose_a), (b, pose_b))):
         is_mesh = isinstance(obj, Mesh)
-        if is_mesh:
+        if isinstance(obj, Mesh):
             meshes.append(_mesh_layer(obj, pose, labels[k], SIDE_COLORS[k]))
         layers.append(
             PointLayer(
