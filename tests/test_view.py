@@ -16,6 +16,7 @@ import cloudprox as cp
 from cloudprox import view
 from cloudprox.cli import main
 from cloudprox.pose import from_translation
+from cloudprox.view._common import quiet_shown
 from tests.chromium import Chromium, find_chromium
 from tests.robots import ARM_URDF, wall
 
@@ -260,7 +261,7 @@ def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
     layer = view.PointLayer("wall", wall.astype(np.float32), prob, view.SIDE_COLORS[1])
     scene = view.Scene("wall", points=[layer])
     cell = scene.extent() / view.QUIET_CELLS
-    shown = view._quiet_shown(layer, scene.quiet_below, cell)
+    shown = quiet_shown(layer, scene.quiet_below, cell)
     # Every shown point is quiet, one in each cell that holds quiet points.
     quiet = np.flatnonzero(prob < scene.quiet_below)
     pts = layer.points.astype(np.float64)
@@ -274,7 +275,7 @@ def test_quiet_points_are_thinned_to_the_screen(tmp_path) -> None:
     with_contact = view.PointLayer(
         "wall", layer.points, prob, layer.color, contact=np.concatenate([dropped, [3]])
     )
-    kept = view._quiet_shown(with_contact, scene.quiet_below, cell)
+    kept = quiet_shown(with_contact, scene.quiet_below, cell)
     assert len(kept) == len(shown) + 50 and np.all(np.isin(dropped, kept)) and 3 not in kept
     objects = {o.name: o for o in view.to_k3d(scene).objects}
     assert f"wall: {len(shown)} of {len(wall) - 400} points with p < 0.001" in objects
