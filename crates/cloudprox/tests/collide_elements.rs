@@ -147,10 +147,7 @@ fn parallel_plates_probability_is_calibrated() {
 #[test]
 fn spheres_are_decided_within_a_sigma_of_contact() {
     // Five pairs of noise draws (seeds 100-104 and 200-204); the claims hold
-    // for the median pair at each gap. `P` a sigma apart is 0.10, 0.67, 0.21,
-    // 0.69 and 0.59 over these draws: where element boundaries fall decides
-    // how close the fitted surfaces come (the shared fixture's draws, seeds
-    // 11 and 12, read 0.92, a collision a sigma apart).
+    // for the median pair at each gap.
     let req = elements();
     let gaps = [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 6.0];
     let per_draw: Vec<Vec<f64>> = (0..5u64)
@@ -182,11 +179,12 @@ fn spheres_are_decided_within_a_sigma_of_contact() {
     // sigma: one sigma either side of contact is decided (or nearly).
     assert!(ps[0] > 0.999 && ps[1] > 0.99 && ps[2] > 0.9, "{ps:?}");
     assert!(ps[5] < 0.1 && ps[6] < 0.01 && ps[7] < 1e-6, "{ps:?}");
-    // Touching counts as a collision; a sigma apart is not one, at most in
-    // one draw of five.
-    assert!(ps[3] > 0.5 && ps[4] < 0.9, "{ps:?} of {per_draw:?}");
-    let collisions = per_draw.iter().filter(|p| p[4] >= 0.9).count();
-    assert!(collisions <= 1, "{per_draw:?}");
+    // Touching reads P near 1/2 over the draws (0.44: 0.92, 0.65, 0.19, 0.35
+    // and 0.08, the contact's readings pooled into one gap field); a sigma
+    // apart is free or nearly in every draw.
+    let touching = per_draw.iter().map(|p| p[3]).sum::<f64>() / per_draw.len() as f64;
+    assert!((0.2..0.8).contains(&touching), "{touching} of {per_draw:?}");
+    assert!(per_draw.iter().all(|p| p[4] < 0.1), "{per_draw:?}");
 }
 
 #[test]

@@ -107,6 +107,8 @@ fn per_point_probabilities_are_eq_3() {
             fit_std: sz,
             beside: false,
             contact: 0,
+            at: None,
+            direction: Vector3::zeros(),
         })
         .collect();
     assert!((r.probability - contact_probability(&readings)).abs() < 1e-12);

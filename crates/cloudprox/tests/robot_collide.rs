@@ -50,7 +50,7 @@ fn a_link_pushed_into_a_wall_collides_and_the_rest_is_free() {
     )
     .unwrap();
     assert_eq!(hit.state, CollisionState::Collision);
-    assert!(link_p(&hit, 3) > 0.99);
+    assert!(link_p(&hit, 3) > 0.99, "{}", link_p(&hit, 3));
     // The links far from the wall are skipped by the broad phase.
     for l in [0, 1] {
         let entry = hit.links.iter().find(|e| e.link == l).unwrap();

@@ -1,6 +1,8 @@
 //! The probability that two sampled surfaces cross at a contact, from the
 //! gaps that their facing surface elements read there.
 
+use crate::math::{Point3, Vector3};
+use crate::probability::gap_field::{field_probability, GapSample};
 use crate::probability::gaussian::wrong_side;
 use crate::Real;
 
@@ -32,6 +34,14 @@ pub struct ElementReading {
     /// The contact the reading belongs to (a query's connected near region):
     /// readings of different contacts are read apart.
     pub contact: u32,
+    /// Where the pair lies, in a frame shared by the query's readings; `None`
+    /// where it is not known (the contact is then read at its most critical
+    /// pair, see [`contact_probability`]).
+    pub at: Option<Point3>,
+    /// The unit direction the gap was measured along, from A towards B
+    /// (zero where the reading has none to compare: an exact side's signed
+    /// distance).
+    pub direction: Vector3,
 }
 
 /// The probability that the two sampled surfaces cross, from the facing
@@ -98,9 +108,17 @@ fn z(r: &ElementReading) -> Real {
 const VARIATION_SDS: Real = 3.0;
 
 /// The crossing probability of one contact's readings
-/// ([`contact_probability`]).
+/// ([`contact_probability`]): the readings turned to one orientation
+/// ([`oriented`]), one per element pair ([`pairs`]), those over a surface
+/// pooled into a gap field where their places are known
+/// ([`field_probability`]); else the most critical pair's.
 fn one_contact(readings: Vec<&ElementReading>) -> Real {
-    pairs(readings)
+    let oriented = oriented(&readings);
+    let chosen = pairs(oriented.iter().collect());
+    if let Some(p) = pooled(&chosen) {
+        return p;
+    }
+    chosen
         .into_iter()
         .min_by(|x, y| {
             x.beside
@@ -110,6 +128,68 @@ fn one_contact(readings: Vec<&ElementReading>) -> Real {
         })
         .map_or(0.0, |r| wrong_side(r.gap, r.std))
 }
+
+/// The readings over a surface among `chosen` (one per element pair) pooled
+/// into the contact's gap field ([`field_probability`]), in an order that
+/// does not depend on which side is A; `None` without three of them or
+/// where one's place is unknown.
+fn pooled(chosen: &[&ElementReading]) -> Option<Real> {
+    let mut over: Vec<&ElementReading> = chosen.iter().copied().filter(|r| !r.beside).collect();
+    over.sort_by(|x, y| {
+        pair_key(x)
+            .cmp(&pair_key(y))
+            .then(x.gap.total_cmp(&y.gap))
+            .then(x.std.total_cmp(&y.std))
+    });
+    let samples = over
+        .iter()
+        .map(|r| {
+            r.at.map(|at| GapSample {
+                at,
+                gap: r.gap,
+                std: r.std,
+            })
+        })
+        .collect::<Option<Vec<_>>>()?;
+    field_probability(&samples)
+}
+
+/// The readings with the contact's one orientation: a reading over a surface
+/// measured against the direction its contact's readings over surfaces share
+/// (their directions' sum, each weighted by its precision) is read along the
+/// other way (its gap negated).
+///
+/// A facing pair's direction is its facing element's normal, turned from A
+/// towards B by the patch's separating surface at the pair. Where that
+/// surface is curved at touching (it passes through the noise of both
+/// clouds), a few pairs of one flat contact are turned the other way and
+/// read the two surfaces in the wrong order: a clearance of 6 mm as a
+/// crossing of 6 mm. Readings without a direction (an exact side's) are kept.
+fn oriented(readings: &[&ElementReading]) -> Vec<ElementReading> {
+    let shared = readings
+        .iter()
+        .filter(|r| !r.beside && r.std > 0.0)
+        .fold(Vector3::zeros(), |d, r| d + r.direction / (r.std * r.std));
+    let shared = shared.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
+    readings
+        .iter()
+        .map(|&&r| {
+            if !r.beside && r.direction.dot(&shared) < -ORIENTATION_COS {
+                ElementReading {
+                    gap: -r.gap,
+                    direction: -r.direction,
+                    ..r
+                }
+            } else {
+                r
+            }
+        })
+        .collect()
+}
+
+/// How far (as the cosine of the angle to the contact's shared direction) a
+/// reading's direction must point the other way to be turned ([`oriented`]).
+const ORIENTATION_COS: Real = 0.5;
 
 /// Each element pair's reading ([`pair_reading`]): over the facing element
 /// where the pair has such readings, beside it where it has none.
@@ -170,6 +250,8 @@ mod tests {
                 fit_std: s,
                 beside: false,
                 contact: 0,
+                at: None,
+                direction: Vector3::zeros(),
             })
             .collect()
     }
@@ -184,6 +266,8 @@ mod tests {
             fit_std: std,
             beside: false,
             contact: 0,
+            at: None,
+            direction: Vector3::zeros(),
         }
     }
 

@@ -553,6 +553,8 @@ pub(crate) fn element_crossing_probabilities(
                 fit_std: r.fit_std,
                 beside: f.key.0 || po[f.own].clearance_across_its_end(r.gap, &r.direction),
                 contact: 0,
+                at: Some(nalgebra::center(&f.x, &f.y)),
+                direction: r.direction,
             });
         }
         true

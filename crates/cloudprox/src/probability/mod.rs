@@ -13,6 +13,7 @@ mod aggregation;
 mod contact;
 mod crossing;
 mod element;
+mod gap_field;
 mod gaussian;
 mod point;
 mod state;

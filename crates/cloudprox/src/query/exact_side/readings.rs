@@ -308,6 +308,10 @@ fn reading(k: u32, gap: Real, var: Real, fit: Real) -> ElementReading {
         beside: false,
         // One contact: the exact side has no near regions to read apart.
         contact: 0,
+        // Read at the most critical element: its signed distances are
+        // measured against the exact surface, which needs no pooling.
+        at: None,
+        direction: Vector3::zeros(),
     }
 }
 

@@ -1,0 +1,303 @@
+//! The gap between two sampled surfaces over one contact, as a smooth field
+//! fitted to the facing pairs' readings ([`field_probability`]).
+
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+use crate::math::{Matrix3, Point3, Vector3};
+use crate::probability::gaussian::wrong_side;
+use crate::Real;
+
+/// One facing pair's reading of the gap at a place of the contact.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GapSample {
+    /// Where the pair lies (any frame shared by the contact's readings).
+    pub at: Point3,
+    /// The gap read there.
+    pub gap: Real,
+    /// Its standard deviation.
+    pub std: Real,
+}
+
+/// How far (in standard deviations of its own reading, scaled by the fit's
+/// spread) a reading must lie below the fitted field to be read on its own:
+/// a place where the surfaces come closer than the field describes.
+const BELOW_FIELD_SDS: Real = 3.5;
+
+/// How many of its own standard deviations a reading must read the two
+/// surfaces crossed by to be read on its own: a crossing that no reading of
+/// a contact at touching reads by chance (`Phi(-4)` is 3e-5 a reading), and
+/// that a smooth field may not follow (at a deep crossing only the pairs near
+/// where the surfaces cross are within reach, and read gaps of both signs).
+const CROSSED_SDS: Real = 4.0;
+
+/// The selection criterion's cost per term of the field (2: Akaike's).
+const CRITERION_PER_TERM: Real = 2.0;
+
+/// Huber's tuning constant of the robust fit (in scaled standard deviations).
+const HUBER: Real = 2.0;
+
+/// The probability that the two surfaces cross over a contact, from its
+/// readings pooled into a smooth gap field; `None` when they cannot be fitted
+/// (fewer than three, or one without a positive finite standard deviation).
+///
+/// The gap over the contact is fitted by weighted least squares as a
+/// constant, a plane or a quadric in the contact's two widest directions,
+/// whichever has the smallest Akaike criterion (`chi^2 + 2k`; a flat contact
+/// is a constant, two spheres a quadric), robustly (Huber weights, so that a
+/// few readings off the field do not move it). The covariance of the field is
+/// scaled by the fit's reduced `chi^2` where it exceeds 1 (readings spread
+/// more than their stated deviations). `P` is the largest `Phi(-g / s)` of
+/// the field at the readings' places, and of every reading lying more than
+/// [`BELOW_FIELD_SDS`] below it or reading a crossing of more than
+/// [`CROSSED_SDS`] (where the surfaces truly come closer than a smooth field
+/// says, it reads the contact).
+///
+/// The pooled field answers the question the readings share: the most
+/// critical of many noisy readings of one flat contact reads the minimum of
+/// their noise, not the gap (at touching it reads `P` near 1, where the
+/// field reads 1/2).
+pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
+    let n = samples.len();
+    if n < 3 || samples.iter().any(|s| !(s.std > 0.0 && s.std.is_finite())) {
+        return None;
+    }
+    let coords = contact_coordinates(samples);
+    let r = DVector::from_iterator(n, samples.iter().map(|s| s.gap));
+    let w0 = DVector::from_iterator(n, samples.iter().map(|s| 1.0 / (s.std * s.std)));
+    let fit = [1usize, 3, 6]
+        .into_iter()
+        .filter(|&k| n >= k + 2)
+        .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
+        .min_by(|a, b| a.criterion().total_cmp(&b.criterion()))?;
+    let scale = (fit.chi2 / fit.dof).max(1.0);
+    let at = |row: &DMatrix<Real>| {
+        let g = (row * &fit.beta)[0];
+        let var = (row * &fit.inverse * row.transpose())[0] * scale;
+        wrong_side(g, var.max(0.0).sqrt())
+    };
+    let mut p = fit.lowest(&coords).map_or(0.0, |c| at(&design(&[c], fit.beta.len())));
+    for i in 0..n {
+        let g = (fit.a.row(i) * &fit.beta)[0];
+        p = p.max(at(&fit.a.rows(i, 1).into_owned()));
+        let s = samples[i].std;
+        if (r[i] - g) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
+            p = p.max(wrong_side(r[i], s));
+        }
+    }
+    Some(p)
+}
+
+/// The readings' places in the contact's two widest directions (about their
+/// centroid, in units of the widest spread; zero when they coincide).
+fn contact_coordinates(samples: &[GapSample]) -> Vec<[Real; 2]> {
+    let n = samples.len() as Real;
+    let c = samples.iter().fold(Vector3::zeros(), |c, s| c + s.at.coords) / n;
+    let m = samples.iter().fold(Matrix3::zeros(), |m, s| {
+        let d = s.at.coords - c;
+        m + d * d.transpose()
+    }) / n;
+    let eig = SymmetricEigen::new(m);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
+    let scale = eig.eigenvalues[order[0]].max(0.0).sqrt();
+    let (e1, e2) = (eig.eigenvectors.column(order[0]), eig.eigenvectors.column(order[1]));
+    samples
+        .iter()
+        .map(|s| {
+            if scale > 0.0 {
+                let d = s.at.coords - c;
+                [d.dot(&e1) / scale, d.dot(&e2) / scale]
+            } else {
+                [0.0, 0.0]
+            }
+        })
+        .collect()
+}
+
+/// The design matrix of the first `k` terms of `(1, u, v, u^2, u v, v^2)`.
+fn design(coords: &[[Real; 2]], k: usize) -> DMatrix<Real> {
+    DMatrix::from_fn(coords.len(), k, |i, j| {
+        let [u, v] = coords[i];
+        [1.0, u, v, u * u, u * v, v * v][j]
+    })
+}
+
+/// A weighted least-squares fit of the gap field.
+struct Fit {
+    a: DMatrix<Real>,
+    beta: DVector<Real>,
+    /// `(A^T W A)^-1` with the readings' own weights.
+    inverse: DMatrix<Real>,
+    chi2: Real,
+    dof: Real,
+}
+
+impl Fit {
+    /// The fit with Huber weights on top of the readings' own (three
+    /// reweightings); `None` when the normal equations are singular.
+    fn robust(a: &DMatrix<Real>, r: &DVector<Real>, w0: &DVector<Real>) -> Option<Self> {
+        let mut w = w0.clone();
+        let mut fit = Self::weighted(a, r, w0, &w)?;
+        for _ in 0..3 {
+            let scale = (fit.chi2 / fit.dof).max(1.0).sqrt();
+            let res = r - &fit.a * &fit.beta;
+            for i in 0..r.len() {
+                let t = (res[i] * w0[i].sqrt() / scale).abs();
+                w[i] = w0[i] * if t > HUBER { HUBER / t } else { 1.0 };
+            }
+            fit = Self::weighted(a, r, w0, &w)?;
+        }
+        Some(fit)
+    }
+
+    /// The fit with weights `w`; `chi^2` with the readings' own weights `w0`
+    /// over the readings Huber's weights keep whole, the rest counted at the
+    /// bound (so that the spread is not read from the outliers).
+    fn weighted(
+        a: &DMatrix<Real>,
+        r: &DVector<Real>,
+        w0: &DVector<Real>,
+        w: &DVector<Real>,
+    ) -> Option<Self> {
+        let (n, k) = a.shape();
+        let aw = DMatrix::from_fn(n, k, |i, j| a[(i, j)] * w[i]);
+        let normal = a.transpose() * &aw;
+        let chol = normal.clone().cholesky()?;
+        let beta = chol.solve(&(aw.transpose() * r));
+        let res = r - a * &beta;
+        let chi2 = (0..n)
+            .map(|i| {
+                let t2 = res[i] * res[i] * w0[i];
+                if w[i] < w0[i] {
+                    // Huber's loss: linear beyond the bound.
+                    2.0 * HUBER * t2.sqrt() - HUBER * HUBER
+                } else {
+                    t2
+                }
+            })
+            .sum();
+        // The covariance of a weighted fit with the readings' deviations:
+        // (A^T W A)^-1 (A^T W W0^-1 W A) (A^T W A)^-1.
+        let inv = chol.inverse();
+        let middle = DMatrix::from_fn(k, k, |p, q| {
+            (0..n).map(|i| aw[(i, p)] * aw[(i, q)] / w0[i]).sum::<Real>()
+        });
+        Some(Self {
+            a: a.clone(),
+            beta,
+            inverse: &inv * middle * &inv,
+            chi2,
+            dof: (n - k) as Real,
+        })
+    }
+
+    /// The model selection criterion of the fit (Akaike's, `chi^2 + 2k`,
+    /// scaled by `CRITERION_PER_TERM`).
+    fn criterion(&self) -> Real {
+        self.chi2 + CRITERION_PER_TERM * self.a.ncols() as Real
+    }
+
+    /// Where a quadric field is lowest, when that lies no farther from the
+    /// readings' centroid than they do (a curved contact's closest place
+    /// between its readings).
+    fn lowest(&self, coords: &[[Real; 2]]) -> Option<[Real; 2]> {
+        if self.beta.len() != 6 {
+            return None;
+        }
+        let b = &self.beta;
+        let h = nalgebra::Matrix2::new(2.0 * b[3], b[4], b[4], 2.0 * b[5]);
+        let c = h.cholesky()?.solve(&nalgebra::Vector2::new(-b[1], -b[2]));
+        // Within the readings' reach from their centroid (a test that does
+        // not turn with the axes, which are arbitrary on a round contact).
+        let reach = coords.iter().fold(0.0, |r: Real, x| r.max(x[0].hypot(x[1])));
+        (c[0].hypot(c[1]) <= reach).then_some([c[0], c[1]])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize, gap: impl Fn(Real, Real) -> Real, s: Real) -> Vec<GapSample> {
+        (0..n * n)
+            .map(|k| {
+                let (x, y) = ((k % n) as Real * 0.01, (k / n) as Real * 0.01);
+                GapSample {
+                    at: Point3::new(x, y, 0.0),
+                    gap: gap(x, y),
+                    std: s,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_flat_contact_reads_its_pooled_gap() {
+        // 25 readings of one gap: the pooled deviation is s / 5.
+        let s = 1e-3;
+        let p = field_probability(&grid(5, |_, _| 1e-3, s)).unwrap();
+        let want = crate::probability::normal_cdf(-1e-3 / (s / 5.0));
+        assert!((p - want).abs() < 1e-9, "P {p} vs {want}");
+    }
+
+    #[test]
+    fn a_reading_far_below_the_field_reads_the_contact() {
+        let s = 1e-3;
+        let mut r = grid(5, |_, _| 5e-3, s);
+        r[12].gap = -2e-3;
+        let p = field_probability(&r).unwrap();
+        assert!((p - crate::probability::normal_cdf(2.0)).abs() < 1e-9, "P {p}");
+    }
+
+    #[test]
+    fn a_curved_contact_is_read_at_its_closest_place() {
+        // A bowl: the gap is smallest at the grid's centre (1 mm).
+        let s = 1e-4;
+        let r = grid(7, |x, y| 1e-3 + 2.0 * ((x - 0.03).powi(2) + (y - 0.03).powi(2)), s);
+        let p = field_probability(&r).unwrap();
+        assert!(p < 1e-12, "P {p}");
+        // Moved down by 1 mm, the centre touches: P near 1/2.
+        let r: Vec<GapSample> = r.iter().map(|g| GapSample { gap: g.gap - 1e-3, ..*g }).collect();
+        let p = field_probability(&r).unwrap();
+        assert!((p - 0.5).abs() < 0.05, "P {p}");
+    }
+
+    #[test]
+    fn too_few_or_exact_readings_are_not_fitted() {
+        let r = grid(1, |_, _| 1e-3, 1e-3);
+        assert!(field_probability(&r).is_none());
+        let mut r = grid(3, |_, _| 1e-3, 1e-3);
+        r[0].std = 0.0;
+        assert!(field_probability(&r).is_none());
+    }
+}
+
+#[cfg(test)]
+mod invariance {
+    use super::*;
+
+    #[test]
+    fn a_rigid_motion_and_another_order_read_the_same() {
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        let r: Vec<GapSample> = (0..40)
+            .map(|_| {
+                let (x, y) = (0.1 * rnd(), 0.1 * rnd());
+                GapSample {
+                    at: Point3::new(x, y, 0.002 * rnd()),
+                    gap: 0.5 * (x * x + y * y) + 1e-3 * rnd(),
+                    std: 1e-3 * (1.0 + rnd()),
+                }
+            })
+            .collect();
+        let p = field_probability(&r).unwrap();
+        let t = crate::math::Pose::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(0.4, 1.1, -0.7));
+        let mut moved: Vec<GapSample> = r.iter().map(|s| GapSample { at: t * s.at, ..*s }).collect();
+        moved.reverse();
+        let q = field_probability(&moved).unwrap();
+        assert!((p - q).abs() < 1e-9, "{p} vs {q}");
+    }
+}
