@@ -486,11 +486,6 @@ def plate_grid() -> tuple[Scene, dict[float, Draws]]:
     return scene, out
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="parallel plates: ECE 0.082 on these 600 draws (tolerance 0.075); P in [0.9, 1]: "
-    "mean 0.97, 84% collide (the pair's reading slightly over-confident at the extremes)",
-)
 def test_parallel_plates_p_is_calibrated(plate_draws: tuple[Scene, Draws]) -> None:
     _, d = plate_draws
     cal = calibration(d.p, d.gap < 0.0)
@@ -559,38 +554,7 @@ def test_parallel_plates_residuals_are_standard_normal(plate_draws: tuple[Scene,
 # Spheres
 
 
-#: Why the spheres fail today (readings at the elements' fixed probes, not at the
-#: closest approach), with what was measured.
-_SPHERES_XFAIL = (
-    "spheres: P is not calibrated (read at fixed probes, not at the closest approach): "
-)
-
-
-@pytest.mark.parametrize(
-    ("n", "count"),
-    [
-        pytest.param(
-            2000,
-            300,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason=_SPHERES_XFAIL + "ECE 0.115 on these 300 draws (tolerance 0.10); "
-                "P < 0.1: 13% collide, P >= 0.9: 83% collide",
-            ),
-            id="2000",
-        ),
-        pytest.param(
-            10_000,
-            240,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason=_SPHERES_XFAIL + "ECE 0.127 on these 240 draws (tolerance 0.12); "
-                "P >= 0.9: 79% collide, P in [0.8, 0.9): 52%",
-            ),
-            id="10000",
-        ),
-    ],
-)
+@pytest.mark.parametrize(("n", "count"), [(2000, 300), (10_000, 240)], ids=["2000", "10000"])
 def test_spheres_p_is_calibrated(n: int, count: int) -> None:
     # Four contacts per pair of clouds (Scene.contacts): 75 and 60 pairs.
     scene = spheres(n)

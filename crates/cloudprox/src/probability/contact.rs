@@ -80,7 +80,14 @@ pub fn contact_probability(readings: &[ElementReading]) -> Real {
     contacts.dedup();
     contacts
         .into_iter()
-        .map(|c| one_contact(readings.iter().filter(|r| r.contact == c).collect()))
+        .map(|c| {
+            one_contact(
+                &readings
+                    .iter()
+                    .filter(|r| r.contact == c)
+                    .collect::<Vec<_>>(),
+            )
+        })
         .fold(0.0, Real::max)
 }
 
@@ -112,8 +119,8 @@ const VARIATION_SDS: Real = 3.0;
 /// ([`oriented`]), one per element pair ([`pairs`]), those over a surface
 /// pooled into a gap field where their places are known
 /// ([`field_probability`]); else the most critical pair's.
-fn one_contact(readings: Vec<&ElementReading>) -> Real {
-    let oriented = oriented(&readings);
+fn one_contact(readings: &[&ElementReading]) -> Real {
+    let oriented = oriented(readings);
     let chosen = pairs(oriented.iter().collect());
     if let Some(p) = pooled(&chosen) {
         return p;

@@ -75,7 +75,9 @@ pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
         let var = (row * &fit.inverse * row.transpose())[0] * scale;
         wrong_side(g, var.max(0.0).sqrt())
     };
-    let mut p = fit.lowest(&coords).map_or(0.0, |c| at(&design(&[c], fit.beta.len())));
+    let mut p = fit
+        .lowest(&coords)
+        .map_or(0.0, |c| at(&design(&[c], fit.beta.len())));
     for i in 0..n {
         let g = (fit.a.row(i) * &fit.beta)[0];
         p = p.max(at(&fit.a.rows(i, 1).into_owned()));
@@ -91,7 +93,10 @@ pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
 /// centroid, in units of the widest spread; zero when they coincide).
 fn contact_coordinates(samples: &[GapSample]) -> Vec<[Real; 2]> {
     let n = samples.len() as Real;
-    let c = samples.iter().fold(Vector3::zeros(), |c, s| c + s.at.coords) / n;
+    let c = samples
+        .iter()
+        .fold(Vector3::zeros(), |c, s| c + s.at.coords)
+        / n;
     let m = samples.iter().fold(Matrix3::zeros(), |m, s| {
         let d = s.at.coords - c;
         m + d * d.transpose()
@@ -100,7 +105,10 @@ fn contact_coordinates(samples: &[GapSample]) -> Vec<[Real; 2]> {
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
     let scale = eig.eigenvalues[order[0]].max(0.0).sqrt();
-    let (e1, e2) = (eig.eigenvectors.column(order[0]), eig.eigenvectors.column(order[1]));
+    let (e1, e2) = (
+        eig.eigenvectors.column(order[0]),
+        eig.eigenvectors.column(order[1]),
+    );
     samples
         .iter()
         .map(|s| {
@@ -180,7 +188,9 @@ impl Fit {
         // (A^T W A)^-1 (A^T W W0^-1 W A) (A^T W A)^-1.
         let inv = chol.inverse();
         let middle = DMatrix::from_fn(k, k, |p, q| {
-            (0..n).map(|i| aw[(i, p)] * aw[(i, q)] / w0[i]).sum::<Real>()
+            (0..n)
+                .map(|i| aw[(i, p)] * aw[(i, q)] / w0[i])
+                .sum::<Real>()
         });
         Some(Self {
             a: a.clone(),
@@ -209,7 +219,9 @@ impl Fit {
         let c = h.cholesky()?.solve(&nalgebra::Vector2::new(-b[1], -b[2]));
         // Within the readings' reach from their centroid (a test that does
         // not turn with the axes, which are arbitrary on a round contact).
-        let reach = coords.iter().fold(0.0, |r: Real, x| r.max(x[0].hypot(x[1])));
+        let reach = coords
+            .iter()
+            .fold(0.0, |r: Real, x| r.max(x[0].hypot(x[1])));
         (c[0].hypot(c[1]) <= reach).then_some([c[0], c[1]])
     }
 }
@@ -246,18 +258,31 @@ mod tests {
         let mut r = grid(5, |_, _| 5e-3, s);
         r[12].gap = -2e-3;
         let p = field_probability(&r).unwrap();
-        assert!((p - crate::probability::normal_cdf(2.0)).abs() < 1e-9, "P {p}");
+        assert!(
+            (p - crate::probability::normal_cdf(2.0)).abs() < 1e-9,
+            "P {p}"
+        );
     }
 
     #[test]
     fn a_curved_contact_is_read_at_its_closest_place() {
         // A bowl: the gap is smallest at the grid's centre (1 mm).
         let s = 1e-4;
-        let r = grid(7, |x, y| 1e-3 + 2.0 * ((x - 0.03).powi(2) + (y - 0.03).powi(2)), s);
+        let r = grid(
+            7,
+            |x, y| 1e-3 + 2.0 * ((x - 0.03).powi(2) + (y - 0.03).powi(2)),
+            s,
+        );
         let p = field_probability(&r).unwrap();
         assert!(p < 1e-12, "P {p}");
         // Moved down by 1 mm, the centre touches: P near 1/2.
-        let r: Vec<GapSample> = r.iter().map(|g| GapSample { gap: g.gap - 1e-3, ..*g }).collect();
+        let r: Vec<GapSample> = r
+            .iter()
+            .map(|g| GapSample {
+                gap: g.gap - 1e-3,
+                ..*g
+            })
+            .collect();
         let p = field_probability(&r).unwrap();
         assert!((p - 0.5).abs() < 0.05, "P {p}");
     }
@@ -280,7 +305,9 @@ mod invariance {
     fn a_rigid_motion_and_another_order_read_the_same() {
         let mut state = 7u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as Real / (1u64 << 53) as Real - 0.5
         };
         let r: Vec<GapSample> = (0..40)
@@ -295,7 +322,8 @@ mod invariance {
             .collect();
         let p = field_probability(&r).unwrap();
         let t = crate::math::Pose::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(0.4, 1.1, -0.7));
-        let mut moved: Vec<GapSample> = r.iter().map(|s| GapSample { at: t * s.at, ..*s }).collect();
+        let mut moved: Vec<GapSample> =
+            r.iter().map(|s| GapSample { at: t * s.at, ..*s }).collect();
         moved.reverse();
         let q = field_probability(&moved).unwrap();
         assert!((p - q).abs() < 1e-9, "{p} vs {q}");
