@@ -5,6 +5,7 @@
 //! |---|---|
 //! | the model: links, joints, mimic joints, limits | `model.rs` |
 //! | URDF loading (`urdf-rs`), mesh URIs (`package://`, `file://`, relative) | `urdf.rs` |
+//! | SRDF `<disable_collisions>` (`quick-xml`) | `srdf.rs` |
 //! | forward kinematics, joint-space motion bounds | `kinematics.rs` |
 //! | link collision geometry: meshes, URDF primitives, samples, exact shapes | `geometry.rs` |
 //! | `collide_robot`, `collide_robot_many`, self-collision | `query.rs` |
@@ -21,6 +22,7 @@ mod kinematics;
 mod model;
 mod motion;
 mod query;
+mod srdf;
 mod urdf;
 
 pub use geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS, LINK_SAMPLING_SEED};
@@ -30,3 +32,4 @@ pub use query::{
     collide_robot, collide_robot_many, LinkCollision, RobotCollisionResult, RobotCounters,
     RobotRequest, RobotStats, SelfCollision,
 };
+pub use srdf::{parse_disabled_collisions, DisabledCollision};
