@@ -9,7 +9,7 @@ object's own frame to the world; ``None`` means identity.
 """
 
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Final, Literal, final
 
@@ -94,6 +94,10 @@ SOR_DEFAULT_K: Final[int]
 #: Default standard-deviation multiplier of :func:`statistical_outlier_removal` (the core's).
 SOR_DEFAULT_STD_RATIO: Final[float]
 _IntArray = npt.NDArray[np.int64]
+#: A robot configuration: an array of one value per entry of ``Robot.joint_names``,
+#: or a mapping from joint name to value (the joints it leaves out at their
+#: reference value: 0, or the limit nearest 0).
+_Configuration = npt.ArrayLike | Mapping[str, float]
 _SurfaceName = Literal["linear", "quadric"]
 _AggregationName = Literal["surface", "max", "union", "independent"]
 _ModelName = Literal["elements", "points"]
@@ -1732,16 +1736,23 @@ class Robot:
 
     A configuration ``q`` holds one value per independent moving joint (revolute,
     continuous, prismatic; mimic joints follow their master), in the order of
-    :attr:`joint_names`. A configuration outside the joint limits, of the wrong
+    :attr:`joint_names`; or it is a mapping from joint name to value, wherever a
+    configuration is taken (``{"panda_joint4": -1.5}``): the joints it leaves out
+    take their reference value (0, or the limit nearest 0), and a name that is not
+    in :attr:`joint_names` raises :class:`InvalidInputError` naming it. A configuration outside the joint limits, of the wrong
     length or with a NaN raises :class:`InvalidInputError` naming the joint; it is
     never clamped silently (:meth:`clamp` clamps on request).
     """
 
     @staticmethod
     def from_urdf(
-        path: str | os.PathLike[str], package_dirs: Sequence[str | os.PathLike[str]] | None = None
+        path: str | os.PathLike[str],
+        package_dirs: Sequence[str | os.PathLike[str]] | None = None,
+        srdf: str | os.PathLike[str] | None = None,
+        *,
+        srdf_string: str | None = None,
     ) -> Robot:
-        """Load a URDF file.
+        """Load a URDF file, and optionally the link pairs an SRDF disables.
 
         ``package://NAME/PATH`` mesh URIs are looked for as ``DIR/NAME/PATH`` (or
         ``DIR/PATH`` when ``DIR`` is named ``NAME``) for each of ``package_dirs``,
@@ -1751,6 +1762,31 @@ class Robot:
         become closed meshes. A missing file raises ``FileNotFoundError`` naming
         the link and the paths tried; a malformed URDF raises :class:`FormatError`
         naming the joint or link.
+
+        ``srdf`` is the path of an SRDF file (as MoveIt writes), ``srdf_string``
+        the text of one (give at most one of them): the link pairs of its
+        ``<disable_collisions link1=... link2=.../>`` entries are taken out of
+        :attr:`self_collision_pairs` and listed in :attr:`ignored_pairs`; the rest
+        of the SRDF is not read. Malformed XML, or an entry naming a link the
+        robot does not have, raises :class:`FormatError` naming the SRDF file and
+        the link.
+        """
+    @staticmethod
+    def from_urdf_string(
+        text: str,
+        package_dirs: Sequence[str | os.PathLike[str]] | None = None,
+        base_dir: str | os.PathLike[str] | None = None,
+        srdf: str | os.PathLike[str] | None = None,
+        *,
+        srdf_string: str | None = None,
+    ) -> Robot:
+        """Load a robot from URDF text, as :meth:`from_urdf` loads a file.
+
+        Relative and ``file://`` mesh paths are resolved against ``base_dir``
+        (``None``: the current folder), ``package://`` URIs in ``package_dirs``
+        and then ``base_dir``. ``srdf`` is the *path* of an SRDF file,
+        ``srdf_string`` the SRDF *text*, as in :meth:`from_urdf`. Errors name the
+        URDF ``<URDF string>`` (and an SRDF text ``<SRDF string>``).
         """
     @property
     def name(self) -> str:
@@ -1772,20 +1808,20 @@ class Robot:
         """Link pairs checked for self-collision."""
     @property
     def ignored_pairs(self) -> list[tuple[str, str]]:
-        """Link pairs never checked: adjacent, or touching at the reference configuration."""
+        """Link pairs never checked: adjacent, touching at the reference configuration, or disabled by the SRDF."""
     def link_poses(
-        self, q: npt.ArrayLike, base_pose: npt.ArrayLike | None = None
+        self, q: _Configuration, base_pose: npt.ArrayLike | None = None
     ) -> dict[str, _FloatArray]:
         """Every link's ``(4, 4)`` pose (link frame to world) at ``q``, the root at ``base_pose``."""
-    def clamp(self, q: npt.ArrayLike) -> _FloatArray:
+    def clamp(self, q: _Configuration) -> _FloatArray:
         """Return ``q`` clamped into the joint limits."""
     def link_mesh(self, link: str) -> Mesh | None:
         """Return the collision mesh of ``link`` in its own frame (``None`` without geometry)."""
-    def self_collisions(self, q: npt.ArrayLike) -> list[tuple[str, str]]:
+    def self_collisions(self, q: _Configuration) -> list[tuple[str, str]]:
         """Return the pairs of non-adjacent links whose exact meshes intersect at ``q``."""
     def self_filter(
         self,
-        q: npt.ArrayLike,
+        q: _Configuration,
         padding: float | None = None,
         base_pose: npt.ArrayLike | None = None,
     ) -> SelfFilter:
@@ -1930,7 +1966,7 @@ class MotionResult:
 
 def collide_robot(
     robot: Robot,
-    q: npt.ArrayLike,
+    q: _Configuration,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,
@@ -1969,19 +2005,19 @@ def collide_robot(
 
 def collide_robot_many(
     robot: Robot,
-    qs: npt.ArrayLike,
+    qs: npt.ArrayLike | Sequence[_Configuration],
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,
     request: CollisionRequest | None = None,
     **options: Any,
 ) -> RobotBatchResult:
-    """:func:`collide_robot` for each row of the ``(m, dof)`` array ``qs``, in parallel, GIL released."""
+    """:func:`collide_robot` for each row of the ``(m, dof)`` array ``qs`` (or each configuration of a list, arrays or joint-name mappings), in parallel, GIL released."""
 
 def check_motion(
     robot: Robot,
-    q0: npt.ArrayLike,
-    q1: npt.ArrayLike,
+    q0: _Configuration,
+    q1: _Configuration,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,

@@ -12,7 +12,7 @@ use cloudprox::robot::{
 };
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyTuple};
+use pyo3::types::{PyDict, PyList, PyMapping, PyTuple};
 
 use crate::cloud::PyPointCloud;
 use crate::convert::{check_shape, pose_from, pose_to_py, to_f64_array, vec_to_py};
@@ -101,11 +101,87 @@ fn link_side(py: Python<'_>, name: Option<&str>, spacing: Option<f64>) -> PyResu
     }
 }
 
-/// A float64 array of shape `(dof,)` as a vector (its length is checked by the core).
-fn config_from(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+/// A configuration of `robot`: a float64 array of shape `(dof,)` (its length
+/// is checked by the core), or a mapping from joint name to value, the joints
+/// it does not name at their reference value
+/// ([`Robot::reference_configuration`]).
+fn config_from(robot: &Robot, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    if let Ok(map) = obj.cast::<PyMapping>() {
+        return config_from_mapping(robot, map, what);
+    }
     let arr = to_f64_array(obj, what)?;
     check_shape(&arr, &[None], what, "(dof,)")?;
     array_data(&arr, what)
+}
+
+/// The configuration of a mapping from joint name to value (see [`config_from`]).
+fn config_from_mapping(
+    robot: &Robot,
+    map: &Bound<'_, PyMapping>,
+    what: &str,
+) -> PyResult<Vec<f64>> {
+    let py = map.py();
+    let names = robot.joint_names();
+    let mut q = robot.reference_configuration();
+    for item in map.items()?.iter() {
+        let (key, value): (Bound<'_, PyAny>, Bound<'_, PyAny>) = item.extract()?;
+        let Ok(joint) = key.extract::<String>() else {
+            let ty = key.get_type().name()?;
+            return Err(invalid_input(
+                py,
+                format!("{what}: joint names must be str, got {ty}"),
+            ));
+        };
+        let Some(i) = names.iter().position(|n| *n == joint) else {
+            return Err(invalid_input(py, unknown_joint(robot, &joint, what)));
+        };
+        q[i] = value.extract::<f64>().map_err(|_| {
+            invalid_input(
+                py,
+                format!("{what}: the value of joint '{joint}' must be a float"),
+            )
+        })?;
+    }
+    Ok(q)
+}
+
+/// The message for a joint name that is not a configuration entry.
+fn unknown_joint(robot: &Robot, joint: &str, what: &str) -> String {
+    let why = match robot.joints().iter().find(|j| j.name == joint) {
+        Some(j) if j.mimic.is_some() => "is a mimic joint (give the joint it follows)",
+        Some(_) => "is a fixed joint",
+        None => "is not a joint",
+    };
+    format!(
+        "{what}: '{joint}' {why} of robot '{}'; its configuration joints: {}",
+        robot.name(),
+        robot.joint_names().join(", ")
+    )
+}
+
+/// The configurations of `collide_robot_many`: an `(m, dof)` array, or a
+/// sequence whose rows are arrays or joint-name mappings.
+fn configs_from(robot: &Robot, obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Vec<f64>>> {
+    let rows_are_mappings = (obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>())
+        && obj
+            .try_iter()?
+            .any(|row| row.is_ok_and(|r| r.cast::<PyMapping>().is_ok()));
+    if rows_are_mappings {
+        return obj
+            .try_iter()?
+            .enumerate()
+            .map(|(i, row)| config_from(robot, &row?, &format!("{what}[{i}]")))
+            .collect();
+    }
+    let dof = robot.dof();
+    let arr = to_f64_array(obj, what)?;
+    check_shape(&arr, &[None, Some(dof)], what, &format!("(m, {dof})"))?;
+    let flat = array_data(&arr, what)?;
+    Ok(if dof == 0 {
+        vec![Vec::new(); arr.shape()[0]]
+    } else {
+        flat.chunks_exact(dof).map(<[f64]>::to_vec).collect()
+    })
 }
 
 fn array_data(arr: &Bound<'_, PyArrayDyn<f64>>, what: &str) -> PyResult<Vec<f64>> {
@@ -134,14 +210,31 @@ pub struct PyRobot {
 }
 
 /// What a robot was loaded from, to load it again after pickling: the URDF's
-/// text and name, the folder relative mesh paths are resolved against, and the
-/// `package://` folders. Mesh files are read again on unpickling.
+/// text and name, the folder relative mesh paths are resolved against, the
+/// `package://` folders, and the SRDF's text and name if one was applied. Mesh
+/// files are read again on unpickling.
 struct RobotSource {
     xml: String,
     name: String,
     base_dir: Option<PathBuf>,
     package_dirs: Vec<PathBuf>,
+    srdf: Option<(String, String)>,
 }
+
+/// The name that stands for URDF text given as a string, in errors.
+const URDF_STRING_NAME: &str = "<URDF string>";
+/// The name that stands for SRDF text given as a string, in errors.
+const SRDF_STRING_NAME: &str = "<SRDF string>";
+
+/// The pickled form of a `Robot`: the arguments of `_from_urdf_text`.
+type RobotState = (
+    String,
+    String,
+    Option<PathBuf>,
+    Vec<PathBuf>,
+    Option<String>,
+    Option<String>,
+);
 
 impl PyRobot {
     fn names(&self, pairs: &[(usize, usize)]) -> Vec<(String, String)> {
@@ -151,38 +244,118 @@ impl PyRobot {
             .map(|&(a, b)| (names[a].to_string(), names[b].to_string()))
             .collect()
     }
+
+    /// Loads the robot of `source` (the URDF, then the SRDF's pairs), with the
+    /// GIL released.
+    fn load(py: Python<'_>, source: RobotSource) -> PyResult<Self> {
+        let (robot, source) = run_detached(py, move || {
+            let s = &source;
+            let mut robot =
+                Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)?;
+            if let Some((text, name)) = &s.srdf {
+                robot.apply_srdf_str(text, name)?;
+            }
+            Ok((robot, source))
+        })?;
+        Ok(Self {
+            inner: Arc::new(robot),
+            source,
+        })
+    }
+}
+
+/// The text of a file, read with the GIL released.
+fn read_text(py: Python<'_>, path: PathBuf) -> PyResult<String> {
+    run_detached(py, move || {
+        std::fs::read_to_string(&path).map_err(|e| cloudprox::Error::io(&path, &e))
+    })
+}
+
+/// The SRDF of a load: the file `path` or the text `text` (not both), as
+/// `(text, name)`.
+fn srdf_source(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    text: Option<String>,
+) -> PyResult<Option<(String, String)>> {
+    match (path, text) {
+        (Some(_), Some(_)) => Err(invalid_input(
+            py,
+            "give the SRDF as srdf (a path) or as srdf_string (its text), not both",
+        )),
+        (Some(path), None) => {
+            let name = path.display().to_string();
+            Ok(Some((read_text(py, path)?, name)))
+        }
+        (None, Some(text)) => Ok(Some((text, SRDF_STRING_NAME.to_string()))),
+        (None, None) => Ok(None),
+    }
 }
 
 #[pymethods]
 impl PyRobot {
-    /// Loads a URDF file; `package_dirs` are searched for `package://` URIs.
+    /// Loads a URDF file; `package_dirs` are searched for `package://` URIs;
+    /// the `<disable_collisions>` pairs of the SRDF file `srdf` (or of the SRDF
+    /// text `srdf_string`) are not checked for self-collision.
     #[staticmethod]
-    #[pyo3(signature = (path, package_dirs=None))]
+    #[pyo3(signature = (path, package_dirs=None, srdf=None, *, srdf_string=None))]
     fn from_urdf(
         py: Python<'_>,
         path: PathBuf,
         package_dirs: Option<Vec<PathBuf>>,
+        srdf: Option<PathBuf>,
+        srdf_string: Option<String>,
     ) -> PyResult<Self> {
         let name = path.display().to_string();
         let base_dir = path.parent().map(std::path::Path::to_path_buf);
         // Read once: the text is parsed and kept for pickling.
-        let xml = run_detached(py, move || {
-            std::fs::read_to_string(&path).map_err(|e| cloudprox::Error::io(&path, &e))
-        })?;
-        Self::_from_urdf_text(py, xml, name, base_dir, package_dirs)
+        let xml = read_text(py, path)?;
+        let srdf = srdf_source(py, srdf, srdf_string)?;
+        Self::load(
+            py,
+            RobotSource {
+                xml,
+                name,
+                base_dir,
+                package_dirs: package_dirs.unwrap_or_default(),
+                srdf,
+            },
+        )
+    }
+
+    /// Loads a robot from URDF text; relative mesh paths are resolved against
+    /// `base_dir`, `package_dirs` searched for `package://` URIs; `srdf` (a
+    /// path) or `srdf_string` (SRDF text) as in `from_urdf`.
+    #[staticmethod]
+    #[pyo3(signature = (text, package_dirs=None, base_dir=None, srdf=None, *, srdf_string=None))]
+    fn from_urdf_string(
+        py: Python<'_>,
+        text: String,
+        package_dirs: Option<Vec<PathBuf>>,
+        base_dir: Option<PathBuf>,
+        srdf: Option<PathBuf>,
+        srdf_string: Option<String>,
+    ) -> PyResult<Self> {
+        let srdf = srdf_source(py, srdf, srdf_string)?;
+        Self::load(
+            py,
+            RobotSource {
+                xml: text,
+                name: URDF_STRING_NAME.to_string(),
+                base_dir,
+                package_dirs: package_dirs.unwrap_or_default(),
+                srdf,
+            },
+        )
     }
 
     /// Pickle support: the URDF text, its name, the folder relative mesh paths
-    /// are resolved against and the package folders; the robot is loaded again
-    /// on unpickling (its mesh files must be readable at the same paths).
-    #[allow(clippy::type_complexity)]
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(
-        Bound<'py, PyAny>,
-        (String, String, Option<PathBuf>, Vec<PathBuf>),
-    )> {
+    /// are resolved against, the package folders and the SRDF text and name;
+    /// the robot is loaded again on unpickling (its mesh files must be
+    /// readable at the same paths).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, RobotState)> {
         let s = &slf.get().source;
+        let (srdf_text, srdf_name) = s.srdf.clone().unzip();
         Ok((
             slf.getattr("_from_urdf_text")?,
             (
@@ -190,37 +363,37 @@ impl PyRobot {
                 s.name.clone(),
                 s.base_dir.clone(),
                 s.package_dirs.clone(),
+                srdf_text,
+                srdf_name,
             ),
         ))
     }
 
     /// Loads a robot from URDF text (see `__reduce__`); `name` stands for the
-    /// file in errors, relative mesh paths are resolved against `base_dir`.
+    /// file in errors, relative mesh paths are resolved against `base_dir`;
+    /// the SRDF text `srdf_text` (named `srdf_name` in errors) is applied.
     #[staticmethod]
-    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None))]
+    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None, srdf_text=None, srdf_name=None))]
     fn _from_urdf_text(
         py: Python<'_>,
         xml: String,
         name: String,
         base_dir: Option<PathBuf>,
         package_dirs: Option<Vec<PathBuf>>,
+        srdf_text: Option<String>,
+        srdf_name: Option<String>,
     ) -> PyResult<Self> {
-        let source = RobotSource {
-            xml,
-            name,
-            base_dir,
-            package_dirs: package_dirs.unwrap_or_default(),
-        };
-        let (robot, source) = run_detached(py, move || {
-            let s = &source;
-            let robot =
-                Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)?;
-            Ok((robot, source))
-        })?;
-        Ok(Self {
-            inner: Arc::new(robot),
-            source,
-        })
+        let srdf = srdf_text.map(|t| (t, srdf_name.unwrap_or_else(|| SRDF_STRING_NAME.into())));
+        Self::load(
+            py,
+            RobotSource {
+                xml,
+                name,
+                base_dir,
+                package_dirs: package_dirs.unwrap_or_default(),
+                srdf,
+            },
+        )
     }
 
     /// The robot's name.
@@ -291,7 +464,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         base_pose: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let q = config_from(q, "q")?;
+        let q = config_from(&self.inner, q, "q")?;
         let base = pose_from(py, base_pose, "base_pose")?;
         let poses = self.inner.link_poses(&q, &base).or_py(py)?;
         let d = PyDict::new(py);
@@ -307,7 +480,7 @@ impl PyRobot {
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = config_from(q, "q")?;
+        let q = config_from(&self.inner, q, "q")?;
         if q.len() != self.inner.dof() {
             return Err(invalid_input(
                 py,
@@ -339,7 +512,7 @@ impl PyRobot {
         py: Python<'_>,
         q: &Bound<'_, PyAny>,
     ) -> PyResult<Vec<(String, String)>> {
-        let q = config_from(q, "q")?;
+        let q = config_from(&self.inner, q, "q")?;
         let pairs = self.inner.self_collisions(&q).or_py(py)?;
         let pairs: Vec<(usize, usize)> = pairs.iter().map(|p| (p.link_a, p.link_b)).collect();
         Ok(self.names(&pairs))
@@ -357,7 +530,7 @@ impl PyRobot {
         base_pose: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PySelfFilter> {
         let padding = padding.unwrap_or(cloudprox::filter::SELF_FILTER_DEFAULT_PADDING);
-        let q = config_from(q, "q")?;
+        let q = config_from(&self.inner, q, "q")?;
         let base = pose_from(py, base_pose, "base_pose")?;
         let robot = Arc::clone(&self.inner);
         let f = run_detached(py, move || robot.self_filter(&q, &base, padding))?;
@@ -596,7 +769,7 @@ pub fn collide_robot(
 ) -> PyResult<PyRobotCollisionResult> {
     let robot = robot_arg(robot)?;
     let request = motion_request(py, request, options, false)?.robot;
-    let q = config_from(q, "q")?;
+    let q = config_from(&robot, q, "q")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
     let r2 = Arc::clone(&robot);
@@ -715,21 +888,7 @@ pub fn collide_robot_many(
 ) -> PyResult<PyRobotBatchResult> {
     let robot = robot_arg(robot)?;
     let request = motion_request(py, request, options, false)?.robot;
-    let arr = to_f64_array(qs, "qs")?;
-    check_shape(
-        &arr,
-        &[None, Some(robot.dof())],
-        "qs",
-        &format!("(m, {})", robot.dof()),
-    )?;
-    let flat = array_data(&arr, "qs")?;
-    let qs: Vec<Vec<f64>> = if robot.dof() == 0 {
-        vec![Vec::new(); arr.shape()[0]]
-    } else {
-        flat.chunks_exact(robot.dof())
-            .map(<[f64]>::to_vec)
-            .collect()
-    };
+    let qs = configs_from(&robot, qs, "qs")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
     let r2 = Arc::clone(&robot);
@@ -840,8 +999,8 @@ pub fn check_motion(
 ) -> PyResult<PyMotionResult> {
     let robot = robot_arg(robot)?;
     let request = motion_request(py, request, options, true)?;
-    let q0 = config_from(q0, "q0")?;
-    let q1 = config_from(q1, "q1")?;
+    let q0 = config_from(&robot, q0, "q0")?;
+    let q1 = config_from(&robot, q1, "q1")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
     let inner = run_detached(py, move || {
