@@ -328,5 +328,9 @@ def test_dict_configuration_errors(panda: cp.Robot, q: dict[object, object], mat
 
 
 def test_dict_configuration_fixed_joint_is_named(panda: cp.Robot) -> None:
-    with pytest.raises(cp.InvalidInputError, match=r"'panda_joint8' is a fixed joint"):
+    with pytest.raises(cp.InvalidInputError, match=r"^q: 'panda_joint8' is a fixed joint"):
         panda.link_poses({"panda_joint8": 0.0})
+    with pytest.raises(cp.InvalidInputError, match=r"^qs\[1\]: 'panda_joint8' is a fixed joint"):
+        cp.collide_robot_many(
+            panda, [{}, {"panda_joint8": 0.0}], cp.PointCloud(np.eye(3), sigma=0.01)
+        )

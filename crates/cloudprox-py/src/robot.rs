@@ -121,8 +121,7 @@ fn config_from_mapping(
     what: &str,
 ) -> PyResult<Vec<f64>> {
     let py = map.py();
-    let names = robot.joint_names();
-    let mut q = robot.reference_configuration();
+    let mut values = Vec::new();
     for item in map.items()?.iter() {
         let (key, value): (Bound<'_, PyAny>, Bound<'_, PyAny>) = item.extract()?;
         let Ok(joint) = key.extract::<String>() else {
@@ -132,31 +131,20 @@ fn config_from_mapping(
                 format!("{what}: joint names must be str, got {ty}"),
             ));
         };
-        let Some(i) = names.iter().position(|n| *n == joint) else {
-            return Err(invalid_input(py, unknown_joint(robot, &joint, what)));
-        };
-        q[i] = value.extract::<f64>().map_err(|_| {
+        let value = value.extract::<f64>().map_err(|_| {
             invalid_input(
                 py,
                 format!("{what}: the value of joint '{joint}' must be a float"),
             )
         })?;
+        values.push((joint, value));
     }
-    Ok(q)
-}
-
-/// The message for a joint name that is not a configuration entry.
-fn unknown_joint(robot: &Robot, joint: &str, what: &str) -> String {
-    let why = match robot.joints().iter().find(|j| j.name == joint) {
-        Some(j) if j.mimic.is_some() => "is a mimic joint (give the joint it follows)",
-        Some(_) => "is a fixed joint",
-        None => "is not a joint",
-    };
-    format!(
-        "{what}: '{joint}' {why} of robot '{}'; its configuration joints: {}",
-        robot.name(),
-        robot.joint_names().join(", ")
-    )
+    robot
+        .configuration_from_names(values.iter().map(|(n, v)| (n.as_str(), *v)))
+        .map_err(|e| match e {
+            cloudprox::Error::InvalidInput(m) => invalid_input(py, format!("{what}: {m}")),
+            other => invalid_input(py, format!("{what}: {other}")),
+        })
 }
 
 /// The configurations of `collide_robot_many`: an `(m, dof)` array, or a

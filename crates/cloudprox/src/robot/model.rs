@@ -260,8 +260,104 @@ impl Robot {
             .collect()
     }
 
+    /// The configuration that gives the named joints their values and every
+    /// other entry its reference value ([`Robot::reference_configuration`]).
+    /// Values are not checked here ([`Robot::check_configuration`] is, by every
+    /// query); a joint named twice takes its last value.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the joint for a name that is not a
+    /// configuration entry (an unknown joint, a fixed joint, a mimic joint).
+    pub fn configuration_from_names<'a>(
+        &self,
+        values: impl IntoIterator<Item = (&'a str, Real)>,
+    ) -> Result<Vec<Real>> {
+        let mut q = self.reference_configuration();
+        for (name, value) in values {
+            let entry = self
+                .dof_joints
+                .iter()
+                .position(|&j| self.joints[j].name == name)
+                .ok_or_else(|| self.not_an_entry(name))?;
+            q[entry] = value;
+        }
+        Ok(q)
+    }
+
+    /// The error of a joint name that is not a configuration entry.
+    fn not_an_entry(&self, name: &str) -> Error {
+        let why = match self.joints.iter().find(|j| j.name == name) {
+            Some(j) if j.mimic.is_some() => "is a mimic joint (give the joint it follows)",
+            Some(_) => "is a fixed joint",
+            None => "is not a joint",
+        };
+        Error::invalid(format!(
+            "'{name}' {why} of robot '{}'; its configuration joints: {}",
+            self.name,
+            self.joint_names().join(", ")
+        ))
+    }
+
     /// The reference configuration: every entry at 0, or at the limit nearest 0.
     pub fn reference_configuration(&self) -> Vec<Real> {
         self.clamp(&vec![0.0; self.dof()])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A slider limited to `[0.2, 1]`, a turn about z, a fixed tool and a
+    /// mimic joint following the turn.
+    const URDF: &str = r#"<robot name="slider">
+      <link name="base"/><link name="carriage"/><link name="arm"/><link name="tool"/><link name="twin"/>
+      <joint name="slide" type="prismatic"><parent link="base"/><child link="carriage"/>
+        <axis xyz="1 0 0"/><limit lower="0.2" upper="1.0" effort="1" velocity="1"/></joint>
+      <joint name="turn" type="continuous"><parent link="carriage"/><child link="arm"/>
+        <axis xyz="0 0 1"/></joint>
+      <joint name="weld" type="fixed"><parent link="arm"/><child link="tool"/></joint>
+      <joint name="copy" type="continuous"><parent link="carriage"/><child link="twin"/>
+        <axis xyz="0 0 1"/><mimic joint="turn" multiplier="2"/></joint>
+    </robot>"#;
+
+    fn slider() -> Robot {
+        Robot::from_urdf_str(URDF, "slider.urdf", None, &[]).unwrap()
+    }
+
+    #[test]
+    fn configuration_from_names_fills_in_the_reference() {
+        let r = slider();
+        assert_eq!(r.joint_names(), ["slide", "turn"]);
+        assert_eq!(r.configuration_from_names([]).unwrap(), [0.2, 0.0]);
+        assert_eq!(
+            r.configuration_from_names([("turn", 1.5)]).unwrap(),
+            [0.2, 1.5]
+        );
+        assert_eq!(
+            r.configuration_from_names([("turn", 1.5), ("slide", 0.5), ("turn", -1.0)])
+                .unwrap(),
+            [0.5, -1.0]
+        );
+        // Values are checked by the queries, not here.
+        let q = r.configuration_from_names([("slide", 7.0)]).unwrap();
+        assert!(r.check_configuration(&q).is_err());
+    }
+
+    #[test]
+    fn configuration_from_names_rejects_other_names() {
+        let r = slider();
+        for (name, why) in [
+            ("elbow", "is not a joint"),
+            ("weld", "is a fixed joint"),
+            ("copy", "is a mimic joint"),
+        ] {
+            let err = r.configuration_from_names([(name, 0.0)]).unwrap_err();
+            let Error::InvalidInput(msg) = &err else {
+                panic!("{err:?}")
+            };
+            assert!(msg.contains(&format!("'{name}' {why}")), "{msg}");
+            assert!(msg.contains("slide, turn"), "{msg}");
+        }
     }
 }
