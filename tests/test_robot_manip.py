@@ -334,3 +334,38 @@ def test_dict_configuration_fixed_joint_is_named(panda: cp.Robot) -> None:
         cp.collide_robot_many(
             panda, [{}, {"panda_joint8": 0.0}], cp.PointCloud(np.eye(3), sigma=0.01)
         )
+
+
+# ------------------------------------------------------------------ allowed pairs
+
+
+def test_with_allowed_collisions(panda: cp.Robot) -> None:
+    colliding = sorted(tuple(sorted(p)) for p in pair_set(panda.self_collisions(FOLDED[1])))
+    assert len(colliding) >= 3
+    allowed = [colliding[0], (colliding[1][1], colliding[1][0])]
+    robot = panda.with_allowed_collisions(allowed)
+    gone = pair_set(allowed)
+    assert pair_set(robot.self_collision_pairs) == pair_set(panda.self_collision_pairs) - gone
+    assert gone <= pair_set(robot.ignored_pairs)
+    assert pair_set(robot.self_collisions(FOLDED[1])) == pair_set(colliding) - gone
+    # The original is unchanged; the copy pickles with its pairs.
+    assert pair_set(panda.self_collisions(FOLDED[1])) == pair_set(colliding)
+    again = pickle.loads(pickle.dumps(robot))
+    assert again.self_collision_pairs == robot.self_collision_pairs
+    # Allowing more on the copy keeps the pairs allowed before.
+    more = again.with_allowed_collisions([colliding[2]])
+    assert not pair_set(more.self_collision_pairs) & (gone | {frozenset(colliding[2])})
+    assert pair_set(more.self_collisions(FOLDED[1])) == pair_set(colliding[3:])
+    far = cp.PointCloud(np.array([[5.0, 5.0, 5.0], [5.1, 5.0, 5.0], [5.0, 5.1, 5.0]]), sigma=0.002)
+    hit = cp.collide_robot(robot, FOLDED[1], far)
+    assert pair_set(hit.self_collisions) == pair_set(colliding) - gone
+
+
+def test_with_allowed_collisions_errors(panda: cp.Robot) -> None:
+    with pytest.raises(cp.InvalidInputError, match="no link named 'panda_link99'"):
+        panda.with_allowed_collisions([("panda_link1", "panda_link99")])
+    with pytest.raises(cp.InvalidInputError, match="'panda_hand' twice"):
+        panda.with_allowed_collisions([("panda_hand", "panda_hand")])
+    with pytest.raises(ValueError, match="length 2"):
+        panda.with_allowed_collisions([("panda_hand",)])  # type: ignore[list-item]
+    assert panda.with_allowed_collisions([]).self_collision_pairs == panda.self_collision_pairs

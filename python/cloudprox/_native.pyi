@@ -1809,6 +1809,16 @@ class Robot:
     @property
     def ignored_pairs(self) -> list[tuple[str, str]]:
         """Link pairs never checked: adjacent, touching at the reference configuration, or disabled by the SRDF."""
+    def with_allowed_collisions(self, pairs: Sequence[tuple[str, str]]) -> Robot:
+        """Return a copy of the robot that does not check ``pairs`` for self-collision.
+
+        Each pair names two links (either order); it leaves
+        :attr:`self_collision_pairs` and joins :attr:`ignored_pairs`, as an SRDF's
+        ``<disable_collisions>`` does (a pair already ignored changes nothing).
+        The robot itself is unchanged; the copy pickles with its allowed pairs.
+        An unknown link, or a link paired with itself, raises
+        :class:`InvalidInputError` naming it.
+        """
     def link_poses(
         self, q: _Configuration, base_pose: npt.ArrayLike | None = None
     ) -> dict[str, _FloatArray]:

@@ -207,6 +207,21 @@ struct RobotSource {
     base_dir: Option<PathBuf>,
     package_dirs: Vec<PathBuf>,
     srdf: Option<(String, String)>,
+    /// Link pairs allowed to collide (`with_allowed_collisions`), after the SRDF's.
+    allowed: Vec<(String, String)>,
+}
+
+impl RobotSource {
+    fn copy(&self) -> Self {
+        Self {
+            xml: self.xml.clone(),
+            name: self.name.clone(),
+            base_dir: self.base_dir.clone(),
+            package_dirs: self.package_dirs.clone(),
+            srdf: self.srdf.clone(),
+            allowed: self.allowed.clone(),
+        }
+    }
 }
 
 /// The name that stands for URDF text given as a string, in errors.
@@ -222,6 +237,7 @@ type RobotState = (
     Vec<PathBuf>,
     Option<String>,
     Option<String>,
+    Vec<(String, String)>,
 );
 
 impl PyRobot {
@@ -242,6 +258,9 @@ impl PyRobot {
                 Robot::from_urdf_str(&s.xml, &s.name, s.base_dir.as_deref(), &s.package_dirs)?;
             if let Some((text, name)) = &s.srdf {
                 robot.apply_srdf_str(text, name)?;
+            }
+            for (a, b) in &s.allowed {
+                robot.allow_collision(a, b)?;
             }
             Ok((robot, source))
         })?;
@@ -307,6 +326,7 @@ impl PyRobot {
                 base_dir,
                 package_dirs: package_dirs.unwrap_or_default(),
                 srdf,
+                allowed: Vec::new(),
             },
         )
     }
@@ -333,6 +353,7 @@ impl PyRobot {
                 base_dir,
                 package_dirs: package_dirs.unwrap_or_default(),
                 srdf,
+                allowed: Vec::new(),
             },
         )
     }
@@ -353,6 +374,7 @@ impl PyRobot {
                 s.package_dirs.clone(),
                 srdf_text,
                 srdf_name,
+                s.allowed.clone(),
             ),
         ))
     }
@@ -361,7 +383,7 @@ impl PyRobot {
     /// file in errors, relative mesh paths are resolved against `base_dir`;
     /// the SRDF text `srdf_text` (named `srdf_name` in errors) is applied.
     #[staticmethod]
-    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None, srdf_text=None, srdf_name=None))]
+    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None, srdf_text=None, srdf_name=None, allowed=None))]
     fn _from_urdf_text(
         py: Python<'_>,
         xml: String,
@@ -370,6 +392,7 @@ impl PyRobot {
         package_dirs: Option<Vec<PathBuf>>,
         srdf_text: Option<String>,
         srdf_name: Option<String>,
+        allowed: Option<Vec<(String, String)>>,
     ) -> PyResult<Self> {
         let srdf = srdf_text.map(|t| (t, srdf_name.unwrap_or_else(|| SRDF_STRING_NAME.into())));
         Self::load(
@@ -380,6 +403,7 @@ impl PyRobot {
                 base_dir,
                 package_dirs: package_dirs.unwrap_or_default(),
                 srdf,
+                allowed: allowed.unwrap_or_default(),
             },
         )
     }
@@ -442,6 +466,25 @@ impl PyRobot {
     #[getter]
     fn ignored_pairs(&self) -> Vec<(String, String)> {
         self.names(self.inner.ignored_pairs())
+    }
+
+    /// A copy of the robot that does not check the link pairs `pairs` (name
+    /// pairs, either order) for self-collision; they join `ignored_pairs`.
+    fn with_allowed_collisions(
+        &self,
+        py: Python<'_>,
+        pairs: Vec<(String, String)>,
+    ) -> PyResult<Self> {
+        let mut robot = (*self.inner).clone();
+        for (a, b) in &pairs {
+            robot.allow_collision(a, b).or_py(py)?;
+        }
+        let mut source = self.source.copy();
+        source.allowed.extend(pairs);
+        Ok(Self {
+            inner: Arc::new(robot),
+            source,
+        })
     }
 
     /// Every link's pose (4x4, link frame to world) at `q`, the root at `base_pose`.

@@ -143,6 +143,29 @@ pub struct Robot {
     pub(crate) samples: Mutex<Vec<(u64, Arc<LinkSamples>)>>,
 }
 
+impl Clone for Robot {
+    /// A copy of the robot, its cached link samples shared with the original
+    /// (none if a thread panicked while holding the cache: it is only a cache).
+    fn clone(&self) -> Self {
+        let samples = self
+            .samples
+            .lock()
+            .map_or_else(|_| Vec::new(), |s| s.clone());
+        Robot {
+            name: self.name.clone(),
+            links: self.links.clone(),
+            joints: self.joints.clone(),
+            root: self.root,
+            order: self.order.clone(),
+            dof_joints: self.dof_joints.clone(),
+            self_pairs: self.self_pairs.clone(),
+            ignored_pairs: self.ignored_pairs.clone(),
+            motion_weights: self.motion_weights.clone(),
+            samples: Mutex::new(samples),
+        }
+    }
+}
+
 impl Robot {
     /// The robot's name (`<robot name=...>`).
     pub fn name(&self) -> &str {

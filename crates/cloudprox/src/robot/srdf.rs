@@ -173,6 +173,30 @@ impl Robot {
         self.apply_srdf_str(&xml, &path.display().to_string())
     }
 
+    /// Takes the pair of links named `link_a` and `link_b` out of
+    /// self-collision checking, as an SRDF's `<disable_collisions>` does.
+    /// Returns whether the pair was checked before.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the link for a link the robot does not
+    /// have, or a pair of one link with itself.
+    pub fn allow_collision(&mut self, link_a: &str, link_b: &str) -> Result<bool> {
+        let find = |link: &str| {
+            self.link_index(link).ok_or_else(|| {
+                Error::invalid(format!("robot '{}' has no link named '{link}'", self.name))
+            })
+        };
+        let (a, b) = (find(link_a)?, find(link_b)?);
+        if a == b {
+            return Err(Error::invalid(format!(
+                "an allowed collision is a pair of two links, got '{link_a}' twice"
+            )));
+        }
+        let before = self.self_pairs.len();
+        self.disable_pair(a, b);
+        Ok(self.self_pairs.len() < before)
+    }
+
     /// Moves the pair of links `a` and `b` (indices, either order) from the
     /// checked self-collision pairs to the ignored ones; no change if the pair
     /// is not checked.
@@ -345,6 +369,26 @@ mod tests {
             };
             assert_eq!((path.as_str(), format.as_str()), ("bad.srdf", "SRDF"));
             assert!(problem.contains(needle), "{xml}: {problem}");
+        }
+    }
+
+    #[test]
+    fn srdf_allow_collision_by_name() {
+        let mut r = chain();
+        assert!(r.allow_collision("d", "a").unwrap());
+        assert!(!r.allow_collision("a", "d").unwrap());
+        assert!(!r.allow_collision("a", "b").unwrap()); // adjacent: already ignored
+        assert_eq!(
+            pair_names(&r, r.self_collision_pairs()),
+            names(&[("a", "c"), ("b", "d")])
+        );
+        assert!(pair_names(&r, r.ignored_pairs()).contains(&("a".into(), "d".into())));
+        for (x, y, needle) in [("a", "zz", "'zz'"), ("c", "c", "'c' twice")] {
+            let err = r.allow_collision(x, y).unwrap_err();
+            let Error::InvalidInput(msg) = &err else {
+                panic!("{err:?}")
+            };
+            assert!(msg.contains(needle), "{msg}");
         }
     }
 
