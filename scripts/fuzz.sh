@@ -9,12 +9,12 @@
 #   --max-len B    largest input of the file readers in bytes (default 65536,
 #                  LAS/LAZ at most 10240; real seeds larger than this are left
 #                  out); the structured targets (pointcloud2, collide, exact)
-#                  take 4096, urdf 65536
+#                  take 4096, urdf and srdf 65536
 #   --reuse-seeds  keep fuzz/seeds from an earlier run (no cargo test build)
 #   --asan         build with the address sanitizer (about 3x slower; the
 #                  default is no sanitizer: the code is safe Rust, and the
 #                  targets abort on any single allocation above 512 MiB)
-#   TARGET...      some of: ply pcd las stl obj off npy xyz pointcloud2 urdf
+#   TARGET...      some of: ply pcd las stl obj off npy xyz pointcloud2 urdf srdf
 #                  collide exact (default: all)
 #
 # Each target's corpus (fuzz/corpus/<target>, not committed) starts from seeds
@@ -46,7 +46,7 @@ while [ $# -gt 0 ]; do
         *) targets+=("$1"); shift ;;
     esac
 done
-all=(ply pcd las stl obj off npy xyz pointcloud2 urdf collide exact)
+all=(ply pcd las stl obj off npy xyz pointcloud2 urdf srdf collide exact)
 [ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 
 command -v cargo-fuzz >/dev/null || { echo "cargo-fuzz is missing: cargo install cargo-fuzz" >&2; exit 1; }
@@ -71,7 +71,7 @@ for t in "${targets[@]}"; do
     len=$max_len
     case "$t" in
         collide|exact|pointcloud2) len=4096 ;;
-        urdf) len=65536 ;;
+        urdf | srdf) len=65536 ;;
         # LAZ decoding is slow: 10 KiB keeps the small LAS 1.4 and LAZ seeds whole.
         las) len=$(( max_len < 10240 ? max_len : 10240 )) ;;
     esac

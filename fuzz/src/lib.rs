@@ -78,7 +78,7 @@ fn check_size(size: usize) {
 static ALLOCATOR: CappedAllocator = CappedAllocator;
 
 /// The names of the fuzz targets, in the order `scripts/fuzz.sh` runs them.
-pub const TARGETS: [&str; 13] = [
+pub const TARGETS: [&str; 14] = [
     "ply",
     "pcd",
     "las",
@@ -90,6 +90,7 @@ pub const TARGETS: [&str; 13] = [
     "pointcloud2",
     "pointcloud2_message",
     "urdf",
+    "srdf",
     "collide",
     "exact",
 ];
@@ -109,6 +110,7 @@ pub fn run(name: &str, data: &[u8]) -> bool {
         "pointcloud2" => pointcloud2(data),
         "pointcloud2_message" => pointcloud2_message(data),
         "urdf" => urdf(data),
+        "srdf" => srdf(data),
         "collide" => collide(data),
         "exact" => exact(data),
         _ => return false,
@@ -339,6 +341,29 @@ pub fn urdf(data: &[u8]) {
         return;
     };
     let _ = Robot::from_urdf_str(text, "fuzz.urdf", None, &[]);
+}
+
+/// SRDF text applied to the robot of [`URDF_SEED`]: an error or a robot
+/// whose checked and ignored pairs are, together, the pairs they were.
+pub fn srdf(data: &[u8]) {
+    static SEED_ROBOT: std::sync::OnceLock<Robot> = std::sync::OnceLock::new();
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let seed = SEED_ROBOT.get_or_init(|| {
+        Robot::from_urdf_str(URDF_SEED, "seed.urdf", None, &[]).expect("the seed URDF loads")
+    });
+    let mut robot = seed.clone();
+    if robot.apply_srdf_str(text, "fuzz.srdf").is_ok() {
+        let pairs = |r: &Robot| {
+            let mut all = [r.self_collision_pairs(), r.ignored_pairs()].concat();
+            all.sort_unstable();
+            all
+        };
+        assert_eq!(pairs(&robot), pairs(seed));
+    } else {
+        assert_eq!(robot.self_collision_pairs(), seed.self_collision_pairs());
+    }
 }
 
 /// A number: mostly small decimals, sometimes any `f64` (NaN, infinities,
@@ -922,6 +947,7 @@ pub fn synthetic_seeds(target: &str) -> Vec<Vec<u8>> {
             }
         }
         "urdf" => out.push(URDF_SEED.as_bytes().to_vec()),
+        "srdf" => out.push(SRDF_SEED.as_bytes().to_vec()),
         _ => {}
     }
     // Structured targets: a few byte patterns give whole inputs.
@@ -960,6 +986,15 @@ fn encode_pc2(layout: &pointcloud2::PointCloud2Layout, data: &[u8]) -> Vec<u8> {
     b.extend(data);
     b
 }
+
+/// A small SRDF for [`URDF_SEED`]: a group and two `<disable_collisions>`.
+pub const SRDF_SEED: &str = r#"<?xml version="1.0"?>
+<robot name="seed">
+  <group name="arm"><chain base_link="base" tip_link="tip"/></group>
+  <disable_collisions link1="base" link2="arm" reason="Adjacent"/>
+  <disable_collisions link1="arm" link2="tip" reason="Never"></disable_collisions>
+</robot>
+"#;
 
 /// A small URDF: two links, a revolute joint, box, sphere and cylinder shapes.
 pub const URDF_SEED: &str = r#"<?xml version="1.0"?>
