@@ -201,6 +201,7 @@ pub struct PyRobot {
 /// text and name, the folder relative mesh paths are resolved against, the
 /// `package://` folders, and the SRDF's text and name if one was applied. Mesh
 /// files are read again on unpickling.
+#[derive(Clone)]
 struct RobotSource {
     xml: String,
     name: String,
@@ -212,14 +213,22 @@ struct RobotSource {
 }
 
 impl RobotSource {
-    fn copy(&self) -> Self {
+    /// The source of a robot loaded from `xml` (named `name` in errors), no
+    /// pairs allowed beyond the SRDF's.
+    fn new(
+        xml: String,
+        name: String,
+        base_dir: Option<PathBuf>,
+        package_dirs: Option<Vec<PathBuf>>,
+        srdf: Option<(String, String)>,
+    ) -> Self {
         Self {
-            xml: self.xml.clone(),
-            name: self.name.clone(),
-            base_dir: self.base_dir.clone(),
-            package_dirs: self.package_dirs.clone(),
-            srdf: self.srdf.clone(),
-            allowed: self.allowed.clone(),
+            xml,
+            name,
+            base_dir,
+            package_dirs: package_dirs.unwrap_or_default(),
+            srdf,
+            allowed: Vec::new(),
         }
     }
 }
@@ -320,14 +329,7 @@ impl PyRobot {
         let srdf = srdf_source(py, srdf, srdf_string)?;
         Self::load(
             py,
-            RobotSource {
-                xml,
-                name,
-                base_dir,
-                package_dirs: package_dirs.unwrap_or_default(),
-                srdf,
-                allowed: Vec::new(),
-            },
+            RobotSource::new(xml, name, base_dir, package_dirs, srdf),
         )
     }
 
@@ -345,16 +347,10 @@ impl PyRobot {
         srdf_string: Option<String>,
     ) -> PyResult<Self> {
         let srdf = srdf_source(py, srdf, srdf_string)?;
+        let name = URDF_STRING_NAME.to_string();
         Self::load(
             py,
-            RobotSource {
-                xml: text,
-                name: URDF_STRING_NAME.to_string(),
-                base_dir,
-                package_dirs: package_dirs.unwrap_or_default(),
-                srdf,
-                allowed: Vec::new(),
-            },
+            RobotSource::new(text, name, base_dir, package_dirs, srdf),
         )
     }
 
@@ -395,17 +391,11 @@ impl PyRobot {
         allowed: Option<Vec<(String, String)>>,
     ) -> PyResult<Self> {
         let srdf = srdf_text.map(|t| (t, srdf_name.unwrap_or_else(|| SRDF_STRING_NAME.into())));
-        Self::load(
-            py,
-            RobotSource {
-                xml,
-                name,
-                base_dir,
-                package_dirs: package_dirs.unwrap_or_default(),
-                srdf,
-                allowed: allowed.unwrap_or_default(),
-            },
-        )
+        let source = RobotSource {
+            allowed: allowed.unwrap_or_default(),
+            ..RobotSource::new(xml, name, base_dir, package_dirs, srdf)
+        };
+        Self::load(py, source)
     }
 
     /// The robot's name.
@@ -479,7 +469,7 @@ impl PyRobot {
         for (a, b) in &pairs {
             robot.allow_collision(a, b).or_py(py)?;
         }
-        let mut source = self.source.copy();
+        let mut source = self.source.clone();
         source.allowed.extend(pairs);
         Ok(Self {
             inner: Arc::new(robot),

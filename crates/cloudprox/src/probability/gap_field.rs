@@ -3,6 +3,7 @@
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
+use crate::element::height_row;
 use crate::math::{Matrix3, Point3, Vector3};
 use crate::probability::gaussian::wrong_side;
 use crate::Real;
@@ -70,17 +71,18 @@ pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
         .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
         .min_by(|a, b| a.criterion().total_cmp(&b.criterion()))?;
     let scale = (fit.chi2 / fit.dof).max(1.0);
+    // The field's gap at a design row and the probability it is crossed there.
     let at = |row: &DMatrix<Real>| {
         let g = (row * &fit.beta)[0];
         let var = (row * &fit.inverse * row.transpose())[0] * scale;
-        wrong_side(g, var.max(0.0).sqrt())
+        (g, wrong_side(g, var.max(0.0).sqrt()))
     };
     let mut p = fit
         .lowest(&coords)
-        .map_or(0.0, |c| at(&design(&[c], fit.beta.len())));
+        .map_or(0.0, |c| at(&design(&[c], fit.beta.len())).1);
     for i in 0..n {
-        let g = (fit.a.row(i) * &fit.beta)[0];
-        p = p.max(at(&fit.a.rows(i, 1).into_owned()));
+        let (g, p_field) = at(&fit.a.rows(i, 1).into_owned());
+        p = p.max(p_field);
         let s = samples[i].std;
         if (r[i] - g) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
             p = p.max(wrong_side(r[i], s));
@@ -126,7 +128,7 @@ fn contact_coordinates(samples: &[GapSample]) -> Vec<[Real; 2]> {
 fn design(coords: &[[Real; 2]], k: usize) -> DMatrix<Real> {
     DMatrix::from_fn(coords.len(), k, |i, j| {
         let [u, v] = coords[i];
-        [1.0, u, v, u * u, u * v, v * v][j]
+        height_row(u, v)[j]
     })
 }
 
@@ -170,7 +172,7 @@ impl Fit {
         let (n, k) = a.shape();
         let aw = DMatrix::from_fn(n, k, |i, j| a[(i, j)] * w[i]);
         let normal = a.transpose() * &aw;
-        let chol = normal.clone().cholesky()?;
+        let chol = normal.cholesky()?;
         let beta = chol.solve(&(aw.transpose() * r));
         let res = r - a * &beta;
         let chi2 = (0..n)
