@@ -35,7 +35,8 @@ in the level's sigma, to see what the noise costs against what the sampling
 does; ``--bounds``: per row, the near-contact AUC the same scores reach with
 every pose beyond 1 and beyond 0.5 pair sigma of contact ranked perfectly).
 ``--residuals``: the elements' standardized residuals ``(g_true - gap) / std``
-at facing pairs near contact against the exact meshes, by level (mean 0 and
+at facing pairs near contact against the exact meshes, by level, by the
+probe's distance to its element's edge and by element size (mean 0 and
 spread 1 when the gaps and their variances are right; bias and
 over-confidence show as either off). ``--reliability``: per row, the
 reliability table behind its ECE (ECE, Brier score, log-loss and the worst bin
@@ -121,12 +122,13 @@ def residuals(
     is that point's signed distance to the other exact mesh; the residual is
     ``(g_true - gap) / std``, standard normal if the gaps and their variances
     are right. Also returned: whether the probe lies beside the other element,
-    and the element's size in units of its probe's own standard deviation.
+    the probe's distance to its own element's edge and its element's size
+    (both in the element's sampling spacings; 0 for a single point).
     """
     a = cp.PointCloud(draw.piano_points, cov=draw.piano_sensor_cov)
     b = cp.PointCloud(draw.room_points, cov=draw.room_sensor_cov)
     da, db = cp.MeshDistance(ma), cp.MeshDistance(mb)
-    out: dict[str, list[np.ndarray]] = {"z": [], "beside": [], "from_a": []}
+    out: dict[str, list[np.ndarray]] = {"z": [], "beside": [], "from_a": [], "edge": [], "size": []}
     for pose in q[np.abs(dist) <= reach]:
         f = cp._native.facing_pairs(a, b, pose_a=pose)
         if len(f["gap"]) == 0:
@@ -146,6 +148,8 @@ def residuals(
         out["z"].append(((g_true - np.asarray(f["gap"])) / np.asarray(f["std"]))[at])
         out["beside"].append(np.asarray(f["beside"])[at])
         out["from_a"].append(from_a[at])
+        out["edge"].append(np.asarray(f["probe_edge"])[at])
+        out["size"].append(np.asarray(f["size"])[at])
     return {k: np.concatenate(v) if v else np.zeros(0) for k, v in out.items()}
 
 
@@ -447,6 +451,29 @@ def main() -> None:
             f"| {level:.1%} | {len(z)} | {np.mean(z):+.2f} | {np.std(z):.2f} | "
             f"{cell(z[~bs])} | {cell(z[bs])} |"
         )
+    if resid:
+        print(
+            "\n| level | residual mean, sd (pairs) by the probe's distance to its element's edge "
+            "(spacings): single points | < 0.5 | 0.5-1 | 1-2 | >= 2 | by element size "
+            "(spacings): < 3 | 3-10 | >= 10 |\n|---|---|---|---|---|---|---|---|---|"
+        )
+    for level, parts in resid.items():
+        z, edge, size = (np.concatenate(parts[k]) for k in ("z", "edge", "size"))
+        point = size <= 0.0
+
+        def cell(mask: np.ndarray, z: np.ndarray = z) -> str:
+            x = z[mask]
+            return f"{np.mean(x):+.2f}, {np.std(x):.2f} ({len(x)})" if len(x) else "-"
+
+        by_edge = [cell(point)] + [
+            cell(~point & (edge >= lo) & (edge < hi))
+            for lo, hi in ((0.0, 0.5), (0.5, 1.0), (1.0, 2.0), (2.0, np.inf))
+        ]
+        by_size = [
+            cell(~point & (size >= lo) & (size < hi))
+            for lo, hi in ((0.0, 3.0), (3.0, 10.0), (10.0, np.inf))
+        ]
+        print(f"| {level:.1%} | " + " | ".join(by_edge + by_size) + " |")
     if reliability:
         print()
         print("\n".join(reliability))
