@@ -130,10 +130,10 @@ fn one_contact(readings: &[&ElementReading]) -> Real {
 
 /// The first of `chosen` (one reading per element pair) by `key`, those over
 /// a surface before those beside it, ties broken by the element pair.
-fn first_by<'a>(
-    chosen: Vec<&'a ElementReading>,
+fn first_by(
+    chosen: Vec<&ElementReading>,
     key: fn(&ElementReading) -> Real,
-) -> Option<&'a ElementReading> {
+) -> Option<&ElementReading> {
     chosen.into_iter().min_by(|x, y| {
         x.beside
             .cmp(&y.beside)
