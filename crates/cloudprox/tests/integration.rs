@@ -18,6 +18,7 @@ mod collide_hierarchy_brute_force;
 mod collide_mesh_cloud;
 mod collide_segmentations;
 mod determinism;
+mod distance;
 mod exact_side;
 mod exact_time_of_impact;
 mod filter_bad_input;

@@ -2,7 +2,7 @@
 //! gaps that their facing surface elements read there.
 
 use crate::math::{Point3, Vector3};
-use crate::probability::gap_field::{field_probability, GapSample};
+use crate::probability::gap_field::{field_minimum, field_probability, GapSample};
 use crate::probability::gaussian::wrong_side;
 use crate::Real;
 
@@ -125,15 +125,49 @@ fn one_contact(readings: &[&ElementReading]) -> Real {
     if let Some(p) = pooled(&chosen) {
         return p;
     }
-    chosen
+    first_by(chosen, z).map_or(0.0, |r| wrong_side(r.gap, r.std))
+}
+
+/// The first of `chosen` (one reading per element pair) by `key`, those over
+/// a surface before those beside it, ties broken by the element pair.
+fn first_by(
+    chosen: Vec<&ElementReading>,
+    key: fn(&ElementReading) -> Real,
+) -> Option<&ElementReading> {
+    chosen.into_iter().min_by(|x, y| {
+        x.beside
+            .cmp(&y.beside)
+            .then(key(x).total_cmp(&key(y)))
+            .then(pair_key(x).cmp(&pair_key(y)))
+    })
+}
+
+/// Where the surfaces come closest, as [`contact_probability`] reads them:
+/// per contact (turned to its one orientation, one reading per element
+/// pair), the smallest term of its pooled gap field where it pools them (and
+/// `pool` asks for it), else its nearest reading ([`nearest_of`]); over the contacts, the smallest gap,
+/// those over a surface before those beside it. `None` without readings.
+///
+/// The gap and standard deviation are one of the terms whose largest
+/// `Phi(-gap / std)` [`contact_probability`] is, so that is at least
+/// `Phi(-gap / std)` of this reading; where a contact's readings are one
+/// element pair, the two are equal.
+pub(crate) fn nearest_reading(readings: &[ElementReading], pool: bool) -> Option<ElementReading> {
+    let mut contacts: Vec<u32> = readings.iter().map(|r| r.contact).collect();
+    contacts.sort_unstable();
+    contacts.dedup();
+    contacts
         .into_iter()
+        .filter_map(|c| {
+            let of: Vec<&ElementReading> = readings.iter().filter(|r| r.contact == c).collect();
+            contact_nearest(&of, pool)
+        })
         .min_by(|x, y| {
             x.beside
                 .cmp(&y.beside)
-                .then(z(x).total_cmp(&z(y)))
+                .then(x.gap.total_cmp(&y.gap))
                 .then(pair_key(x).cmp(&pair_key(y)))
         })
-        .map_or(0.0, |r| wrong_side(r.gap, r.std))
 }
 
 /// The readings over a surface among `chosen` (one per element pair) pooled
@@ -141,6 +175,15 @@ fn one_contact(readings: &[&ElementReading]) -> Real {
 /// does not depend on which side is A; `None` without three of them or
 /// where one's place is unknown.
 fn pooled(chosen: &[&ElementReading]) -> Option<Real> {
+    field_probability(&pooled_samples(chosen)?.1)
+}
+
+/// The readings over a surface among `chosen`, in an order that does not
+/// depend on which side is A, and their places and gaps as the gap field
+/// reads them; `None` where one's place is unknown.
+fn pooled_samples<'a>(
+    chosen: &[&'a ElementReading],
+) -> Option<(Vec<&'a ElementReading>, Vec<GapSample>)> {
     let mut over: Vec<&ElementReading> = chosen.iter().copied().filter(|r| !r.beside).collect();
     over.sort_by(|x, y| {
         pair_key(x)
@@ -158,7 +201,46 @@ fn pooled(chosen: &[&ElementReading]) -> Option<Real> {
             })
         })
         .collect::<Option<Vec<_>>>()?;
-    field_probability(&samples)
+    Some((over, samples))
+}
+
+/// The nearest place of one contact's readings: the pooled gap field's
+/// smallest term ([`field_minimum`]) where the readings are pooled (the
+/// reading nearest it, with the field's gap and standard deviation), else
+/// (or without `pool`) its nearest reading ([`nearest_of`]).
+fn contact_nearest(readings: &[&ElementReading], pool: bool) -> Option<ElementReading> {
+    let oriented = oriented(readings);
+    let chosen = pairs(oriented.iter().collect());
+    let pooled = pool.then(|| pooled_samples(&chosen)).flatten();
+    let field = pooled.and_then(|(over, samples)| {
+        let t = field_minimum(&samples)?;
+        Some(ElementReading {
+            gap: t.gap,
+            std: t.std,
+            ..*over[t.sample]
+        })
+    });
+    field.or_else(|| nearest_of(&chosen).copied())
+}
+
+/// The nearest of `chosen` (one reading per element pair): among those over
+/// a surface (beside, where none is), the most precise of the readings whose
+/// gap lies within `VARIATION_SDS` standard deviations of the two fits of
+/// the smallest gap, as [`pair_reading`] reads one pair's readings: the
+/// smallest of many noisy gaps is biased towards the surfaces (a small,
+/// noisy element's reading most of all), and a reading as near within the
+/// noise reads the gap where the fits are best.
+fn nearest_of<'a>(chosen: &[&'a ElementReading]) -> Option<&'a ElementReading> {
+    let over = chosen.iter().any(|r| !r.beside);
+    let kept: Vec<&ElementReading> = chosen
+        .iter()
+        .copied()
+        .filter(|r| !over || !r.beside)
+        .collect();
+    let nearest = first_by(kept.clone(), |r| r.gap)?;
+    kept.into_iter()
+        .filter(|r| r.gap - nearest.gap <= VARIATION_SDS * r.fit_std.hypot(nearest.fit_std))
+        .min_by(|x, y| x.std.total_cmp(&y.std).then(pair_key(x).cmp(&pair_key(y))))
 }
 
 /// The readings with the contact's one orientation: a reading over a surface

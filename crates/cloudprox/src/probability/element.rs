@@ -11,6 +11,11 @@ use crate::Real;
 /// Elements of the other side tried as the facing one (the nearest by mean).
 const FACING_CANDIDATES: usize = 6;
 
+mod nearest;
+pub(crate) use nearest::{
+    nearest_surface_pair, surface_pair_bound, surface_pair_readings, surface_point_near, ElementGap,
+};
+
 /// One side's elements of a patch, posed in the separator's frame.
 pub(crate) struct ElementSide<'a> {
     /// The elements and their hulls.
@@ -617,9 +622,27 @@ fn read_pair(
     }
     // From A towards B: f decreases from A's side to B's.
     let u_sep = g / (-gn);
-    let (u, steep) = pair_direction(&po[f.own], &pt[f.other], f.key.0, &u_sep);
+    Some(PairReading {
+        gradient_norm: gn,
+        ..read_oriented(f, (&po[f.own], &pt[f.other]), &u_sep, label, reach_sds)
+    })
+}
+
+/// The reading of the facing pair `f` of `own_e` (the probe's element) and
+/// `other_e` with the order of the two surfaces given by `u_sep`, a unit
+/// vector from A towards B (the separating surface's normal at the pair in a
+/// query; see [`pair_direction`]): the one formula of a pair's gap and its
+/// standard deviation, which the crossing probabilities and the distance
+/// query ([`nearest`]) both read. `gradient_norm` is left at 1.
+fn read_oriented(
+    f: &Facing,
+    (own_e, other_e): (&Posed<'_>, &Posed<'_>),
+    u_sep: &Vector3,
+    label: Real,
+    reach_sds: Real,
+) -> PairReading {
+    let (u, steep) = pair_direction(own_e, other_e, f.key.0, u_sep);
     let gap = label * (f.y - f.x).dot(&u);
-    let (own_e, other_e) = (&po[f.own], &pt[f.other]);
     // Where the probe lies over the other element, the gap is measured
     // across that element's surface (along its normal), and where the
     // probe's own sampled surface ends is uncertain along it; the other
@@ -639,7 +662,7 @@ fn read_pair(
     let sd = (fit + edges).max(0.0).sqrt();
     let span = (f.y - f.x).norm();
     let reach = f.allowed + reach_sds * sd;
-    Some(PairReading {
+    PairReading {
         direction: u,
         gap,
         std: sd,
@@ -647,9 +670,9 @@ fn read_pair(
         probability: wrong_side(gap, sd),
         within_reach: span <= reach,
         steep,
-        gradient_norm: gn,
+        gradient_norm: 1.0,
         span_limit: span + reach,
-    })
+    }
 }
 
 /// One facing pair of a patch's element surfaces, as the elements model reads

@@ -58,6 +58,42 @@ const HUBER: Real = 2.0;
 /// their noise, not the gap (at touching it reads `P` near 1, where the
 /// field reads 1/2).
 pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
+    let terms = field_terms(samples)?;
+    Some(
+        terms
+            .iter()
+            .map(|t| wrong_side(t.gap, t.std))
+            .fold(0.0, Real::max),
+    )
+}
+
+/// The gap and standard deviation at one place the pooled field is read
+/// ([`field_terms`]), and the reading nearest that place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FieldTerm {
+    /// The gap there.
+    pub gap: Real,
+    /// Its standard deviation.
+    pub std: Real,
+    /// The index of the sample nearest the place (the sample itself where
+    /// the term is a sample's place or the sample read on its own).
+    pub sample: usize,
+}
+
+/// The term of the pooled field with the smallest gap ([`field_terms`]):
+/// where the fitted gap field (or a reading read on its own) says the two
+/// surfaces come closest; its `Phi(-gap / std)` is one of the terms whose
+/// largest [`field_probability`] is. `None` as [`field_probability`].
+pub(crate) fn field_minimum(samples: &[GapSample]) -> Option<FieldTerm> {
+    field_terms(samples)?
+        .into_iter()
+        .min_by(|x, y| x.gap.total_cmp(&y.gap))
+}
+
+/// Every place [`field_probability`] reads: the fitted field where a
+/// quadric field is lowest, at each reading's place, and each reading that
+/// is read on its own; `None` without a fit.
+fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
     let n = samples.len();
     if n < 3 || samples.iter().any(|s| !(s.std > 0.0 && s.std.is_finite())) {
         return None;
@@ -71,24 +107,39 @@ pub(crate) fn field_probability(samples: &[GapSample]) -> Option<Real> {
         .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
         .min_by(|a, b| a.criterion().total_cmp(&b.criterion()))?;
     let scale = (fit.chi2 / fit.dof).max(1.0);
-    // The field's gap at a design row and the probability it is crossed there.
-    let at = |row: &DMatrix<Real>| {
+    // The field's gap at a design row and its standard deviation.
+    let at = |row: &DMatrix<Real>, sample: usize| {
         let g = (row * &fit.beta)[0];
         let var = (row * &fit.inverse * row.transpose())[0] * scale;
-        (g, wrong_side(g, var.max(0.0).sqrt()))
-    };
-    let mut p = fit
-        .lowest(&coords)
-        .map_or(0.0, |c| at(&design(&[c], fit.beta.len())).1);
-    for i in 0..n {
-        let (g, p_field) = at(&fit.a.rows(i, 1).into_owned());
-        p = p.max(p_field);
-        let s = samples[i].std;
-        if (r[i] - g) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
-            p = p.max(wrong_side(r[i], s));
+        FieldTerm {
+            gap: g,
+            std: var.max(0.0).sqrt(),
+            sample,
         }
+    };
+    let mut terms = Vec::with_capacity(n + 1);
+    if let Some(c) = fit.lowest(&coords) {
+        let nearest = (0..n)
+            .min_by(|&i, &j| {
+                let d = |k: usize| (coords[k][0] - c[0]).hypot(coords[k][1] - c[1]);
+                d(i).total_cmp(&d(j))
+            })
+            .unwrap_or(0);
+        terms.push(at(&design(&[c], fit.beta.len()), nearest));
     }
-    Some(p)
+    for i in 0..n {
+        let field = at(&fit.a.rows(i, 1).into_owned(), i);
+        let s = samples[i].std;
+        if (r[i] - field.gap) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
+            terms.push(FieldTerm {
+                gap: r[i],
+                std: s,
+                sample: i,
+            });
+        }
+        terms.push(field);
+    }
+    Some(terms)
 }
 
 /// The readings' places in the contact's two widest directions (about their

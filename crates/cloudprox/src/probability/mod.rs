@@ -20,14 +20,17 @@ mod state;
 
 pub(crate) use aggregation::NEIGHBOURHOOD;
 pub use aggregation::{surface_probability, Aggregation};
+pub(crate) use contact::nearest_reading;
 pub use contact::{contact_probability, ElementReading};
 pub use crossing::crossing_probabilities;
 pub(crate) use crossing::{crossing_probabilities_in, CrossingSide};
 pub use element::FacingPair;
 pub(crate) use element::{
     element_crossing_probabilities, element_facing_pairs, element_pair_crosses,
-    element_pair_within_reach, elements_within_reach, ElementSide,
+    element_pair_within_reach, elements_within_reach, nearest_surface_pair, surface_pair_bound,
+    surface_pair_readings, surface_point_near, ElementGap, ElementSide,
 };
+pub(crate) use gaussian::wrong_side;
 pub use gaussian::{normal_cdf, normal_quantile};
 pub use point::point_probability;
 pub use state::{CollisionState, Thresholds};

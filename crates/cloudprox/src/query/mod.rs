@@ -6,8 +6,13 @@
 //! first, each before its object: `collide(pose_a, a, pose_b, b, request)`.
 
 pub mod collide;
+pub mod distance;
 pub mod exact;
 pub mod exact_side;
+
+pub use distance::{
+    distance, distance_cloud_exact, distance_exact_cloud, DistanceRequest, DistanceResult,
+};
 
 pub use collide::{
     collide, collide_along, collide_many, collide_mesh_cloud, facing_pairs, prepare,

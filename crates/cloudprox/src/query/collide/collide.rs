@@ -87,7 +87,9 @@ pub(crate) fn collide_with_workspace(
     let k = request.segmentations;
     let per_point = !request.decide_only;
     if request.model != QueryModel::Elements || k <= 1 {
-        return collide_segmentation(pose_a, a, pose_b, b, request, workspace, warm, 0, per_point);
+        return collide_segmentation(
+            pose_a, a, pose_b, b, request, workspace, warm, 0, per_point, None,
+        );
     }
     // The mean over segmentations (see `CollisionRequest::segmentations`):
     // each run's whole `P`, so deciding only, no early stop (and no per-point
@@ -114,21 +116,25 @@ pub(crate) fn collide_with_workspace(
         for s in 0..k {
             let w = if s == 0 { warm.as_deref_mut() } else { None };
             runs.push(collide_segmentation(
-                pose_a, a, pose_b, b, &each, workspace, w, s, per_point,
+                pose_a, a, pose_b, b, &each, workspace, w, s, per_point, None,
             )?);
         }
     } else {
         prepare(a, request);
         prepare(b, request);
         let (first, rest) = rayon::join(
-            || collide_segmentation(pose_a, a, pose_b, b, &each, workspace, warm, 0, per_point),
+            || {
+                collide_segmentation(
+                    pose_a, a, pose_b, b, &each, workspace, warm, 0, per_point, None,
+                )
+            },
             || {
                 (1..k)
                     .into_par_iter()
                     .map(|s| {
                         let mut own = BvhWorkspace::default();
                         collide_segmentation(
-                            pose_a, a, pose_b, b, &each, &mut own, None, s, per_point,
+                            pose_a, a, pose_b, b, &each, &mut own, None, s, per_point, None,
                         )
                     })
                     .collect::<Result<Vec<_>>>()
@@ -165,6 +171,40 @@ pub(crate) fn collide_with_workspace(
     })
 }
 
+/// The full query of one segmentation (the clouds' own, `request`'s
+/// `segmentations` and `decide_only` not read) and every facing pair's
+/// reading within reach that its `P` read, in `b`'s frame, with A's
+/// elements as `own` ([`crate::query::distance`]).
+pub(crate) fn collide_readings(
+    pose_a: &Pose,
+    a: &PointCloud,
+    pose_b: &Pose,
+    b: &PointCloud,
+    request: &CollisionRequest,
+) -> Result<(CollisionResult, Vec<ElementReading>)> {
+    request.validate()?;
+    let request = CollisionRequest {
+        decide_only: false,
+        segmentations: 1,
+        ..*request
+    };
+    let mut workspace = BvhWorkspace::default();
+    let mut readings = Vec::new();
+    let result = collide_segmentation(
+        pose_a,
+        a,
+        pose_b,
+        b,
+        &request,
+        &mut workspace,
+        None,
+        0,
+        false,
+        Some(&mut readings),
+    )?;
+    Ok((result, readings))
+}
+
 /// One run of the query: with the elements model, on the clouds' element
 /// sets of segmentation `offset` past each cloud's own
 /// ([`ElementSettings::segmentation`](crate::element::ElementSettings::segmentation)).
@@ -183,6 +223,7 @@ fn collide_segmentation(
     mut warm: Option<&mut WarmStart>,
     offset: u32,
     per_point: bool,
+    sink: Option<&mut Vec<ElementReading>>,
 ) -> Result<CollisionResult> {
     validate_pose(pose_a, "pose_a")?;
     validate_pose(pose_b, "pose_b")?;
@@ -544,6 +585,9 @@ fn collide_segmentation(
     let by_patch = elements
         .is_some()
         .then(|| contact_probability(&readings).max(lone));
+    if let Some(sink) = sink {
+        *sink = std::mem::take(&mut readings);
+    }
     let probability = by_patch
         .or_else(|| point_aggregates.and_then(|g| g.get(request.aggregation)))
         .unwrap_or_else(|| {

@@ -38,7 +38,7 @@ mod result;
 mod warm_start;
 
 pub use collide::collide;
-pub(crate) use collide::collide_with_workspace;
+pub(crate) use collide::{collide_readings, collide_with_workspace};
 pub use collide_many::{collide_along, collide_many, prepare, ALONG_RUN};
 pub use collide_mesh_cloud::{
     collide_mesh_cloud, mesh_sampling_spacing, MeshSampling, MeshSide, MESH_SPACING_FACTOR,

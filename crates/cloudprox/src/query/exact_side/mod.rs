@@ -23,9 +23,12 @@
 //! - `points.rs`: the per-point probabilities (Eq. 3);
 //! - `reach.rs`: whether a box around the mesh can reach the cloud at all
 //!   (a robot's broad phase, before any signed distance);
+//! - `nearest.rs`: the cloud's surface estimate nearest the surface, for
+//!   the distance query ([`crate::query::distance`]);
 //! - `query.rs`: the entry points.
 
 mod frame;
+mod nearest;
 mod points;
 mod query;
 mod reach;
@@ -33,6 +36,7 @@ mod readings;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use nearest::nearest_to_mesh;
 pub use query::{
     collide_cloud_exact, collide_cloud_exact_many, collide_exact_cloud, collide_exact_cloud_many,
 };

@@ -54,7 +54,7 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
 /// A single point's reading: its signed distance and its covariance along
 /// the distance's gradient (Eq. 3). Always within reach (the broad phase
 /// found the surface within reach of it).
-fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
+pub(super) fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
     let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
     let n = frame.to_cloud(&c.normal);
     let var = n.dot(&(e.cov_mean * n));
@@ -173,10 +173,10 @@ fn support_reading(
 
 /// The element's surface point read nearest the surface so far: its gap, its
 /// tangential coordinates (`None` before any) and the mesh's closest point.
-struct Nearest {
-    gap: Real,
-    at: Option<(Real, Real)>,
-    closest: ClosestPoint,
+pub(super) struct Nearest {
+    pub gap: Real,
+    pub at: Option<(Real, Real)>,
+    pub closest: ClosestPoint,
 }
 
 /// A search radius for an element's probes that holds every reading within
@@ -195,7 +195,7 @@ fn probe_radius(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> Real {
 /// point, where the element was sampled (a mesh's corner pressed into the
 /// surface between the probes is read there), at most [`REFINE_STEPS`]
 /// times while the gap shrinks; each step's reading within reach is kept.
-fn refine(
+pub(super) fn refine(
     frame: &Frame<'_>,
     e: &SurfaceElement,
     k: u32,
@@ -280,7 +280,7 @@ const REFINE_STEPS: usize = 3;
 /// The reading of element `k`'s fitted surface at tangential coordinates
 /// `(u, v)` (see [`probe_readings`]) and the mesh's closest point to it;
 /// `None` if the surface point lies outside, farther than `radius`.
-fn read_at(
+pub(super) fn read_at(
     frame: &Frame<'_>,
     e: &SurfaceElement,
     k: u32,
