@@ -1,6 +1,6 @@
 //! The nearest pair of points of two elements' fitted surfaces, read with the
 //! one gap formula of the crossing probabilities ([`read_oriented`]): the
-//! distance query beyond the near region ([`crate::query::distance`]).
+//! distance query beyond the near region ([`mod@crate::query::distance`]).
 
 use super::{read_oriented, Facing, Posed, HALF_SPACING};
 use crate::element::{Hull, SurfaceElement};

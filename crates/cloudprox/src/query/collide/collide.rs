@@ -174,7 +174,7 @@ pub(crate) fn collide_with_workspace(
 /// The full query of one segmentation (the clouds' own, `request`'s
 /// `segmentations` and `decide_only` not read) and every facing pair's
 /// reading within reach that its `P` read, in `b`'s frame, with A's
-/// elements as `own` ([`crate::query::distance`]).
+/// elements as `own` ([`mod@crate::query::distance`]).
 pub(crate) fn collide_readings(
     pose_a: &Pose,
     a: &PointCloud,

@@ -24,7 +24,7 @@
 //! - `reach.rs`: whether a box around the mesh can reach the cloud at all
 //!   (a robot's broad phase, before any signed distance);
 //! - `nearest.rs`: the cloud's surface estimate nearest the surface, for
-//!   the distance query ([`crate::query::distance`]);
+//!   the distance query ([`mod@crate::query::distance`]);
 //! - `query.rs`: the entry points.
 
 mod frame;
