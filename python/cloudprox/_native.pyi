@@ -27,6 +27,7 @@ __all__ = [
     "ContactPatch",
     "DepthCamera",
     "DistanceField",
+    "DistanceResult",
     "ExactShape",
     "FormatError",
     "InvalidInputError",
@@ -60,6 +61,7 @@ __all__ = [
     "collide_robot",
     "collide_robot_many",
     "crop_box",
+    "distance",
     "exact_intersects_many",
     "exact_proximity",
     "exact_proximity_many",
@@ -270,6 +272,47 @@ class PointCloud:
             If ``transform`` is not a ``(4, 4)`` rigid transform.
         """
     def __len__(self) -> int: ...
+
+@final
+class DistanceResult:
+    """The answer of :func:`distance`, in world coordinates."""
+
+    @property
+    def distance(self) -> float:
+        """The estimated signed separation of the two surface estimates, metres.
+
+        Negative where they interpenetrate; with ``beyond_max_distance``, a
+        lower bound on it instead.
+        """
+    @property
+    def std(self) -> float:
+        """The standard deviation of ``distance``, metres (0 for a bound)."""
+    @property
+    def point_a(self) -> _FloatArray:
+        """The point of A's surface estimate where the distance is read, shape ``(3,)`` (NaN for a bound)."""
+    @property
+    def point_b(self) -> _FloatArray:
+        """The point of B's surface estimate, shape ``(3,)`` (NaN for a bound)."""
+    @property
+    def normal(self) -> _FloatArray:
+        """The unit direction the distance is measured along, from A towards B, shape ``(3,)`` (NaN for a bound)."""
+    @property
+    def beyond_max_distance(self) -> bool:
+        """Whether the query stopped at ``max_distance``: ``distance`` is a lower bound."""
+    @property
+    def near_contact(self) -> bool:
+        """Whether the reading is one of :func:`collide`'s: two clouds within the noise's reach of each other.
+
+        Always ``False`` with an exact mesh side, whose reading is the cloud's
+        nearest element surface to the mesh at any distance.
+        """
+    @property
+    def crossing_probability(self) -> float:
+        """``Phi(-distance / std)``: the probability that the surfaces cross at the reading.
+
+        At most :func:`collide`'s ``P``; equal to it when the contact is one
+        facing pair of surface elements.
+        """
 
 @final
 class ContactPatch:
@@ -890,6 +933,48 @@ def facing_pairs(
     ``other_size`` and ``own_std``. ``benches/analytic.py`` and
     ``benches/realmesh.py --residuals`` compare ``gap`` with the exact gap:
     ``(g_true - gap) / std`` should be standard normal.
+    """
+
+def distance(
+    a: PointCloud | Mesh | Any,
+    b: PointCloud | Mesh | Any,
+    pose_a: npt.ArrayLike | None = None,
+    pose_b: npt.ArrayLike | None = None,
+    *,
+    max_distance: float | None = None,
+    request: CollisionRequest | None = None,
+    **options: Any,
+) -> DistanceResult:
+    """Measure the clearance between two sampled surfaces, with its standard deviation.
+
+    Estimates the signed separation of the *surface estimates* of two clouds
+    (each cloud's surface elements), or of an exact mesh and a cloud's, not
+    of raw points: negative where they interpenetrate. Near a contact the
+    gap and its standard deviation are the readings :func:`collide`'s ``P``
+    is made of, so ``Phi(-distance / std)`` (``crossing_probability``) is at
+    most ``collide``'s ``P`` and equals it when the contact is one pair of
+    surface elements. Farther away, the nearest pair of element surfaces is
+    read with the same gap formula.
+
+    Parameters
+    ----------
+    a, b : PointCloud or mesh
+        Two clouds, or one cloud and one mesh (its exact surface).
+    pose_a, pose_b : array_like, shape (4, 4), optional
+        Rigid poses (own frame to world); ``None`` is the identity.
+    max_distance : float, optional
+        Stop early, metres, when the surfaces are surely farther apart than
+        this: the result is then a lower bound (``beyond_max_distance``).
+        Must be ``>= 0``.
+    request, **options
+        The collision request whose noise model and reach the reading uses,
+        as for :func:`collide`.
+
+    Raises
+    ------
+    InvalidInputError
+        A negative or NaN ``max_distance``, a pose that is not a finite
+        rigid transform, an unknown option or an invalid request.
     """
 
 def collide(

@@ -35,6 +35,7 @@ mod macros;
 mod cloud;
 mod collide;
 mod convert;
+mod distance;
 mod error;
 mod exact_side;
 mod filter;
@@ -62,6 +63,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(collide::collide_many, m)?)?;
     m.add_function(wrap_pyfunction!(collide::collide_along, m)?)?;
     m.add_function(wrap_pyfunction!(collide::facing_pairs, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::distance, m)?)?;
+    m.add_class::<distance::PyDistanceResult>()?;
     m.add_class::<request::PyCollisionRequest>()?;
     m.add_class::<result::PyQueryStats>()?;
     m.add_class::<mesh::PyMesh>()?;
