@@ -80,6 +80,9 @@ def test_held_cloud_collides(arm: cp.Robot) -> None:
     cloud = wall_cloud()
     assert cp.collide_robot(scan, Q0, cloud).links["scan"].probability > 0.99
     assert cp.collide_robot(scan, Q_AWAY, cloud).probability < 1e-6
+    # The self-filter removes the points inside the cloud's convex hull.
+    points = np.array([[0.4, 0.0, 0.3], [0.4, 0.3, 0.3]])
+    np.testing.assert_array_equal(scan.self_filter(Q0, padding=0.01).apply(points), [1])
 
 
 def test_batch_and_motion_see_the_held_object(arm: cp.Robot, holding: cp.Robot) -> None:

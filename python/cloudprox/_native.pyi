@@ -1904,7 +1904,9 @@ class Robot:
     ) -> SelfFilter:
         """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame).
 
-        Attached objects are filtered too (a cloud object by its convex hull).
+        Attached objects are filtered too (a cloud object by its convex hull),
+        after the links with geometry, in the order attached (the order
+        :meth:`SelfFilter.set_poses` reads).
 
         ``padding=None`` is the core's ``SELF_FILTER_DEFAULT_PADDING``.
         """
@@ -1962,7 +1964,7 @@ class RobotStats:
 
     @property
     def links_with_geometry(self) -> int:
-        """Links with geometry."""
+        """Links with geometry, and attached objects."""
     @property
     def links_queried(self) -> int:
         """Links queried against the cloud (the others skipped by the broad phase or the decision)."""

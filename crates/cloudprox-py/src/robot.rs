@@ -826,7 +826,7 @@ stats_class! {
     state: RobotStatsState,
     repr: [links_with_geometry, links_queried],
     counters: {
-        /// Links with geometry.
+        /// Links with geometry, and attached objects.
         links_with_geometry: usize,
         /// Links queried against the cloud (the others were skipped by the broad
         /// phase, or left once the query was decided).

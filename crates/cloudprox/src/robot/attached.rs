@@ -178,13 +178,13 @@ impl Robot {
         touch.dedup();
         let label = format!("attached object '{name}'");
         let (geometry, cloud) = match shape {
-            AttachedShape::Mesh(mesh) => (LinkGeometry::new(&label, vec![mesh])?, None),
+            AttachedShape::Mesh(mesh) => (LinkGeometry::labelled(&label, vec![mesh])?, None),
             AttachedShape::Cloud(cloud) => {
                 if cloud.is_empty() {
                     return Err(Error::invalid(format!("{label}: the cloud is empty")));
                 }
                 let hull = cloud_hull(name, &cloud)?;
-                (LinkGeometry::new(&label, vec![hull])?, Some(cloud))
+                (LinkGeometry::labelled(&label, vec![hull])?, Some(cloud))
             }
         };
         let checked_links = (0..self.links.len())

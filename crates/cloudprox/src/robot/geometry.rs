@@ -128,7 +128,13 @@ impl LinkGeometry {
     /// [`Error::InvalidInput`] naming the link if parry rejects a part or
     /// every face of the parts is degenerate.
     pub fn new(link: &str, parts: Vec<Mesh>) -> Result<Self> {
-        let named = |e: Error| Error::invalid(format!("link '{link}': {e}"));
+        Self::labelled(&format!("link '{link}'"), parts)
+    }
+
+    /// [`LinkGeometry::new`] of a body that `label` names in errors (a link,
+    /// or an attached object).
+    pub(crate) fn labelled(label: &str, parts: Vec<Mesh>) -> Result<Self> {
+        let named = |e: Error| Error::invalid(format!("{label}: {e}"));
         let mesh = Mesh::merged(&parts)?;
         let exact = ExactShape::new(&parts).map_err(named)?;
         let distance = Arc::new(MeshDistance::new(&mesh).map_err(named)?);
