@@ -47,6 +47,9 @@ pub struct AttachedObject {
     pub(crate) checked_links: Vec<usize>,
     pub(crate) geometry: LinkGeometry,
     pub(crate) cloud: Option<Arc<PointCloud>>,
+    /// A cloud object's largest sampling spacing and largest noise standard
+    /// deviation (for the broad phase; 0 for a mesh object).
+    pub(crate) cloud_spread: (Real, Real),
 }
 
 impl AttachedObject {
@@ -190,6 +193,10 @@ impl Robot {
         let checked_links = (0..self.links.len())
             .filter(|&l| l != holder && !touch.contains(&l) && self.links[l].geometry.is_some())
             .collect();
+        let largest = |v: &[Real]| v.iter().copied().fold(0.0, Real::max);
+        let cloud_spread = cloud.as_ref().map_or((0.0, 0.0), |c| {
+            (largest(c.spacing()), largest(c.sigma_max()))
+        });
         self.attached.push(AttachedObject {
             name: name.to_string(),
             link: holder,
@@ -198,6 +205,7 @@ impl Robot {
             checked_links,
             geometry,
             cloud,
+            cloud_spread,
         });
         self.attached_changed();
         Ok(())
@@ -323,7 +331,7 @@ impl Robot {
 mod tests {
     use super::*;
     use crate::math::{Point3, Vector3};
-    use crate::query::MeshSide;
+    use crate::query::{MeshSide, QueryModel};
     use crate::robot::{collide_robot, RobotRequest};
 
     /// A base box (0.2 x 0.2 x 0.1 at the origin), a turn about z at
@@ -455,6 +463,32 @@ mod tests {
         )
         .unwrap();
         assert!(miss.probability < 1e-6, "{}", miss.probability);
+    }
+
+    #[test]
+    fn broad_phase_reads_a_held_cloud_with_its_noise() {
+        // A noisy held cloud (sigma 1 cm) 3 cm from the wall: beyond the
+        // wall's own reach, within the cloud's (the points model's near rule;
+        // the elements model's test reads both clouds' element hulls).
+        let mut r = holder();
+        let pts = cube(0.05).sample_surface(2000, 3).unwrap().points;
+        let object = Arc::new(PointCloud::from_sigma(pts, 0.01).unwrap());
+        let pose = Pose::translation(0.1, 0.0, 0.0);
+        r.attach("finger", AttachedShape::Cloud(object), &pose, "scan", &[])
+            .unwrap();
+        let cloud = wall(0.58, 0.1);
+        let query = |broad_phase| {
+            let mut request = RobotRequest {
+                broad_phase,
+                ..RobotRequest::default()
+            };
+            request.collide.model = QueryModel::Points;
+            collide_robot(&r, &[0.0], &Pose::identity(), &cloud, &request).unwrap()
+        };
+        let (with, without) = (query(true), query(false));
+        assert!(without.probability > 1e-6, "{}", without.probability);
+        assert!(with.links.last().unwrap().queried);
+        assert!((with.probability - without.probability).abs() < 1e-9);
     }
 
     #[test]

@@ -49,7 +49,9 @@ pub struct RobotRequest {
     /// the exact side's per-point probabilities leave them). No signed
     /// distance is evaluated. Sampled links, points model: the link's
     /// bounding box is beyond the noise's reach of every node of the cloud's
-    /// hierarchy, so no pair of points is near by the query's near rule.
+    /// hierarchy, so no pair of points is near by the query's near rule
+    /// (an attached cloud object, whose points carry noise, has its box
+    /// grown by its largest noise sigma times the same `k` first).
     /// Sampled links, elements model: no element surface of the link may
     /// reach one of the cloud through the hierarchies over both clouds'
     /// element hulls (the elements query's own first test). The broad phase
@@ -369,6 +371,7 @@ impl LinkSides {
                     cloud,
                     aabb: &g.aabb,
                     spacing_max: samples.spacing_max[l],
+                    sigma_max: 0.0,
                 },
                 // Never: every link with geometry has a sample.
                 None => Body::Exact(g),
@@ -381,10 +384,12 @@ impl LinkSides {
     fn object_body<'a>(&'a self, k: usize, object: &'a AttachedObject) -> Body<'a> {
         let g = &object.geometry;
         if let Some(cloud) = &object.cloud {
+            let (spacing_max, sigma_max) = object.cloud_spread;
             return Body::Cloud {
                 cloud,
                 aabb: &g.aabb,
-                spacing_max: cloud.spacing().iter().copied().fold(0.0, Real::max),
+                spacing_max,
+                sigma_max,
             };
         }
         match self {
@@ -394,6 +399,7 @@ impl LinkSides {
                     cloud,
                     aabb: &g.aabb,
                     spacing_max: *spacing_max,
+                    sigma_max: 0.0,
                 },
                 None => Body::Exact(g),
             },
@@ -415,6 +421,9 @@ enum Body<'a> {
         aabb: &'a Aabb,
         /// The cloud's largest sampling spacing.
         spacing_max: Real,
+        /// The largest noise standard deviation of its points (0 for a
+        /// sample: it carries no sensor noise).
+        sigma_max: Real,
     },
 }
 
@@ -547,7 +556,7 @@ fn link_near(
     counters: &mut RobotCounters,
 ) -> bool {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
-    let (link_cloud, aabb, spacing_max) = match body {
+    let (link_cloud, aabb, spacing_max, sigma_max) = match body {
         Body::Exact(geometry) => {
             let (near, visited) = exact_side_may_reach(
                 (&geometry.aabb, pose),
@@ -562,7 +571,8 @@ fn link_near(
             cloud,
             aabb,
             spacing_max,
-        } => (cloud, aabb, spacing_max),
+            sigma_max,
+        } => (cloud, aabb, spacing_max, sigma_max),
     };
     match collide.model {
         // The elements model's own first test: the hierarchies over both
@@ -579,8 +589,9 @@ fn link_near(
             counters.broad_phase_nodes += visited;
             may
         }),
+        // A noisy body's box (a cloud object's) grown by its own noise's reach.
         QueryModel::Points => near_cloud(
-            &aabb.transformed(pose),
+            &grown(&aabb.transformed(pose), sigma_max * scene.reach),
             spacing_max,
             cloud,
             scene.reach,
@@ -588,6 +599,16 @@ fn link_near(
             &mut ws.stack,
         ),
     }
+}
+
+/// `b` grown by `d` on every side.
+fn grown(b: &Aabb, d: Real) -> Aabb {
+    let mut out = *b;
+    for a in 0..3 {
+        out.mins[a] -= d;
+        out.maxs[a] += d;
+    }
+    out
 }
 
 /// The query of one body that passed the broad phase.
