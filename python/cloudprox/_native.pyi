@@ -1904,6 +1904,69 @@ class Robot:
         An unknown link, or a link paired with itself, raises
         :class:`InvalidInputError` naming it.
         """
+    def attach(
+        self,
+        link: str,
+        obj: Mesh | PointCloud,
+        pose: npt.ArrayLike | None = None,
+        *,
+        name: str,
+        touch_links: Sequence[str] | None = None,
+    ) -> Robot:
+        """Return a copy of the robot holding ``obj`` on ``link``.
+
+        Parameters
+        ----------
+        link : str
+            The link that holds the object; the object moves with it.
+        obj : Mesh or PointCloud
+            The object in its own frame. A mesh stands in queries as a link does
+            (its exact surface, or its sample with ``mesh_side="sampled"``); a
+            cloud is collided as a cloud, and its convex hull stands for it in
+            self-collision and the self-filter.
+        pose : (4, 4) float, optional
+            The object's frame in the link's frame (``None``: identity).
+        name : str
+            The object's name: its key in :attr:`RobotCollisionResult.links` and
+            :attr:`RobotCollisionResult.self_collisions`.
+        touch_links : sequence of str, optional
+            Links allowed to touch the object besides ``link`` (MoveIt's touch
+            links, e.g. the fingers that grasp it).
+
+        Returns
+        -------
+        Robot
+            The copy; the robot itself is unchanged. The copy's queries read the
+            object against the environment, its :meth:`self_filter` removes the
+            points on it, and its self-collision checks it against every link
+            with geometry but ``link`` and ``touch_links``. Attached objects are
+            not checked against each other. It pickles with its objects.
+
+        Raises
+        ------
+        InvalidInputError
+            Naming the problem: an unknown link or touch link, a name already
+            used by an attached object or a link, a non-finite pose, a mesh
+            rejected as a link's would be, or a flat cloud.
+        TypeError
+            If ``obj`` is neither a :class:`Mesh` nor a :class:`PointCloud`.
+        """
+    def detach(self, name: str) -> Robot:
+        """Return a copy of the robot without the attached object ``name``.
+
+        An unknown name raises :class:`InvalidInputError` listing the objects held.
+        """
+    @property
+    def attached_objects(self) -> list[str]:
+        """Names of the attached objects, in the order attached."""
+    def attached_poses(
+        self, q: _Configuration, base_pose: npt.ArrayLike | None = None
+    ) -> dict[str, _FloatArray]:
+        """Every attached object's ``(4, 4)`` pose (object frame to world) at ``q``, by name.
+
+        The holding link's pose (:meth:`link_poses`) composed with the object's
+        pose in the link.
+        """
     def link_poses(
         self, q: _Configuration, base_pose: npt.ArrayLike | None = None
     ) -> dict[str, _FloatArray]:
@@ -1913,7 +1976,11 @@ class Robot:
     def link_mesh(self, link: str) -> Mesh | None:
         """Return the collision mesh of ``link`` in its own frame (``None`` without geometry)."""
     def self_collisions(self, q: _Configuration) -> list[tuple[str, str]]:
-        """Return the pairs of non-adjacent links whose exact meshes intersect at ``q``."""
+        """Return the pairs of non-adjacent links whose exact meshes intersect at ``q``.
+
+        Then the ``(link, object)`` pairs of attached objects that intersect a
+        link other than their holder and touch links.
+        """
     def self_filter(
         self,
         q: _Configuration,
@@ -1921,6 +1988,10 @@ class Robot:
         base_pose: npt.ArrayLike | None = None,
     ) -> SelfFilter:
         """Return the :class:`SelfFilter` of the robot's links at ``q`` (root at ``base_pose``, cloud frame).
+
+        Attached objects are filtered too (a cloud object by its convex hull),
+        after the links with geometry, in the order attached (the order
+        :meth:`SelfFilter.set_poses` reads).
 
         ``padding=None`` is the core's ``SELF_FILTER_DEFAULT_PADDING``.
         """
@@ -1961,7 +2032,7 @@ class RobotCollisionResult:
         """The state from ``probability`` and the thresholds."""
     @property
     def links(self) -> dict[str, LinkCollision]:
-        """Per link with geometry, by name (URDF order)."""
+        """Per link with geometry, by name (URDF order), then per attached object, by its name."""
     @property
     def patches(self) -> list[tuple[str, ContactPatch]]:
         """Contact patches of every queried link, as ``(link name, patch)``."""
@@ -1978,7 +2049,7 @@ class RobotStats:
 
     @property
     def links_with_geometry(self) -> int:
-        """Links with geometry."""
+        """Links with geometry, and attached objects."""
     @property
     def links_queried(self) -> int:
         """Links queried against the cloud (the others skipped by the broad phase or the decision)."""
@@ -2022,7 +2093,7 @@ class RobotBatchResult:
         """Whether non-adjacent links intersect, shape ``(m,)``."""
     @property
     def link_probabilities(self) -> _FloatArray:
-        """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order."""
+        """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order (attached objects enter ``probabilities`` only)."""
     @staticmethod
     def _from_state(
         state: tuple[list[float], list[str], list[bool], list[float], int],

@@ -4,11 +4,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
+use cloudprox::math::Pose;
 use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
-    collide_robot_many as core_collide_robot_many, LinkCollision, MotionRequest, Robot,
-    RobotCollisionResult, RobotCounters, RobotStats,
+    collide_robot_many as core_collide_robot_many, AttachedShape, LinkCollision, MotionRequest,
+    Robot, RobotCollisionResult, RobotCounters, RobotStats,
 };
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -210,7 +211,73 @@ struct RobotSource {
     srdf: Option<(String, String)>,
     /// Link pairs allowed to collide (`with_allowed_collisions`), after the SRDF's.
     allowed: Vec<(String, String)>,
+    /// Objects attached (`attach`), in order, after the allowed pairs.
+    attached: Vec<AttachedSource>,
 }
+
+/// One attached object of a `RobotSource`: the Python object given (pickled
+/// with the robot) and its core shape (attached again on loading).
+#[derive(Clone)]
+struct AttachedSource {
+    link: String,
+    object: Arc<Py<PyAny>>,
+    shape: AttachedShape,
+    pose: Pose,
+    name: String,
+    touch_links: Vec<String>,
+}
+
+impl AttachedSource {
+    /// The source of `obj` (a `Mesh` or a `PointCloud`) attached to `link`.
+    fn new(
+        link: String,
+        obj: &Bound<'_, PyAny>,
+        pose: Pose,
+        name: String,
+        touch_links: Vec<String>,
+    ) -> PyResult<Self> {
+        let shape = if let Ok(m) = obj.cast::<PyMesh>() {
+            AttachedShape::Mesh((*m.get().inner).clone())
+        } else if let Ok(c) = obj.cast::<PyPointCloud>() {
+            AttachedShape::Cloud(Arc::clone(&c.get().inner))
+        } else {
+            let ty = obj.get_type().name()?;
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "an attached object must be a cloudprox.Mesh or a cloudprox.PointCloud, got {ty}"
+            )));
+        };
+        Ok(Self {
+            link,
+            object: Arc::new(obj.clone().unbind()),
+            shape,
+            pose,
+            name,
+            touch_links,
+        })
+    }
+
+    /// Attaches the object to `robot`.
+    fn attach(&self, robot: &mut Robot) -> cloudprox::Result<()> {
+        let touch: Vec<&str> = self.touch_links.iter().map(String::as_str).collect();
+        robot.attach(
+            &self.link,
+            self.shape.clone(),
+            &self.pose,
+            &self.name,
+            &touch,
+        )
+    }
+}
+
+/// The pickled form of an attached object: the link, the `Mesh` or
+/// `PointCloud`, the `(4, 4)` pose, the name and the touch links.
+type AttachedState<'py> = (
+    String,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    String,
+    Vec<String>,
+);
 
 impl RobotSource {
     /// The source of a robot loaded from `xml` (named `name` in errors), no
@@ -229,6 +296,7 @@ impl RobotSource {
             package_dirs: package_dirs.unwrap_or_default(),
             srdf,
             allowed: Vec::new(),
+            attached: Vec::new(),
         }
     }
 }
@@ -239,7 +307,7 @@ const URDF_STRING_NAME: &str = "<URDF string>";
 const SRDF_STRING_NAME: &str = "<SRDF string>";
 
 /// The pickled form of a `Robot`: the arguments of `_from_urdf_text`.
-type RobotState = (
+type RobotState<'py> = (
     String,
     String,
     Option<PathBuf>,
@@ -247,9 +315,18 @@ type RobotState = (
     Option<String>,
     Option<String>,
     Vec<(String, String)>,
+    Vec<AttachedState<'py>>,
 );
 
 impl PyRobot {
+    /// Name pairs of entry pairs (links, then attached objects).
+    fn entry_names(&self, pairs: &[(usize, usize)]) -> Vec<(String, String)> {
+        pairs
+            .iter()
+            .map(|&(a, b)| (entry_name(&self.inner, a), entry_name(&self.inner, b)))
+            .collect()
+    }
+
     fn names(&self, pairs: &[(usize, usize)]) -> Vec<(String, String)> {
         let names = self.inner.link_names();
         pairs
@@ -271,6 +348,9 @@ impl PyRobot {
             for (a, b) in &s.allowed {
                 robot.allow_collision(a, b)?;
             }
+            for object in &s.attached {
+                object.attach(&mut robot)?;
+            }
             Ok((robot, source))
         })?;
         Ok(Self {
@@ -278,6 +358,11 @@ impl PyRobot {
             source,
         })
     }
+}
+
+/// The name of a query entry: a link's, or an attached object's.
+fn entry_name(robot: &Robot, i: usize) -> String {
+    robot.entry_name(i).unwrap_or("?").to_string()
 }
 
 /// The text of a file, read with the GIL released.
@@ -355,12 +440,27 @@ impl PyRobot {
     }
 
     /// Pickle support: the URDF text, its name, the folder relative mesh paths
-    /// are resolved against, the package folders and the SRDF text and name;
-    /// the robot is loaded again on unpickling (its mesh files must be
-    /// readable at the same paths).
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, RobotState)> {
+    /// are resolved against, the package folders, the SRDF text and name, the
+    /// allowed pairs and the attached objects (each with its `Mesh` or
+    /// `PointCloud`); the robot is loaded again on unpickling (its mesh files
+    /// must be readable at the same paths).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, RobotState<'py>)> {
+        let py = slf.py();
         let s = &slf.get().source;
         let (srdf_text, srdf_name) = s.srdf.clone().unzip();
+        let attached = s
+            .attached
+            .iter()
+            .map(|a| {
+                Ok((
+                    a.link.clone(),
+                    a.object.clone_ref(py).into_bound(py),
+                    pose_to_py(py, &a.pose)?.into_any(),
+                    a.name.clone(),
+                    a.touch_links.clone(),
+                ))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         Ok((
             slf.getattr("_from_urdf_text")?,
             (
@@ -371,15 +471,18 @@ impl PyRobot {
                 srdf_text,
                 srdf_name,
                 s.allowed.clone(),
+                attached,
             ),
         ))
     }
 
     /// Loads a robot from URDF text (see `__reduce__`); `name` stands for the
     /// file in errors, relative mesh paths are resolved against `base_dir`;
-    /// the SRDF text `srdf_text` (named `srdf_name` in errors) is applied.
+    /// the SRDF text `srdf_text` (named `srdf_name` in errors) is applied,
+    /// then the `allowed` pairs, then the `attached` objects.
     #[staticmethod]
-    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None, srdf_text=None, srdf_name=None, allowed=None))]
+    #[pyo3(signature = (xml, name, base_dir=None, package_dirs=None, srdf_text=None, srdf_name=None, allowed=None, attached=None))]
+    #[allow(clippy::too_many_arguments)]
     fn _from_urdf_text(
         py: Python<'_>,
         xml: String,
@@ -389,10 +492,20 @@ impl PyRobot {
         srdf_text: Option<String>,
         srdf_name: Option<String>,
         allowed: Option<Vec<(String, String)>>,
+        attached: Option<Vec<AttachedState<'_>>>,
     ) -> PyResult<Self> {
         let srdf = srdf_text.map(|t| (t, srdf_name.unwrap_or_else(|| SRDF_STRING_NAME.into())));
+        let attached = attached
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(link, obj, pose, name, touch)| {
+                let pose = pose_from(py, Some(&pose), "pose")?;
+                AttachedSource::new(link, &obj, pose, name, touch)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         let source = RobotSource {
             allowed: allowed.unwrap_or_default(),
+            attached,
             ..RobotSource::new(xml, name, base_dir, package_dirs, srdf)
         };
         Self::load(py, source)
@@ -477,6 +590,77 @@ impl PyRobot {
         })
     }
 
+    /// A copy of the robot holding `obj` (a `Mesh` or a `PointCloud`, in its
+    /// own frame) on `link` at `pose` (the object's frame in the link's
+    /// frame; `None`: identity), named `name`; `touch_links` may touch it
+    /// without self-collision, besides `link`.
+    #[pyo3(signature = (link, obj, pose=None, *, name, touch_links=None))]
+    fn attach(
+        &self,
+        py: Python<'_>,
+        link: String,
+        obj: &Bound<'_, PyAny>,
+        pose: Option<&Bound<'_, PyAny>>,
+        name: String,
+        touch_links: Option<Vec<String>>,
+    ) -> PyResult<Self> {
+        let pose = pose_from(py, pose, "pose")?;
+        let object = AttachedSource::new(link, obj, pose, name, touch_links.unwrap_or_default())?;
+        let robot = Arc::clone(&self.inner);
+        let (robot, object) = run_detached(py, move || {
+            let mut robot = (*robot).clone();
+            object.attach(&mut robot)?;
+            Ok((robot, object))
+        })?;
+        let mut source = self.source.clone();
+        source.attached.push(object);
+        Ok(Self {
+            inner: Arc::new(robot),
+            source,
+        })
+    }
+
+    /// A copy of the robot without the attached object `name`.
+    fn detach(&self, py: Python<'_>, name: &str) -> PyResult<Self> {
+        let mut robot = (*self.inner).clone();
+        robot.detach(name).or_py(py)?;
+        let mut source = self.source.clone();
+        source.attached.retain(|a| a.name != name);
+        Ok(Self {
+            inner: Arc::new(robot),
+            source,
+        })
+    }
+
+    /// Names of the attached objects, in the order attached.
+    #[getter]
+    fn attached_objects(&self) -> Vec<String> {
+        self.inner
+            .attached_objects()
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect()
+    }
+
+    /// Every attached object's pose (4x4, object frame to world) at `q`, the
+    /// root at `base_pose`, by name.
+    #[pyo3(signature = (q, base_pose=None))]
+    fn attached_poses<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        base_pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let q = config_from(&self.inner, q, "q")?;
+        let base = pose_from(py, base_pose, "base_pose")?;
+        let poses = self.inner.attached_poses(&q, &base).or_py(py)?;
+        let d = PyDict::new(py);
+        for (object, pose) in self.inner.attached_objects().iter().zip(&poses) {
+            d.set_item(object.name(), pose_to_py(py, pose)?)?;
+        }
+        Ok(d)
+    }
+
     /// Every link's pose (4x4, link frame to world) at `q`, the root at `base_pose`.
     #[pyo3(signature = (q, base_pose=None))]
     fn link_poses<'py>(
@@ -536,7 +720,7 @@ impl PyRobot {
         let q = config_from(&self.inner, q, "q")?;
         let pairs = self.inner.self_collisions(&q).or_py(py)?;
         let pairs: Vec<(usize, usize)> = pairs.iter().map(|p| (p.link_a, p.link_b)).collect();
-        Ok(self.names(&pairs))
+        Ok(self.entry_names(&pairs))
     }
 
     /// The self-filter of the robot at `q` (root at `base_pose`, in the cloud's
@@ -565,8 +749,12 @@ impl PyRobot {
             .iter()
             .filter(|l| l.geometry.is_some())
             .count();
+        let attached = match self.inner.attached_objects().len() {
+            0 => String::new(),
+            n => format!(", attached={n}"),
+        };
         format!(
-            "Robot(name='{}', dof={}, links={}, with_geometry={})",
+            "Robot(name='{}', dof={}, links={}, with_geometry={}{attached})",
             self.inner.name(),
             self.inner.dof(),
             self.inner.links().len(),
@@ -638,7 +826,7 @@ stats_class! {
     state: RobotStatsState,
     repr: [links_with_geometry, links_queried],
     counters: {
-        /// Links with geometry.
+        /// Links with geometry, and attached objects.
         links_with_geometry: usize,
         /// Links queried against the cloud (the others were skipped by the broad
         /// phase, or left once the query was decided).
@@ -670,7 +858,6 @@ pub struct PyRobotCollisionResult {
 
 impl PyRobotCollisionResult {
     fn new(py: Python<'_>, robot: &Robot, r: RobotCollisionResult) -> PyResult<Self> {
-        let names = robot.link_names();
         let links = r
             .links
             .into_iter()
@@ -678,7 +865,7 @@ impl PyRobotCollisionResult {
                 Py::new(
                     py,
                     PyLinkCollision {
-                        name: names[l.link].to_string(),
+                        name: entry_name(robot, l.link),
                         inner: l,
                     },
                 )
@@ -687,7 +874,7 @@ impl PyRobotCollisionResult {
         let self_collisions = r
             .self_collisions
             .iter()
-            .map(|p| (names[p.link_a].to_string(), names[p.link_b].to_string()))
+            .map(|p| (entry_name(robot, p.link_a), entry_name(robot, p.link_b)))
             .collect();
         Ok(Self {
             probability: r.probability,
@@ -919,7 +1106,8 @@ pub fn collide_robot_many(
     let n_links = robot.links().len();
     let mut link_probabilities = vec![0.0; results.len() * n_links];
     for (i, r) in results.iter().enumerate() {
-        for l in &r.links {
+        // Attached objects (entries beyond the links) enter the probabilities only.
+        for l in r.links.iter().filter(|l| l.link < n_links) {
             link_probabilities[i * n_links + l.link] = l.probability;
         }
     }

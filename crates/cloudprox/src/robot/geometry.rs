@@ -128,7 +128,13 @@ impl LinkGeometry {
     /// [`Error::InvalidInput`] naming the link if parry rejects a part or
     /// every face of the parts is degenerate.
     pub fn new(link: &str, parts: Vec<Mesh>) -> Result<Self> {
-        let named = |e: Error| Error::invalid(format!("link '{link}': {e}"));
+        Self::labelled(&format!("link '{link}'"), parts)
+    }
+
+    /// [`LinkGeometry::new`] of a body that `label` names in errors (a link,
+    /// or an attached object).
+    pub(crate) fn labelled(label: &str, parts: Vec<Mesh>) -> Result<Self> {
+        let named = |e: Error| Error::invalid(format!("{label}: {e}"));
         let mesh = Mesh::merged(&parts)?;
         let exact = ExactShape::new(&parts).map_err(named)?;
         let distance = Arc::new(MeshDistance::new(&mesh).map_err(named)?);
@@ -160,32 +166,60 @@ pub(crate) struct LinkSamples {
     pub clouds: Vec<Option<PointCloud>>,
     /// Per link: the largest sampling spacing of its cloud (for the broad phase).
     pub spacing_max: Vec<Real>,
+    /// Per attached object (in [`super::Robot::attached_objects`] order): the
+    /// sample of a mesh object in its own frame, and its largest spacing;
+    /// `None` for a cloud object (its own cloud stands for it).
+    pub attached: Vec<Option<(PointCloud, Real)>>,
+}
+
+/// The cloud sampled from `g`'s merged mesh at `spacing` (`what` names it in
+/// errors), its hierarchy built, and its largest sampling spacing.
+fn sample_geometry(g: &LinkGeometry, spacing: Real, what: &str) -> Result<(PointCloud, Real)> {
+    let cloud = PointCloud::from_mesh(&g.mesh, spacing, LINK_SAMPLING_SEED)
+        .map_err(|e| Error::invalid(format!("{what}: {e}")))?;
+    let _ = cloud.bvh();
+    let spacing_max = cloud.spacing().iter().copied().fold(0.0, Real::max);
+    Ok((cloud, spacing_max))
 }
 
 impl LinkSamples {
-    pub(crate) fn new(links: &[super::Link], spacing: Real) -> Result<Self> {
+    pub(crate) fn new(robot: &super::Robot, spacing: Real) -> Result<Self> {
+        let links = &robot.links;
         let mut clouds = Vec::with_capacity(links.len());
         let mut spacing_max = Vec::with_capacity(links.len());
         for link in links {
             if let Some(g) = &link.geometry {
-                let cloud = PointCloud::from_mesh(&g.mesh, spacing, LINK_SAMPLING_SEED)
-                    .map_err(|e| Error::invalid(format!("link '{}': {e}", link.name)))?;
-                let _ = cloud.bvh();
-                spacing_max.push(cloud.spacing().iter().copied().fold(0.0, Real::max));
+                let (cloud, h) = sample_geometry(g, spacing, &format!("link '{}'", link.name))?;
+                spacing_max.push(h);
                 clouds.push(Some(cloud));
             } else {
                 clouds.push(None);
                 spacing_max.push(0.0);
             }
         }
+        let attached = robot
+            .attached
+            .iter()
+            .map(|o| match o.cloud {
+                Some(_) => Ok(None),
+                None => sample_geometry(
+                    &o.geometry,
+                    spacing,
+                    &format!("attached object '{}'", o.name),
+                )
+                .map(Some),
+            })
+            .collect::<Result<_>>()?;
         Ok(Self {
             clouds,
             spacing_max,
+            attached,
         })
     }
 }
 
-/// Cached samples of every link at `spacing`, sampled on first use.
+/// Cached samples of every link (and attached mesh object) at `spacing`,
+/// sampled on first use.
 pub(crate) fn samples_at(robot: &super::Robot, spacing: Real) -> Result<Arc<LinkSamples>> {
     let key = spacing.to_bits();
     {
@@ -197,7 +231,7 @@ pub(crate) fn samples_at(robot: &super::Robot, spacing: Real) -> Result<Arc<Link
             return Ok(Arc::clone(s));
         }
     }
-    let s = Arc::new(LinkSamples::new(&robot.links, spacing)?);
+    let s = Arc::new(LinkSamples::new(robot, spacing)?);
     let mut cache = robot
         .samples
         .lock()

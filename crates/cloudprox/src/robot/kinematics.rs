@@ -32,7 +32,8 @@ impl Robot {
         poses
     }
 
-    /// An upper bound on how far any point of any link's geometry moves
+    /// An upper bound on how far any point of any link's geometry (or of an
+    /// object it holds, [`Robot::attach`]) moves
     /// between configurations `q0` and `q0 + dq`, and between any two
     /// configurations on the straight segment joining them: for each link, the
     /// sum over the joints above it of `|d value| * r` (`r` the largest distance
@@ -53,6 +54,10 @@ impl Robot {
         let mut reach = vec![0.0; self.links.len()];
         for (l, link) in self.links.iter().enumerate() {
             reach[l] = link.geometry.as_ref().map_or(0.0, |g| g.radius);
+        }
+        // A held object is part of its link's geometry here.
+        for object in &self.attached {
+            reach[object.link] = reach[object.link].max(object.reach());
         }
         for &j in self.order.iter().rev() {
             let joint = &self.joints[j];
@@ -94,9 +99,9 @@ impl Robot {
             }
             weights[joint.child] = w;
         }
-        // Links without geometry do not move anything.
+        // Links without geometry (or a held object) do not move anything.
         for (l, link) in self.links.iter().enumerate() {
-            if link.geometry.is_none() {
+            if link.geometry.is_none() && !self.attached.iter().any(|o| o.link == l) {
                 weights[l].clear();
             }
         }

@@ -10,6 +10,7 @@
 //! | link collision geometry: meshes, URDF primitives, samples, exact shapes | `geometry.rs` |
 //! | `collide_robot`, `collide_robot_many`, self-collision | `query.rs` |
 //! | `check_motion` | `motion.rs` |
+//! | attached (held) objects: `Robot::attach`, `Robot::detach` | `attached.rs` |
 //!
 //! A robot is prepared once ([`Robot::from_urdf_file`]): every link's collision
 //! elements become one [`Mesh`](crate::shape::Mesh) in the link frame (for
@@ -17,6 +18,7 @@
 //! (for self-collision); the point cloud that stands for a link in a query is
 //! sampled once per sampling spacing and cached on the robot.
 
+mod attached;
 mod geometry;
 mod kinematics;
 mod model;
@@ -25,6 +27,7 @@ mod query;
 mod srdf;
 mod urdf;
 
+pub use attached::{AttachedObject, AttachedShape};
 pub use geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS, LINK_SAMPLING_SEED};
 pub use model::{Joint, JointKind, Link, Mimic, Robot};
 pub use motion::{check_motion, MotionRequest, MotionResult};

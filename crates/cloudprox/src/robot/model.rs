@@ -2,6 +2,7 @@
 
 use std::sync::{Arc, Mutex};
 
+use super::attached::AttachedObject;
 use super::geometry::{LinkGeometry, LinkSamples};
 use crate::error::{Error, Result};
 use crate::math::{Pose, Vector3};
@@ -139,6 +140,8 @@ pub struct Robot {
     /// Per link: `(dof, weight)` such that a link point moves at most
     /// `sum weight * |dq[dof]|` for a joint-space step `dq`.
     pub(crate) motion_weights: Vec<Vec<(usize, Real)>>,
+    /// Objects held by links ([`Robot::attach`]), in the order attached.
+    pub(crate) attached: Vec<AttachedObject>,
     /// Link samples per sampling spacing (bit pattern of the spacing).
     pub(crate) samples: Mutex<Vec<(u64, Arc<LinkSamples>)>>,
 }
@@ -161,6 +164,7 @@ impl Clone for Robot {
             self_pairs: self.self_pairs.clone(),
             ignored_pairs: self.ignored_pairs.clone(),
             motion_weights: self.motion_weights.clone(),
+            attached: self.attached.clone(),
             samples: Mutex::new(samples),
         }
     }

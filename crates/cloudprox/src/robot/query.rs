@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use super::attached::AttachedObject;
 use super::geometry::{samples_at, LinkGeometry, LinkSamples};
 use super::model::Robot;
 use crate::bvh::{Aabb, BvhWorkspace};
@@ -48,7 +49,9 @@ pub struct RobotRequest {
     /// the exact side's per-point probabilities leave them). No signed
     /// distance is evaluated. Sampled links, points model: the link's
     /// bounding box is beyond the noise's reach of every node of the cloud's
-    /// hierarchy, so no pair of points is near by the query's near rule.
+    /// hierarchy, so no pair of points is near by the query's near rule
+    /// (an attached cloud object, whose points carry noise, has its box
+    /// grown by its largest noise sigma times the same `k` first).
     /// Sampled links, elements model: no element surface of the link may
     /// reach one of the cloud through the hierarchies over both clouds'
     /// element hulls (the elements query's own first test). The broad phase
@@ -111,7 +114,9 @@ impl RobotRequest {
 /// One link's part of a [`RobotCollisionResult`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinkCollision {
-    /// The link's index ([`Robot::link_names`]).
+    /// The link's index ([`Robot::link_names`]); for an attached object,
+    /// `links().len() + k` with `k` its place in [`Robot::attached_objects`]
+    /// ([`Robot::entry_name`] names either).
     pub link: usize,
     /// The link's collision probability (0 when the broad phase skipped it;
     /// NaN when a `decide_only` query had decided before reaching it).
@@ -126,12 +131,13 @@ pub struct LinkCollision {
     pub result: Option<CollisionResult>,
 }
 
-/// Two links whose exact shapes intersect.
+/// Two links (or a link and an attached object) whose exact shapes intersect.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SelfCollision {
     /// The first link's index.
     pub link_a: usize,
-    /// The second link's index (`link_a < link_b`).
+    /// The second link's index (`link_a < link_b`); an attached object's is
+    /// `links().len() + k`, as in [`LinkCollision::link`].
     pub link_b: usize,
 }
 
@@ -139,7 +145,7 @@ pub struct SelfCollision {
 /// wall time, so that two runs of one query compare equal.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct RobotCounters {
-    /// Links with geometry.
+    /// Links with geometry, and attached objects.
     pub links_with_geometry: usize,
     /// Links queried against the cloud (the others were skipped by the broad
     /// phase, or left once the query was decided).
@@ -185,7 +191,8 @@ pub struct RobotCollisionResult {
     pub probability: Real,
     /// The state from `probability` and the thresholds.
     pub state: CollisionState,
-    /// One entry per link with geometry, in link order.
+    /// One entry per link with geometry, in link order, then one per
+    /// attached object, in [`Robot::attached_objects`] order.
     pub links: Vec<LinkCollision>,
     /// Pairs of non-adjacent links that intersect (exact meshes), empty when
     /// not requested. Reported apart: it does not enter `probability`.
@@ -270,9 +277,11 @@ fn after_decision(link: usize) -> LinkCollision {
     }
 }
 
-/// Self-collision at `poses`: the checked pairs whose exact shapes intersect.
+/// Self-collision at the link poses `poses`: the checked link pairs whose
+/// exact shapes intersect, then the attached objects' (see
+/// [`Robot::attach`]).
 pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollision> {
-    robot
+    let mut out: Vec<SelfCollision> = robot
         .self_pairs
         .iter()
         .filter_map(|&(a, b)| {
@@ -283,7 +292,9 @@ pub(crate) fn self_collisions(robot: &Robot, poses: &[Pose]) -> Vec<SelfCollisio
                 link_b: b,
             })
         })
-        .collect()
+        .collect();
+    out.extend(robot.attached_self_collisions(poses));
+    out
 }
 
 /// Workspace of one thread of robot queries.
@@ -344,14 +355,80 @@ impl LinkSides {
                 for link_cloud in samples.clouds.iter().flatten() {
                     prepare(link_cloud, request);
                 }
+                for (object_cloud, _) in samples.attached.iter().flatten() {
+                    prepare(object_cloud, request);
+                }
             }
+        }
+    }
+
+    /// What stands for link `l` (with geometry `g`) in a query.
+    fn link_body<'a>(&'a self, l: usize, g: &'a LinkGeometry) -> Body<'a> {
+        match self {
+            LinkSides::Exact => Body::Exact(g),
+            LinkSides::Sampled(samples) => match &samples.clouds[l] {
+                Some(cloud) => Body::Cloud {
+                    cloud,
+                    aabb: &g.aabb,
+                    spacing_max: samples.spacing_max[l],
+                    sigma_max: 0.0,
+                },
+                // Never: every link with geometry has a sample.
+                None => Body::Exact(g),
+            },
+        }
+    }
+
+    /// What stands for the attached object `k` in a query: a cloud object's
+    /// cloud; a mesh object's exact surface or sample, as a link's.
+    fn object_body<'a>(&'a self, k: usize, object: &'a AttachedObject) -> Body<'a> {
+        let g = &object.geometry;
+        if let Some(cloud) = &object.cloud {
+            let (spacing_max, sigma_max) = object.cloud_spread;
+            return Body::Cloud {
+                cloud,
+                aabb: &g.aabb,
+                spacing_max,
+                sigma_max,
+            };
+        }
+        match self {
+            LinkSides::Exact => Body::Exact(g),
+            LinkSides::Sampled(samples) => match &samples.attached[k] {
+                Some((cloud, spacing_max)) => Body::Cloud {
+                    cloud,
+                    aabb: &g.aabb,
+                    spacing_max: *spacing_max,
+                    sigma_max: 0.0,
+                },
+                None => Body::Exact(g),
+            },
         }
     }
 }
 
+/// What stands for one body of the robot (a link, or an attached object) in
+/// its query against the environment, in the body's frame.
+#[derive(Debug, Clone, Copy)]
+enum Body<'a> {
+    /// Its exact surface ([`LinkGeometry::distance`]).
+    Exact(&'a LinkGeometry),
+    /// A cloud: a link's or mesh object's sample, or a cloud object's own.
+    Cloud {
+        /// The cloud.
+        cloud: &'a PointCloud,
+        /// The body's bounding box.
+        aabb: &'a Aabb,
+        /// The cloud's largest sampling spacing.
+        spacing_max: Real,
+        /// The largest noise standard deviation of its points (0 for a
+        /// sample: it carries no sensor noise).
+        sigma_max: Real,
+    },
+}
+
 /// One robot query's fixed inputs.
 struct Scene<'a> {
-    sides: &'a LinkSides,
     cloud: &'a PointCloud,
     request: &'a RobotRequest,
     /// The noise's reach in standard deviations (`-Phi^-1(epsilon / 2)`).
@@ -371,7 +448,6 @@ pub(crate) fn collide_robot_prepared(
     let start = Instant::now();
     let poses = robot.link_poses_unchecked(q, base);
     let scene = Scene {
-        sides,
         cloud,
         request,
         reach: -normal_quantile(0.5 * request.collide.prune_epsilon),
@@ -381,17 +457,26 @@ pub(crate) fn collide_robot_prepared(
     // Every aggregation is at least the largest link probability: once a link
     // reaches the collision threshold, a decide_only query is decided.
     let mut decided = false;
-    for (l, link) in robot.links.iter().enumerate() {
-        let Some(geometry) = &link.geometry else {
-            continue;
-        };
+    let object_poses = robot.attached_poses_from(&poses);
+    let link_bodies = robot.links.iter().enumerate().filter_map(|(l, link)| {
+        let g = link.geometry.as_ref()?;
+        Some((l, sides.link_body(l, g), &poses[l]))
+    });
+    let object_bodies = robot.attached.iter().enumerate().map(|(k, object)| {
+        (
+            robot.links.len() + k,
+            sides.object_body(k, object),
+            &object_poses[k],
+        )
+    });
+    for (l, body, pose) in link_bodies.chain(object_bodies) {
         stats.counters.links_with_geometry += 1;
         if decided {
             stats.counters.links_after_decision += 1;
             links.push(after_decision(l));
             continue;
         }
-        let entry = query_link(&scene, (l, geometry, &poses[l]), ws, &mut stats.counters);
+        let entry = query_link(&scene, (l, body, pose), ws, &mut stats.counters);
         decided = request.collide.decide_only
             && entry.queried
             && entry.probability >= request.collide.thresholds.collision;
@@ -404,7 +489,7 @@ pub(crate) fn collide_robot_prepared(
         .collect();
     let probability = aggregate(request.collide.aggregation, &p);
     let self_collisions = if request.self_collision {
-        stats.counters.self_pairs_checked = robot.self_pairs.len();
+        stats.counters.self_pairs_checked = robot.self_pairs.len() + robot.attached_pairs();
         self_collisions(robot, &poses)
     } else {
         Vec::new()
@@ -419,16 +504,16 @@ pub(crate) fn collide_robot_prepared(
     }
 }
 
-/// One link (its index, geometry and world pose) against the cloud: skipped
-/// by the broad phase, or queried.
+/// One body (its entry index, what stands for it and its world pose) against
+/// the cloud: skipped by the broad phase, or queried.
 fn query_link(
     scene: &Scene<'_>,
-    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    (l, body, pose): (usize, Body<'_>, &Pose),
     ws: &mut RobotWorkspace,
     counters: &mut RobotCounters,
 ) -> LinkCollision {
     let request = scene.request;
-    if request.broad_phase && !link_near(scene, (l, geometry, pose), ws, counters) {
+    if request.broad_phase && !link_near(scene, body, pose, ws, counters) {
         return LinkCollision {
             link: l,
             probability: 0.0,
@@ -438,7 +523,7 @@ fn query_link(
         };
     }
     counters.links_queried += 1;
-    match link_query(scene, (l, geometry, pose), ws) {
+    match link_query(scene, (l, body, pose), ws) {
         Ok(r) => {
             counters.node_pairs_visited += r.stats.counters.node_pairs_visited;
             counters.solver_iterations += r.stats.counters.solver_iterations;
@@ -465,13 +550,14 @@ fn query_link(
 /// [`RobotRequest::broad_phase`]); counts the visited nodes.
 fn link_near(
     scene: &Scene<'_>,
-    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    body: Body<'_>,
+    pose: &Pose,
     ws: &mut RobotWorkspace,
     counters: &mut RobotCounters,
 ) -> bool {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
-    let samples = match scene.sides {
-        LinkSides::Exact => {
+    let (link_cloud, aabb, spacing_max, sigma_max) = match body {
+        Body::Exact(geometry) => {
             let (near, visited) = exact_side_may_reach(
                 (&geometry.aabb, pose),
                 cloud,
@@ -481,10 +567,12 @@ fn link_near(
             counters.broad_phase_nodes += visited;
             return near;
         }
-        LinkSides::Sampled(samples) => samples,
-    };
-    let Some(link_cloud) = &samples.clouds[l] else {
-        return false;
+        Body::Cloud {
+            cloud,
+            aabb,
+            spacing_max,
+            sigma_max,
+        } => (cloud, aabb, spacing_max, sigma_max),
     };
     match collide.model {
         // The elements model's own first test: the hierarchies over both
@@ -501,9 +589,10 @@ fn link_near(
             counters.broad_phase_nodes += visited;
             may
         }),
+        // A noisy body's box (a cloud object's) grown by its own noise's reach.
         QueryModel::Points => near_cloud(
-            &geometry.aabb.transformed(pose),
-            samples.spacing_max[l],
+            &grown(&aabb.transformed(pose), sigma_max * scene.reach),
+            spacing_max,
             cloud,
             scene.reach,
             &mut counters.broad_phase_nodes,
@@ -512,22 +601,29 @@ fn link_near(
     }
 }
 
-/// The query of one link that passed the broad phase.
+/// `b` grown by `d` on every side.
+fn grown(b: &Aabb, d: Real) -> Aabb {
+    let mut out = *b;
+    for a in 0..3 {
+        out.mins[a] -= d;
+        out.maxs[a] += d;
+    }
+    out
+}
+
+/// The query of one body that passed the broad phase.
 fn link_query(
     scene: &Scene<'_>,
-    (l, geometry, pose): (usize, &LinkGeometry, &Pose),
+    (l, body, pose): (usize, Body<'_>, &Pose),
     ws: &mut RobotWorkspace,
 ) -> Result<CollisionResult> {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
-    let samples = match scene.sides {
-        LinkSides::Exact => {
+    let link_cloud = match body {
+        Body::Exact(geometry) => {
             return collide_exact_cloud(pose, &geometry.distance, &Pose::identity(), cloud, collide)
         }
-        LinkSides::Sampled(samples) => samples,
+        Body::Cloud { cloud, .. } => cloud,
     };
-    let link_cloud = samples.clouds[l]
-        .as_ref()
-        .ok_or_else(|| Error::invalid("a link with geometry has no sample"))?;
     let warm = ws.warm.as_mut().map(|w| {
         if w.len() <= l {
             w.resize_with(l + 1, WarmStart::default);
@@ -632,7 +728,9 @@ pub(crate) fn check_base(base: &Pose) -> Result<()> {
 
 impl Robot {
     /// Pairs of non-adjacent links whose exact shapes intersect at
-    /// configuration `q` (see [`Robot::self_collision_pairs`]).
+    /// configuration `q` (see [`Robot::self_collision_pairs`]), then attached
+    /// objects that intersect a link other than their holder and touch links
+    /// (see [`Robot::attach`]).
     ///
     /// # Errors
     /// As [`Robot::check_configuration`].
@@ -642,7 +740,9 @@ impl Robot {
     }
 
     /// The self-filter of the robot at `q` (root at `base`, in the cloud's
-    /// frame): every link with geometry, its merged collision mesh at its pose.
+    /// frame): every link with geometry, its merged collision mesh at its
+    /// pose, then every attached object (a mesh object's mesh, a cloud
+    /// object's convex hull) at its pose: the camera sees the held object too.
     ///
     /// # Errors
     /// As [`Robot::check_configuration`] and [`crate::filter::SelfFilter::new`];
@@ -655,11 +755,18 @@ impl Robot {
     ) -> Result<crate::filter::SelfFilter> {
         check_base(base)?;
         let poses = self.link_poses(q, base)?;
+        let object_poses = self.attached_poses_from(&poses);
         let links: Vec<_> = self
             .links
             .iter()
             .zip(&poses)
             .filter_map(|(l, p)| l.geometry.as_ref().map(|g| (g.mesh.clone(), *p)))
+            .chain(
+                self.attached
+                    .iter()
+                    .zip(&object_poses)
+                    .map(|(o, p)| (o.geometry.mesh.clone(), *p)),
+            )
             .collect();
         if links.is_empty() {
             return Err(Error::invalid(format!(

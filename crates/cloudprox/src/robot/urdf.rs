@@ -384,6 +384,7 @@ impl Robot {
             self_pairs: Vec::new(),
             ignored_pairs: Vec::new(),
             motion_weights: Vec::new(),
+            attached: Vec::new(),
             samples: Mutex::new(Vec::new()),
         };
         robot.compute_motion_weights();
