@@ -40,11 +40,12 @@ fn coverage(results: &[(DistanceResult, f64)]) -> (f64, f64) {
     (inside as f64 / results.len() as f64, worst)
 }
 
-// The target (within 2 std in >= 95 % of the draws) is not met yet: 82.5 %
-// of 40 draws (mean 10.19 mm, spread 0.87 mm across draws, stated std
-// 0.23-1.08 mm): the pooled field's std is too small in a few draws.
+// The target (within 2 std in >= 95 % of the draws) is not met yet: 85 %
+// of 40 draws (mean 10.22 mm, spread 0.77 mm across draws, stated std
+// 0.32-1.42 mm): plane elements on the curved spheres lie inside them by
+// their sag, which their variance does not hold.
 #[test]
-#[ignore = "target not met yet: 82.5 % of draws within 2 std"]
+#[ignore = "target not met yet: 85 % of draws within 2 std"]
 fn two_noisy_spheres_10_mm_apart_are_read_within_two_std() {
     let results: Vec<(DistanceResult, f64)> = (0..DRAWS)
         .map(|k| {

@@ -42,12 +42,12 @@ const HUBER: Real = 2.0;
 /// (fewer than three, or one without a positive finite standard deviation).
 ///
 /// The gap over the contact is fitted by weighted least squares as a
-/// constant, a plane or a quadric in the contact's two widest directions,
-/// whichever has the smallest Akaike criterion (`chi^2 + 2k`; a flat contact
-/// is a constant, two spheres a quadric), robustly (Huber weights, so that a
-/// few readings off the field do not move it). The covariance of the field is
-/// scaled by the fit's reduced `chi^2` where it exceeds 1 (readings spread
-/// more than their stated deviations). `P` is the largest `Phi(-g / s)` of
+/// constant, a plane and a quadric in the contact's two widest directions,
+/// robustly (Huber weights, so that a few readings off the field do not move
+/// it), each fit's covariance scaled by its reduced `chi^2` where it exceeds 1
+/// (readings spread more than their stated deviations), and the three are
+/// averaged with their Akaike weights ([`Averaged`]; a flat contact reads
+/// mostly as a constant, two spheres as a quadric). `P` is the largest `Phi(-g / s)` of
 /// the field at the readings' places, and of every reading lying more than
 /// [`BELOW_FIELD_SDS`] below it or reading a crossing of more than
 /// [`CROSSED_SDS`] (where the surfaces truly come closer than a smooth field
@@ -101,43 +101,43 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
     let coords = contact_coordinates(samples);
     let r = DVector::from_iterator(n, samples.iter().map(|s| s.gap));
     let w0 = DVector::from_iterator(n, samples.iter().map(|s| 1.0 / (s.std * s.std)));
-    let fit = [1usize, 3, 6]
-        .into_iter()
-        .filter(|&k| n >= k + 2)
-        .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
-        .min_by(|a, b| a.criterion().total_cmp(&b.criterion()))?;
-    let scale = (fit.chi2 / fit.dof).max(1.0);
-    // The field's gap at a design row and its standard deviation.
-    let at = |row: &DMatrix<Real>, sample: usize| {
-        let g = (row * &fit.beta)[0];
-        let var = (row * &fit.inverse * row.transpose())[0] * scale;
+    let field = Averaged::new(
+        [1usize, 3, 6]
+            .into_iter()
+            .filter(|&k| n >= k + 2)
+            .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
+            .collect(),
+    )?;
+    let at = |u: [Real; 2], sample: usize| {
+        let (gap, var) = field.at(u);
         FieldTerm {
-            gap: g,
+            gap,
             std: var.max(0.0).sqrt(),
             sample,
         }
     };
     let mut terms = Vec::with_capacity(n + 1);
-    if let Some(c) = fit.lowest(&coords) {
+    if let Some(c) = field.lowest(&coords) {
         let nearest = (0..n)
             .min_by(|&i, &j| {
                 let d = |k: usize| (coords[k][0] - c[0]).hypot(coords[k][1] - c[1]);
                 d(i).total_cmp(&d(j))
             })
             .unwrap_or(0);
-        terms.push(at(&design(&[c], fit.beta.len()), nearest));
+        terms.push(at(c, nearest));
     }
+    let scale = field.best_scale();
     for i in 0..n {
-        let field = at(&fit.a.rows(i, 1).into_owned(), i);
+        let term = at(coords[i], i);
         let s = samples[i].std;
-        if (r[i] - field.gap) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
+        if (r[i] - term.gap) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
             terms.push(FieldTerm {
                 gap: r[i],
                 std: s,
                 sample: i,
             });
         }
-        terms.push(field);
+        terms.push(term);
     }
     Some(terms)
 }
@@ -181,6 +181,65 @@ fn design(coords: &[[Real; 2]], k: usize) -> DMatrix<Real> {
         let [u, v] = coords[i];
         height_row(u, v)[j]
     })
+}
+
+/// The gap fields of every order that could be fitted, averaged with their
+/// Akaike weights (`exp(-criterion / 2)`, normalized): the field at a place
+/// is the weighted mean of the fits' gaps, and its variance the weighted
+/// mean of their variances plus their spread about the mean (the law of
+/// total variance), so that which order the readings support is part of the
+/// field's uncertainty rather than a choice made and then forgotten (a flat
+/// fit of a curved contact that wins the criterion by a little would state
+/// its pooled deviation about a gap biased by the curvature it left out).
+struct Averaged {
+    fits: Vec<Fit>,
+    weights: Vec<Real>,
+}
+
+impl Averaged {
+    /// The average of `fits`; `None` without one.
+    fn new(fits: Vec<Fit>) -> Option<Self> {
+        let best = fits.iter().map(Fit::criterion).min_by(Real::total_cmp)?;
+        let raw: Vec<Real> = fits
+            .iter()
+            .map(|f| (-0.5 * (f.criterion() - best)).exp())
+            .collect();
+        let total: Real = raw.iter().sum();
+        Some(Self {
+            weights: raw.iter().map(|w| w / total).collect(),
+            fits,
+        })
+    }
+
+    /// The averaged field's gap and variance at contact coordinates `u`.
+    fn at(&self, u: [Real; 2]) -> (Real, Real) {
+        let row = height_row(u[0], u[1]);
+        let each: Vec<(Real, Real)> = self.fits.iter().map(|f| f.at(&row)).collect();
+        let mean: Real = each
+            .iter()
+            .zip(&self.weights)
+            .map(|((g, _), w)| w * g)
+            .sum();
+        let var = each
+            .iter()
+            .zip(&self.weights)
+            .map(|((g, v), w)| w * (v + (g - mean) * (g - mean)))
+            .sum();
+        (mean, var)
+    }
+
+    /// The variance scale (reduced `chi^2`, at least 1) of the best fit.
+    fn best_scale(&self) -> Real {
+        let best = (0..self.fits.len())
+            .max_by(|&i, &j| self.weights[i].total_cmp(&self.weights[j]))
+            .unwrap_or(0);
+        self.fits[best].scale()
+    }
+
+    /// Where the quadric field is lowest ([`Fit::lowest`]), when one was fitted.
+    fn lowest(&self, coords: &[[Real; 2]]) -> Option<[Real; 2]> {
+        self.fits.iter().find_map(|f| f.lowest(coords))
+    }
 }
 
 /// A weighted least-squares fit of the gap field.
@@ -254,6 +313,22 @@ impl Fit {
         })
     }
 
+    /// The variance scale: the reduced `chi^2` where it exceeds 1
+    /// (readings spread more than their stated deviations), else 1.
+    fn scale(&self) -> Real {
+        (self.chi2 / self.dof).max(1.0)
+    }
+
+    /// The fitted gap and its variance at the terms `row` of
+    /// `(1, u, v, u^2, u v, v^2)` (the fit's first ones).
+    fn at(&self, row: &nalgebra::SVector<Real, 6>) -> (Real, Real) {
+        let k = self.beta.len();
+        let x = row.rows(0, k);
+        let gap = x.dot(&self.beta);
+        let var = (x.transpose() * &self.inverse * x)[0] * self.scale();
+        (gap, var)
+    }
+
     /// The model selection criterion of the fit (Akaike's, `chi^2 + 2k`,
     /// scaled by `CRITERION_PER_TERM`).
     fn criterion(&self) -> Real {
@@ -298,11 +373,24 @@ mod tests {
 
     #[test]
     fn a_flat_contact_reads_its_pooled_gap() {
-        // 25 readings of one gap: the pooled deviation is s / 5.
+        // 25 readings of one gap: a constant field's pooled deviation is
+        // s / 5, where one reading's is s; the plane and quadric fits, which
+        // the criterion weighs less, widen it away from the readings' centre.
         let s = 1e-3;
+        let terms = field_terms(&grid(5, |_, _| 1e-3, s)).unwrap();
+        let centre = terms.iter().find(|t| t.sample == 12).unwrap();
+        assert!((centre.gap - 1e-3).abs() < 1e-12, "{centre:?}");
+        assert!(
+            centre.std > s / 5.0 && centre.std < 1.2 * s / 5.0,
+            "{centre:?}"
+        );
         let p = field_probability(&grid(5, |_, _| 1e-3, s)).unwrap();
-        let want = crate::probability::normal_cdf(-1e-3 / (s / 5.0));
-        assert!((p - want).abs() < 1e-9, "P {p} vs {want}");
+        let pooled = crate::probability::normal_cdf(-1e-3 / (s / 5.0));
+        let one = crate::probability::normal_cdf(-1e-3 / s);
+        assert!(
+            p > pooled && p < 1e-3 * one,
+            "P {p}: pooled {pooled}, one reading {one}"
+        );
     }
 
     #[test]
