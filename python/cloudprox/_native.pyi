@@ -37,6 +37,7 @@ __all__ = [
     "MeshDistance",
     "MeshSample",
     "MotionResult",
+    "Occlusion",
     "PointCloud",
     "Proximity",
     "ProximityBatch",
@@ -1720,6 +1721,58 @@ def shadow_filter(
     k: int | None = None,
 ) -> _IntArray:
     """Return the indices of the points kept by the veil filter (see :mod:`cloudprox.filters`)."""
+
+@final
+class Occlusion:
+    """What a scan did not see: the space behind its observed surfaces.
+
+    A single view observes the first surface along each ray from the sensor;
+    space in front of it is seen to be free, space behind it is unknown, not
+    free (a collision there leaves no point in the scan). ``Occlusion`` keeps
+    the nearest return per viewing direction (a cube map of the rays, cells
+    of twice the scan's median angular spacing unless ``cell`` is given) and
+    tells where any point lies as the scan saw it.
+
+    Parameters
+    ----------
+    scan : PointCloud
+        The scan; its sensor covariances give the range noise along each ray.
+    origin : array_like, shape (3,)
+        The sensor's origin, in the scan's frame.
+    cell : float, optional
+        The angular cell in radians (> 0).
+
+    Raises
+    ------
+    InvalidInputError
+        A scan that is not a ``PointCloud``, a non-finite origin, a scan point
+        at the origin (a no-return point) or a cell that is not positive.
+    """
+
+    def __new__(
+        cls, scan: PointCloud, origin: npt.ArrayLike, *, cell: float | None = None
+    ) -> Occlusion: ...
+    @property
+    def cell(self) -> float:
+        """The angular cell in radians."""
+    def hidden_probability(self, points: npt.ArrayLike, depth: float | None = None) -> _FloatArray:
+        """Return, per point (``(n, 3)``, the scan's frame), the probability that it lies behind the observed surface.
+
+        ``Phi((|x - o| - r) / s)``, with ``r`` the nearest return of the
+        point's direction's cell and ``s`` that
+        range's standard deviation; 0 along a direction without a return.
+        With ``depth`` (metres, > 0): behind it by at most ``depth``, inside
+        an object seen from the front whose thickness is at most ``depth``
+        (``Phi((d - r) / s) - Phi((d - r - depth) / s)``).
+        """
+    def visibility(self, points: npt.ArrayLike) -> list[Literal["seen", "hidden", "unobserved"]]:
+        """Return each point as the scan saw it: ``"seen"``, ``"hidden"`` or ``"unobserved"``.
+
+        ``"seen"``: in front of the observed surface along its ray (seen to be
+        free); ``"hidden"``: behind it (``hidden_probability > 0.5``);
+        ``"unobserved"``: no return along its direction (outside the field of
+        view, beyond the sensor's range, no-return pixels).
+        """
 
 @final
 class SelfFilter:

@@ -12,7 +12,11 @@ about 0.9 s on two cores (see BENCHMARKS.md).
 - :func:`voxel_downsample`: one point per voxel, covariances merged, as PCL
   ``VoxelGrid``;
 - :func:`statistical_outlier_removal`: isolated points, as PCL
-  ``StatisticalOutlierRemoval``.
+  ``StatisticalOutlierRemoval``;
+- :class:`Occlusion`: not a filter but its complement, what the scan did not
+  see: whether a point lies in front of the observed surface along its
+  viewing ray, behind it (in its shadow, with the probability under the
+  range noise) or along a direction with no return.
 
 Filters that remove points return the **indices of the kept points** (int64,
 ascending), so that points, covariances and pixels can be subset alike::
@@ -33,6 +37,7 @@ from __future__ import annotations
 from cloudprox._native import (
     SOR_DEFAULT_K,
     SOR_DEFAULT_STD_RATIO,
+    Occlusion,
     SelfFilter,
     crop_box,
     shadow_filter,
@@ -43,6 +48,7 @@ from cloudprox._native import (
 __all__ = [
     "SOR_DEFAULT_K",
     "SOR_DEFAULT_STD_RATIO",
+    "Occlusion",
     "SelfFilter",
     "crop_box",
     "shadow_filter",

@@ -41,6 +41,7 @@ mod exact_side;
 mod filter;
 mod io;
 mod mesh;
+mod occlusion;
 mod pose;
 mod request;
 mod result;
@@ -73,6 +74,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::PyProximityBatch>()?;
     m.add_class::<filter::PyVoxels>()?;
     m.add_class::<filter::PySelfFilter>()?;
+    m.add_class::<occlusion::PyOcclusion>()?;
     m.add_function(wrap_pyfunction!(filter::crop_box, m)?)?;
     m.add_function(wrap_pyfunction!(filter::voxel_downsample, m)?)?;
     m.add_function(wrap_pyfunction!(filter::statistical_outlier_removal, m)?)?;

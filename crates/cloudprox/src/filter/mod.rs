@@ -7,6 +7,7 @@
 //! | crop box | [`crop_box`] | PCL `CropBox` |
 //! | voxel downsampling | [`voxel_downsample`] | PCL `VoxelGrid` |
 //! | statistical outliers | [`statistical_outlier_removal`] | PCL `StatisticalOutlierRemoval` |
+//! | what the sensor did not see (space behind the observed surfaces) | [`Occlusion`] | OctoMap's unknown space |
 //!
 //! Filters that only remove points return the **indices of the kept points, in
 //! ascending order** (`Vec<u32>`), so that the caller can subset points,
@@ -26,12 +27,14 @@
 //! parameter out of its domain gives [`crate::Error::InvalidInput`] naming it.
 
 mod crop_box;
+mod occlusion;
 mod outlier;
 mod self_filter;
 mod shadow;
 mod voxel;
 
 pub use crop_box::crop_box;
+pub use occlusion::{Occlusion, Visibility};
 pub use outlier::{statistical_outlier_removal, SOR_DEFAULT_K, SOR_DEFAULT_STD_RATIO};
 pub use self_filter::{SelfFilter, SELF_FILTER_DEFAULT_PADDING};
 pub use shadow::{shadow_filter, ShadowSettings};
