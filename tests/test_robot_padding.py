@@ -78,11 +78,23 @@ def test_bad_padding_names_the_problem(arm: cp.Robot, bad: float) -> None:
         cp.collide_robot(arm, Q0, cloud, padding={"link2": bad})
 
 
-def test_padding_unknown_link_wrong_type_and_sampled(arm: cp.Robot) -> None:
+def test_padding_unknown_link_and_wrong_type(arm: cp.Robot) -> None:
     cloud = facing(0.01)
     with pytest.raises(cp.InvalidInputError, match="'gripper', which robot 'arm' does not have"):
         cp.collide_robot(arm, Q0, cloud, padding={"gripper": 0.01})
     with pytest.raises(cp.InvalidInputError, match="float"):
         cp.collide_robot(arm, Q0, cloud, padding="1cm")
-    with pytest.raises(cp.InvalidInputError, match="mesh_side 'exact'"):
-        cp.collide_robot(arm, Q0, cloud, padding=0.01, mesh_side="sampled")
+
+
+def test_padding_moves_sampled_links_samples(arm: cp.Robot) -> None:
+    def p(clearance: float, padding: float) -> float:
+        r = cp.collide_robot(
+            arm, Q0, facing(clearance), mesh_side="sampled", mesh_spacing=0.005, padding=padding
+        )
+        return r.links["base"].probability
+
+    # Two sampled sheets read contact only where they meet, and not
+    # monotonically within a millimetre of it: compare at touching.
+    assert p(0.008, 0.0) < 1e-6
+    assert p(0.008, 0.008) > 0.2
+    assert p(0.0, 0.0) > 0.2

@@ -2205,9 +2205,11 @@ def collide_robot(
     ``allowed_links``; unknown names raise :class:`InvalidInputError`. The GIL
     is released.
 
-    ``padding`` (metres, default 0) grows each exact link's surface by a safety
-    margin: a float for every link, or a dict from link name to metres for the
-    links it names (the others unpadded); attached objects are not padded.
+    ``padding`` (metres, default 0) grows each link's surface by a safety margin
+    (an exact link's signed distance less it; a sampled link's samples moved
+    along their faces' normals): a float for every link, or a dict from link name
+    to metres for the links it names (the others unpadded); attached objects are
+    not padded.
 
     ``target`` is an object about to be grasped, still in the scene: a
     :class:`PointCloud` (in the cloud's frame) or a :class:`Mesh` at

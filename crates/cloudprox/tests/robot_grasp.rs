@@ -191,6 +191,42 @@ fn robot_padding_d_at_clearance_c_reads_as_clearance_c_minus_d() {
 }
 
 #[test]
+fn robot_padding_moves_a_sampled_links_samples_along_its_normals() {
+    // The base's face x = 0.1 sampled: its samples on that face move to
+    // x = 0.1 + d, so the padded base at clearance c reads about as the bare
+    // base at c - d (its other faces' samples move too, elsewhere).
+    let sampled = |padding: f64, clearance: f64| {
+        let cloud = wall(0.1 + clearance, 0.0, 0.03, SIGMA, 6);
+        let req = RobotRequest {
+            mesh_side: MeshSide::Sampled,
+            mesh_spacing: Some(0.005),
+            self_collision: false,
+            padding,
+            ..RobotRequest::default()
+        };
+        link_p(&query(&cloud, &req), 0)
+    };
+    // Two sampled sheets read contact only where they meet (a wall pressed
+    // in parallel to a face is a second sheet, separable from it), and not
+    // monotonically within a millimetre of it: compare at touching.
+    let c = 0.008;
+    assert!(sampled(0.0, c) < 1e-6);
+    let (padded, touching) = (sampled(c, c), sampled(0.0, 0.0));
+    assert!(padded > 0.2 && touching > 0.2, "{padded} {touching}");
+    assert_eq!(sampled(0.0, c).to_bits(), {
+        let cloud = wall(0.1 + c, 0.0, 0.03, SIGMA, 6);
+        let req = RobotRequest {
+            mesh_side: MeshSide::Sampled,
+            mesh_spacing: Some(0.005),
+            self_collision: false,
+            link_padding: vec![("base".into(), 0.0)],
+            ..RobotRequest::default()
+        };
+        link_p(&query(&cloud, &req), 0).to_bits()
+    });
+}
+
+#[test]
 fn robot_padding_by_link_name_pads_that_link_only() {
     // A wall near both the base (x = 0.1) and nothing else: padding link3
     // changes nothing; padding the base raises its P.
@@ -251,12 +287,6 @@ fn robot_padding_and_target_bad_inputs_name_the_problem() {
         e.contains("'gripper'") && e.contains("does not have"),
         "{e}"
     );
-    let e = err(RobotRequest {
-        padding: 0.01,
-        mesh_side: MeshSide::Sampled,
-        ..RobotRequest::default()
-    });
-    assert!(e.contains("mesh_side 'exact'"), "{e}");
     let e = err(with_target(wall(0.3, 0.3, 0.02, SIGMA, 1), &["finger"]));
     assert!(e.contains("allowed_links names 'finger'"), "{e}");
 }

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::attached::AttachedObject;
-use super::geometry::{samples_at, LinkGeometry, LinkSamples};
+use super::geometry::{sample_padded, samples_at, LinkGeometry, LinkSamples};
 use super::model::Robot;
 use super::target::{check_padding, resolve, GraspTarget, TargetCollision};
 use crate::bvh::{Aabb, BvhWorkspace};
@@ -63,7 +63,10 @@ pub struct RobotRequest {
     pub self_collision: bool,
     /// A safety margin (metres, finite and `>= 0`; default 0) added to every
     /// link's surface: each link is queried as its surface grown by it, its
-    /// signed distance less the padding (exact links only). It is
+    /// signed distance less the padding (exact links); a sampled link's
+    /// samples move that far along their faces' outward normals (the faces'
+    /// offsets, without the exact offset's rounded edges; sampled again for
+    /// each query call, once for a batch or a motion). It is
     /// deterministic: the sensor noise is already in `P`, so a padding `d`
     /// shifts `P`'s curve by `d / sigma` standard deviations; keep it for
     /// model error (kinematic calibration, mesh simplification). Attached
@@ -104,21 +107,15 @@ impl RobotRequest {
     /// and positive, or given with [`MeshSide::Exact`] (nothing is sampled);
     /// the `surface` aggregation with the points model and an exact side (it
     /// reads a trained surface around each point); a padding that is not
-    /// finite and `>= 0`, or a positive one with [`MeshSide::Sampled`] (a
-    /// sample has no surface to grow). Link names are checked against the
-    /// robot by the queries.
+    /// finite and `>= 0`. Link names are checked against the robot by the
+    /// queries.
     pub fn validate(&self) -> Result<()> {
         self.collide.validate()?;
         check_padding(self.padding, "padding")?;
         for (name, d) in &self.link_padding {
             check_padding(*d, &format!("padding of link '{name}'"))?;
         }
-        let padded = self.padding > 0.0 || self.link_padding.iter().any(|(_, d)| *d > 0.0);
-        if padded && self.mesh_side == MeshSide::Sampled {
-            return Err(Error::invalid(
-                "padding grows the links' exact surfaces: it needs mesh_side 'exact'",
-            ));
-        }
+
         if let Some(s) = self.mesh_spacing {
             if !(s.is_finite() && s > 0.0) {
                 return Err(Error::invalid(format!(
@@ -385,6 +382,18 @@ pub(crate) struct LinkSides {
     padding: Vec<Real>,
     /// The grasp target's cloud and, per entry, whether it may touch it.
     target: Option<(Arc<PointCloud>, Vec<bool>)>,
+    /// Sampled links only, per link with a positive padding: its padded
+    /// sample.
+    padded: Vec<Option<PaddedSample>>,
+}
+
+/// A sampled link's sample moved along its faces' normals by its padding.
+#[derive(Debug)]
+struct PaddedSample {
+    cloud: PointCloud,
+    /// The link's bounding box grown by the padding.
+    aabb: Aabb,
+    spacing_max: Real,
 }
 
 impl LinkSides {
@@ -409,10 +418,31 @@ impl LinkSides {
             request.target.as_ref(),
             || link_spacing(request, cloud),
         )?;
+        let mut padded: Vec<Option<PaddedSample>> = Vec::new();
+        if matches!(kind, SideKind::Sampled(_)) {
+            let spacing = link_spacing(request, cloud)?;
+            for (link, &d) in robot.links.iter().zip(&resolved.padding) {
+                let sample = match &link.geometry {
+                    Some(g) if d > 0.0 => {
+                        let what = format!("link '{}'", link.name);
+                        let (cloud, spacing_max) = sample_padded(g, spacing, d, &what)?;
+                        let _ = cloud.bvh();
+                        Some(PaddedSample {
+                            cloud,
+                            aabb: grown(&g.aabb, d),
+                            spacing_max,
+                        })
+                    }
+                    _ => None,
+                };
+                padded.push(sample);
+            }
+        }
         Ok(LinkSides {
             kind,
             padding: resolved.padding,
             target: resolved.target,
+            padded,
         })
     }
 
@@ -437,6 +467,9 @@ impl LinkSides {
                 for link_cloud in samples.clouds.iter().flatten() {
                     prepare(link_cloud, request);
                 }
+                for p in self.padded.iter().flatten() {
+                    prepare(&p.cloud, request);
+                }
                 for (object_cloud, _) in samples.attached.iter().flatten() {
                     prepare(object_cloud, request);
                 }
@@ -446,6 +479,14 @@ impl LinkSides {
 
     /// What stands for link `l` (with geometry `g`) in a query.
     fn link_body<'a>(&'a self, l: usize, g: &'a LinkGeometry) -> Body<'a> {
+        if let Some(Some(p)) = self.padded.get(l) {
+            return Body::Cloud {
+                cloud: &p.cloud,
+                aabb: &p.aabb,
+                spacing_max: p.spacing_max,
+                sigma_max: 0.0,
+            };
+        }
         match &self.kind {
             SideKind::Exact => Body::Exact(g, self.padding[l]),
             SideKind::Sampled(samples) => match &samples.clouds[l] {
