@@ -9,6 +9,8 @@ wall far away, so that everything the robot reads comes from the target.
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -83,6 +85,12 @@ def test_batches_and_motions_count_the_target(arm: cp.Robot, scene: cp.PointClou
     denied = cp.collide_robot_many(arm, [Q0, away], scene, target=target)
     assert list(allowed.states) == ["free", "free"]
     assert list(denied.states) == ["collision", "free"]
+    assert allowed.target_probabilities is not None
+    assert allowed.target_probabilities[0] > 0.99
+    assert allowed.target_probabilities[1] < 1e-6
+    assert cp.collide_robot_many(arm, [Q0], scene).target_probabilities is None
+    again = pickle.loads(pickle.dumps(allowed))
+    np.testing.assert_array_equal(again.target_probabilities, allowed.target_probabilities)
     assert cp.check_motion(arm, away, Q0, scene, target=target, allowed_links=FINGERS).safe
     assert not cp.check_motion(arm, away, Q0, scene, target=target).safe
 

@@ -2130,11 +2130,15 @@ class RobotBatchResult:
     @property
     def link_probabilities(self) -> _FloatArray:
         """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order (attached objects enter ``probabilities`` only)."""
+    @property
+    def target_probabilities(self) -> _FloatArray | None:
+        """With a grasp target (``target=``): the allowed links' contact probability with it, shape ``(m,)``; else ``None``."""
     @staticmethod
     def _from_state(
-        state: tuple[list[float], list[str], list[bool], list[float], int],
+        state: tuple[list[float], list[str], list[bool], list[float], int]
+        | tuple[list[float], list[str], list[bool], list[float], int, list[float] | None],
     ) -> RobotBatchResult:
-        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links)``."""
+        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links[, target_probabilities])``."""
     def __len__(self) -> int: ...
 
 @final

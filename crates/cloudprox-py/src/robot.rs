@@ -11,6 +11,7 @@ use cloudprox::robot::{
     collide_robot_many as core_collide_robot_many, AttachedShape, GraspTarget, LinkCollision,
     MotionRequest, Robot, RobotCollisionResult, RobotCounters, RobotStats, TargetCollision,
 };
+use cloudprox::Real;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyTuple};
@@ -1153,12 +1154,24 @@ pub struct PyRobotBatchResult {
     probabilities: Vec<f64>,
     states: Vec<&'static str>,
     self_colliding: Vec<bool>,
+    /// With a grasp target: per configuration, the allowed links' contact
+    /// probability with it.
+    target_probabilities: Option<Vec<f64>>,
     link_probabilities: Vec<f64>,
     n_links: usize,
 }
 
 /// The pickled form of a `RobotBatchResult`.
-type BatchState = (Vec<f64>, Vec<String>, Vec<bool>, Vec<f64>, usize);
+type BatchState = (
+    Vec<f64>,
+    Vec<String>,
+    Vec<bool>,
+    Vec<f64>,
+    usize,
+    Option<Vec<f64>>,
+);
+/// The state of a batch result pickled before grasp targets.
+type BatchStateV1 = (Vec<f64>, Vec<String>, Vec<bool>, Vec<f64>, usize);
 
 #[pymethods]
 impl PyRobotBatchResult {
@@ -1171,14 +1184,19 @@ impl PyRobotBatchResult {
             me.self_colliding.clone(),
             me.link_probabilities.clone(),
             me.n_links,
+            me.target_probabilities.clone(),
         );
         Ok((slf.getattr("_from_state")?, (state,)))
     }
 
     /// Rebuilds a pickled batch result (see `__reduce__`).
     #[staticmethod]
-    fn _from_state(py: Python<'_>, state: BatchState) -> PyResult<Self> {
-        let (probabilities, states, self_colliding, link_probabilities, n_links) = state;
+    fn _from_state(py: Python<'_>, state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let state: BatchState = match state.extract::<BatchStateV1>() {
+            Ok((p, s, c, l, n)) => (p, s, c, l, n, None),
+            Err(_) => state.extract()?,
+        };
+        let (probabilities, states, self_colliding, link_probabilities, n_links, target) = state;
         let states = states
             .iter()
             .map(|s| crate::result::state_name(py, s))
@@ -1186,6 +1204,9 @@ impl PyRobotBatchResult {
         if states.len() != probabilities.len()
             || self_colliding.len() != probabilities.len()
             || link_probabilities.len() != probabilities.len() * n_links
+            || target
+                .as_ref()
+                .is_some_and(|t| t.len() != probabilities.len())
         {
             return Err(invalid_input(
                 py,
@@ -1196,9 +1217,18 @@ impl PyRobotBatchResult {
             probabilities,
             states,
             self_colliding,
+            target_probabilities: target,
             link_probabilities,
             n_links,
         })
+    }
+
+    /// `(m,)` with a grasp target (`target=`): the allowed links' contact
+    /// probability with it per configuration (not in `probabilities`); `None`
+    /// without a target.
+    #[getter]
+    fn target_probabilities<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.target_probabilities.as_ref().map(|t| vec_to_py(py, t))
     }
 
     /// `(m,)` collision probabilities.
@@ -1256,6 +1286,7 @@ pub fn collide_robot_many(
 ) -> PyResult<PyRobotBatchResult> {
     let robot = robot_arg(robot)?;
     let request = motion_request(py, request, options, false)?.robot;
+    let has_target = request.target.is_some();
     let qs = configs_from(&robot, qs, "qs")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
@@ -1278,6 +1309,12 @@ pub fn collide_robot_many(
             .iter()
             .map(RobotCollisionResult::self_colliding)
             .collect(),
+        target_probabilities: has_target.then(|| {
+            results
+                .iter()
+                .map(|r| r.target.map_or(Real::NAN, |t| t.probability))
+                .collect()
+        }),
         link_probabilities,
         n_links,
     })
