@@ -98,3 +98,13 @@ def test_padding_moves_sampled_links_samples(arm: cp.Robot) -> None:
     assert p(0.008, 0.0) < 1e-6
     assert p(0.008, 0.008) > 0.2
     assert p(0.0, 0.0) > 0.2
+
+
+def test_padding_refuses_attached_objects(arm: cp.Robot) -> None:
+    holding = arm.attach("link3", cp.Mesh.cuboid(0.02, 0.02, 0.02), name="box")
+    with pytest.raises(cp.InvalidInputError, match="attached objects are not padded"):
+        cp.collide_robot(holding, Q0, facing(0.01), padding={"box": 0.01})
+    # A float pads the links only: the held box reads as without padding.
+    padded = cp.collide_robot(holding, Q0, facing(0.01), padding=0.001)
+    plain = cp.collide_robot(holding, Q0, facing(0.01))
+    assert padded.links["box"].probability == plain.links["box"].probability

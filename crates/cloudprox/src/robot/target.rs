@@ -33,6 +33,40 @@ pub enum TargetObject {
 /// An object the robot is about to grasp, still in the scene: the links of
 /// `allowed_links` may touch it, every other link is checked against it as
 /// against the environment (see [`RobotRequest::target`](super::RobotRequest::target)).
+///
+/// # Example
+/// ```
+/// use std::sync::Arc;
+/// use cloudprox::prelude::*;
+/// use cloudprox::robot::{collide_robot, GraspTarget, Robot, RobotRequest};
+/// let urdf = r#"<robot name="hand"><link name="finger"><collision>
+///     <geometry><box size="0.02 0.02 0.02"/></geometry></collision></link></robot>"#;
+/// let robot = Robot::from_urdf_str(urdf, "hand.urdf", None, &[]).unwrap();
+/// // A patch of the plane x = x0 (2 mm grid, 1 mm noise).
+/// let patch = |x0: f64| {
+///     let points = (0..49)
+///         .map(|i| Point3::new(x0, (i % 7) as f64 * 0.002 - 0.006, (i / 7) as f64 * 0.002 - 0.006))
+///         .collect();
+///     PointCloud::from_sigma(points, 0.001).unwrap()
+/// };
+/// // The object on the finger's face x = 0.01; the rest of the scene far away.
+/// let object = Arc::new(patch(0.009));
+/// let scene = patch(1.0);
+/// let allowed = RobotRequest {
+///     target: Some(GraspTarget::cloud(Arc::clone(&object), vec!["finger".into()])),
+///     ..RobotRequest::default()
+/// };
+/// let r = collide_robot(&robot, &[], &Pose::identity(), &scene, &allowed).unwrap();
+/// assert_eq!(r.state, CollisionState::Free);
+/// assert_eq!(r.target.unwrap().state, CollisionState::Collision);
+/// // Not allowed: the object counts as the scene does.
+/// let denied = RobotRequest {
+///     target: Some(GraspTarget::cloud(object, Vec::new())),
+///     ..RobotRequest::default()
+/// };
+/// let r = collide_robot(&robot, &[], &Pose::identity(), &scene, &denied).unwrap();
+/// assert_eq!(r.state, CollisionState::Collision);
+/// ```
 #[derive(Debug, Clone)]
 pub struct GraspTarget {
     /// The object.
@@ -117,6 +151,11 @@ fn resolve_padding(
     out.resize(links + robot.attached.len(), 0.0);
     for (name, d) in link_padding {
         let Some(i) = robot.link_index(name) else {
+            if robot.attached_index(name).is_some() {
+                return Err(Error::invalid(format!(
+                    "padding names attached object '{name}': attached objects are not padded"
+                )));
+            }
             return Err(Error::invalid(format!(
                 "padding names link '{name}', which robot '{}' does not have",
                 robot.name
