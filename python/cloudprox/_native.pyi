@@ -2088,7 +2088,7 @@ class RobotStats:
         """Links with geometry, and attached objects."""
     @property
     def links_queried(self) -> int:
-        """Links queried against the cloud (the others skipped by the broad phase or the decision)."""
+        """Links queried against the cloud (the others skipped by the broad phase or the decision), plus, with a grasp target, those queried against it."""
     @property
     def links_after_decision(self) -> int:
         """With ``decide_only``, the links left once one reached the collision threshold."""

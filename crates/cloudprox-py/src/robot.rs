@@ -942,7 +942,8 @@ stats_class! {
         /// Links with geometry, and attached objects.
         links_with_geometry: usize,
         /// Links queried against the cloud (the others were skipped by the broad
-        /// phase, or left once the query was decided).
+        /// phase, or left once the query was decided), plus, with a grasp
+        /// target, those queried against it.
         links_queried: usize,
         /// Links left unqueried because an earlier link's probability had reached
         /// the collision threshold (``decide_only`` only).

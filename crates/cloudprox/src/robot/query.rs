@@ -115,7 +115,6 @@ impl RobotRequest {
         for (name, d) in &self.link_padding {
             check_padding(*d, &format!("padding of link '{name}'"))?;
         }
-
         if let Some(s) = self.mesh_spacing {
             if !(s.is_finite() && s > 0.0) {
                 return Err(Error::invalid(format!(
@@ -187,7 +186,8 @@ pub struct RobotCounters {
     /// Links with geometry, and attached objects.
     pub links_with_geometry: usize,
     /// Links queried against the cloud (the others were skipped by the broad
-    /// phase, or left once the query was decided).
+    /// phase, or left once the query was decided), plus, with a grasp target,
+    /// those queried against it.
     pub links_queried: usize,
     /// Links left unqueried because an earlier link's probability had reached
     /// the collision threshold (`decide_only` only).
