@@ -51,6 +51,7 @@ __all__ = [
     "SelfFilter",
     "SolverError",
     "StereoCamera",
+    "TargetCollision",
     "Voxels",
     "__version__",
     "_read_mesh_counted",
@@ -254,6 +255,17 @@ class PointCloud:
     @staticmethod
     def _from_state(state: tuple[Any, ...]) -> PointCloud:
         """Rebuild a pickled cloud (pickle support; the state comes from ``__reduce__``)."""
+    def select_by_index(self, indices: npt.ArrayLike, invert: bool = False) -> PointCloud:
+        """Return a new cloud of the points at ``indices`` (with ``invert``, of the others).
+
+        Each point keeps its sensor covariance and the cloud its noise
+        correlation; a discretization covariance is estimated again from the kept
+        points' neighbours. An index out of range, a boolean mask (pass
+        ``numpy.flatnonzero(mask)``) or an empty selection raise
+        :class:`InvalidInputError`. :func:`cloudprox.filters.split_box` and
+        :func:`cloudprox.filters.split_labels` split a scan into a grasp target
+        and the rest with it.
+        """
     def transformed(self, transform: npt.ArrayLike) -> PointCloud:
         """Return a copy moved by a rigid transform.
 
@@ -2072,6 +2084,27 @@ class LinkCollision:
         Side A is the link: its exact surface (no points) for exact links, its
         sample for sampled ones.
         """
+    @property
+    def target(self) -> LinkCollision | None:
+        """With a grasp target (``target=``), the link's query against it; else ``None``.
+
+        A link not in ``allowed_links`` has it in :attr:`probability` and
+        :attr:`state`; an allowed link's :attr:`probability` is the environment's alone.
+        """
+
+@final
+class TargetCollision:
+    """The grasp target's part of a :class:`RobotCollisionResult` (``result.target``)."""
+
+    @property
+    def probability(self) -> float:
+        """The allowed links' contact probability with the target (not in the robot's ``probability``)."""
+    @property
+    def state(self) -> _StateName:
+        """The state from :attr:`probability` and the thresholds (``"collision"``: the fingers are on it)."""
+    @property
+    def other_probability(self) -> float:
+        """The other links' collision probability with the target (in the robot's ``probability``)."""
 
 @final
 class RobotCollisionResult:
@@ -2086,6 +2119,9 @@ class RobotCollisionResult:
     @property
     def links(self) -> dict[str, LinkCollision]:
         """Per link with geometry, by name (URDF order), then per attached object, by its name."""
+    @property
+    def target(self) -> TargetCollision | None:
+        """With a grasp target (``target=``): the allowed links' contact with it and the others' collision with it; else ``None``."""
     @property
     def patches(self) -> list[tuple[str, ContactPatch]]:
         """Contact patches of every queried link, as ``(link name, patch)``."""
@@ -2105,7 +2141,7 @@ class RobotStats:
         """Links with geometry, and attached objects."""
     @property
     def links_queried(self) -> int:
-        """Links queried against the cloud (the others skipped by the broad phase or the decision)."""
+        """Links queried against the cloud (the others skipped by the broad phase or the decision), plus, with a grasp target, those queried against it."""
     @property
     def links_after_decision(self) -> int:
         """With ``decide_only``, the links left once one reached the collision threshold."""
@@ -2147,11 +2183,15 @@ class RobotBatchResult:
     @property
     def link_probabilities(self) -> _FloatArray:
         """Per-link probabilities, shape ``(m, n_links)``, links in ``Robot.link_names`` order (attached objects enter ``probabilities`` only)."""
+    @property
+    def target_probabilities(self) -> _FloatArray | None:
+        """With a grasp target (``target=``): the allowed links' contact probability with it, shape ``(m,)``; else ``None``."""
     @staticmethod
     def _from_state(
-        state: tuple[list[float], list[str], list[bool], list[float], int],
+        state: tuple[list[float], list[str], list[bool], list[float], int]
+        | tuple[list[float], list[str], list[bool], list[float], int, list[float] | None],
     ) -> RobotBatchResult:
-        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links)``."""
+        """Rebuild from ``(probabilities, states, self_colliding, link_probabilities (flat), n_links[, target_probabilities])``."""
     def __len__(self) -> int: ...
 
 @final
@@ -2217,9 +2257,26 @@ def collide_robot(
     ``request`` is a :class:`CollisionRequest` (the link queries' options);
     ``options`` are the keyword options of :class:`CollisionRequest`
     (overriding ``request``'s) plus ``mesh_side`` (``"exact"`` or ``"sampled"``),
-    ``mesh_spacing`` (with sampled links only), ``broad_phase`` and
-    ``self_collision``; unknown names raise :class:`InvalidInputError`. The GIL
+    ``mesh_spacing`` (with sampled links only), ``broad_phase``,
+    ``self_collision``, ``padding``, ``target``, ``target_pose`` and
+    ``allowed_links``; unknown names raise :class:`InvalidInputError`. The GIL
     is released.
+
+    ``padding`` (metres, default 0) grows each link's surface by a safety margin
+    (an exact link's signed distance less it; a sampled link's samples moved
+    along their faces' normals): a float for every link, or a dict from link name
+    to metres for the links it names (the others unpadded); attached objects are
+    not padded.
+
+    ``target`` is an object about to be grasped, still in the scene: a
+    :class:`PointCloud` (in the cloud's frame) or a :class:`Mesh` at
+    ``target_pose`` (sampled at the links' sampling spacing). The links (or
+    attached objects) named in ``allowed_links`` may touch it: their contacts
+    are reported apart (:attr:`RobotCollisionResult.target`,
+    :attr:`LinkCollision.target`); every other link is queried against it as
+    against the cloud, and counts. Unknown link names, a negative or NaN
+    padding, ``allowed_links`` without a ``target`` raise
+    :class:`InvalidInputError`.
     """
 
 def collide_robot_many(

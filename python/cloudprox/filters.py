@@ -16,7 +16,10 @@ about 0.9 s on two cores (see BENCHMARKS.md).
 - :class:`Occlusion`: not a filter but its complement, what the scan did not
   see: whether a point lies in front of the observed surface along its
   viewing ray, behind it (in its shadow, with the probability under the
-  range noise) or along a direction with no return.
+  range noise) or along a direction with no return;
+- :func:`split_box` and :func:`split_labels`: a grasp target and the rest of
+  the scene, as two :class:`~cloudprox.PointCloud` objects (for
+  ``collide_robot(..., target=...)``).
 
 Filters that remove points return the **indices of the kept points** (int64,
 ascending), so that points, covariances and pixels can be subset alike::
@@ -34,10 +37,15 @@ filter, ``ShadowSettings::default()`` for the shadow filter and
 
 from __future__ import annotations
 
+import numpy as np
+import numpy.typing as npt
+
 from cloudprox._native import (
     SOR_DEFAULT_K,
     SOR_DEFAULT_STD_RATIO,
+    InvalidInputError,
     Occlusion,
+    PointCloud,
     SelfFilter,
     crop_box,
     shadow_filter,
@@ -52,6 +60,92 @@ __all__ = [
     "SelfFilter",
     "crop_box",
     "shadow_filter",
+    "split_box",
+    "split_labels",
     "statistical_outlier_removal",
     "voxel_downsample",
 ]
+
+
+def _split(
+    cloud: PointCloud, inside: npt.NDArray[np.int64], what: str
+) -> tuple[PointCloud, PointCloud]:
+    if not isinstance(cloud, PointCloud):
+        raise TypeError(f"cloud must be a PointCloud, got {type(cloud).__name__}")
+    if inside.size == 0:
+        raise InvalidInputError(f"{what} holds no point of the cloud: the target would be empty")
+    if inside.size == len(cloud):
+        raise InvalidInputError(
+            f"{what} holds every point of the cloud: nothing would be left of the scene"
+        )
+    return cloud.select_by_index(inside), cloud.select_by_index(inside, invert=True)
+
+
+def split_box(
+    cloud: PointCloud,
+    min: npt.ArrayLike,
+    max: npt.ArrayLike,
+    pose: npt.ArrayLike | None = None,
+) -> tuple[PointCloud, PointCloud]:
+    """Split a cloud into the points inside a box (a grasp target) and the rest.
+
+    Parameters
+    ----------
+    cloud : PointCloud
+        The scan, in its own frame.
+    min, max : array_like, shape (3,)
+        The box's corners in its own frame (as :func:`crop_box` takes them).
+    pose : array_like, shape (4, 4), optional
+        The box's pose in the cloud's frame (``None``: axis-aligned, identity);
+        an oriented box is a rotated pose.
+
+    Returns
+    -------
+    tuple of PointCloud
+        ``(target, rest)``: each point keeps its sensor covariance and the
+        clouds the scan's noise correlation (see
+        :meth:`PointCloud.select_by_index`), in the scan's frame.
+
+    Raises
+    ------
+    InvalidInputError
+        A box that holds no point (the target would be empty) or every point;
+        bad corners or pose, as :func:`crop_box`.
+    """
+    inside = crop_box(cloud.points, min, max, pose)
+    return _split(cloud, inside, "the box")
+
+
+def split_labels(
+    cloud: PointCloud, labels: npt.ArrayLike, label: int
+) -> tuple[PointCloud, PointCloud]:
+    """Split a cloud into the points labelled ``label`` (a grasp target) and the rest.
+
+    Parameters
+    ----------
+    cloud : PointCloud
+        The scan.
+    labels : array_like of int, shape (n,)
+        One label per point of ``cloud`` (an instance segmentation's).
+    label : int
+        The target's label: ``labels == label`` selects it.
+
+    Returns
+    -------
+    tuple of PointCloud
+        ``(target, rest)``, as :func:`split_box` returns them.
+
+    Raises
+    ------
+    InvalidInputError
+        Labels of the wrong shape or not integers; a label that no point, or
+        every point, carries.
+    """
+    arr = np.asarray(labels)
+    if arr.shape != (len(cloud),):
+        raise InvalidInputError(
+            f"labels must have shape ({len(cloud)},), one per point, got {arr.shape}"
+        )
+    if arr.dtype.kind not in "iu":
+        raise InvalidInputError(f"labels must be integers, got dtype {arr.dtype}")
+    return _split(cloud, np.flatnonzero(arr == label).astype(np.int64), f"label {label}")

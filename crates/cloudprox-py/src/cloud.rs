@@ -320,6 +320,82 @@ impl PyPointCloud {
         matrices3_to_py(py, self.inner.sensor_covariances())
     }
 
+    /// A new cloud of the points at `indices` (or, with `invert`, of every
+    /// other point), in the order given: each keeps its sensor covariance and
+    /// the cloud its noise correlation; a discretization covariance is
+    /// estimated again from the kept points' neighbours (same `k`).
+    #[pyo3(signature = (indices, invert=false))]
+    fn select_by_index(
+        &self,
+        py: Python<'_>,
+        indices: &Bound<'_, PyAny>,
+        invert: bool,
+    ) -> PyResult<Self> {
+        if indices.cast::<PyArray1<bool>>().is_ok() {
+            return Err(invalid_input(
+                py,
+                "indices must be integers, got a boolean mask: pass numpy.flatnonzero(mask)",
+            ));
+        }
+        let raw: Vec<i64> = indices
+            .extract()
+            .map_err(|_| invalid_input(py, "indices must be a sequence of integers"))?;
+        let n = self.inner.len();
+        let mut chosen = Vec::with_capacity(raw.len());
+        for &i in &raw {
+            match usize::try_from(i) {
+                Ok(u) if u < n => chosen.push(u),
+                _ => {
+                    return Err(invalid_input(
+                        py,
+                        format!("index {i} is out of range for a cloud of {n} points"),
+                    ))
+                }
+            }
+        }
+        if invert {
+            let mut keep = vec![true; n];
+            for &i in &chosen {
+                keep[i] = false;
+            }
+            chosen = (0..n).filter(|&i| keep[i]).collect();
+        }
+        if chosen.is_empty() {
+            return Err(invalid_input(
+                py,
+                "the selection holds no point: a cloud needs at least one",
+            ));
+        }
+        let points: Vec<_> = chosen.iter().map(|&i| self.inner.points()[i]).collect();
+        let sensor: Vec<_> = chosen
+            .iter()
+            .map(|&i| self.inner.sensor_covariances()[i])
+            .collect();
+        let rho = self.inner.element_settings().noise_correlation;
+        let disc_k = self.recipe.disc_k;
+        let root = run_detached(py, move || {
+            let mut root = PointCloud::from_covariances(points, sensor)?;
+            if let Some(k) = disc_k {
+                let settings = DiscretizationSettings {
+                    k,
+                    ..DiscretizationSettings::default()
+                };
+                root = root.with_discretization(&settings)?;
+            }
+            root.set_noise_correlation(rho)?;
+            Ok(root)
+        })?;
+        let root = Arc::new(root);
+        Ok(Self {
+            inner: Arc::clone(&root),
+            recipe: Recipe {
+                root,
+                disc_k,
+                poses: Vec::new(),
+            },
+        })
+    }
+
     /// A new cloud moved by the `(4, 4)` rigid transform `transform`.
     fn transformed(&self, py: Python<'_>, transform: &Bound<'_, PyAny>) -> PyResult<Self> {
         let pose = pose_from(py, Some(transform), "transform")?;

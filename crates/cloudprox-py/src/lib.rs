@@ -117,6 +117,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<robot::PyLinkCollision>()?;
     m.add_class::<robot::PyRobotCollisionResult>()?;
+    m.add_class::<robot::PyTargetCollision>()?;
     m.add_class::<robot::PyRobotStats>()?;
     m.add_class::<robot::PyRobotBatchResult>()?;
     m.add_class::<robot::PyMotionResult>()?;

@@ -8,9 +8,10 @@ use cloudprox::math::Pose;
 use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
-    collide_robot_many as core_collide_robot_many, AttachedShape, LinkCollision, MotionRequest,
-    Robot, RobotCollisionResult, RobotCounters, RobotStats,
+    collide_robot_many as core_collide_robot_many, AttachedShape, GraspTarget, LinkCollision,
+    MotionRequest, Robot, RobotCollisionResult, RobotCounters, RobotStats, TargetCollision,
 };
+use cloudprox::Real;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyTuple};
@@ -24,12 +25,16 @@ use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, PyContactPatch};
 
 /// The keywords of `collide_robot` that are not request options.
-const ROBOT_KEYWORDS: [&str; 5] = [
+const ROBOT_KEYWORDS: [&str; 9] = [
     "request",
     "mesh_side",
     "mesh_spacing",
     "broad_phase",
     "self_collision",
+    "padding",
+    "target",
+    "target_pose",
+    "allowed_links",
 ];
 /// The keywords of `check_motion` beyond those of `collide_robot`.
 const MOTION_KEYWORDS: [&str; 3] = ["resolution", "max_probability", "warm_start"];
@@ -56,6 +61,9 @@ fn motion_request(
     let mut out = MotionRequest::default();
     let collide_options = PyDict::new(py);
     let mut mesh_side: Option<String> = None;
+    let mut target: Option<Bound<'_, PyAny>> = None;
+    let mut target_pose: Option<Bound<'_, PyAny>> = None;
+    let mut allowed: Option<Vec<String>> = None;
     if let Some(options) = options {
         for (k, v) in options.iter() {
             let key: String = k.extract()?;
@@ -69,6 +77,10 @@ fn motion_request(
                 }
                 "broad_phase" => out.robot.broad_phase = extract(py, &v, &key, "a bool")?,
                 "self_collision" => out.robot.self_collision = extract(py, &v, &key, "a bool")?,
+                "padding" => padding_from(py, &v, &mut out.robot)?,
+                "target" => target = Some(v),
+                "target_pose" => target_pose = Some(v),
+                "allowed_links" => allowed = Some(names_from(py, &v, "allowed_links")?),
                 "resolution" if motion => {
                     out.resolution = Some(extract(py, &v, &key, "a float")?);
                 }
@@ -84,10 +96,101 @@ fn motion_request(
     if motion {
         also_valid.extend(MOTION_KEYWORDS);
     }
+    out.robot.target = target_from(py, target.as_ref(), target_pose.as_ref(), allowed)?;
     out.robot.mesh_side = link_side(py, mesh_side.as_deref(), out.robot.mesh_spacing)?;
     out.robot.collide = request_from(py, request, Some(&collide_options), &also_valid)?;
     out.robot.validate().or_py(py)?;
     Ok(out)
+}
+
+/// `padding=`: a float for every link, or a mapping from link name to metres.
+fn padding_from(
+    py: Python<'_>,
+    v: &Bound<'_, PyAny>,
+    robot: &mut cloudprox::robot::RobotRequest,
+) -> PyResult<()> {
+    if let Ok(map) = v.cast::<PyMapping>() {
+        for item in map.items()?.iter() {
+            let (name, d): (Bound<'_, PyAny>, Bound<'_, PyAny>) = item.extract()?;
+            let name: String = name.extract().map_err(|_| {
+                invalid_input(py, "padding's keys must be link names (str)".to_string())
+            })?;
+            let d: f64 = d.extract().map_err(|_| {
+                invalid_input(
+                    py,
+                    format!("padding of link '{name}' must be a float (metres)"),
+                )
+            })?;
+            robot.link_padding.push((name, d));
+        }
+        return Ok(());
+    }
+    robot.padding = v.extract().map_err(|_| {
+        invalid_input(
+            py,
+            "option padding must be a float (metres) or a dict from link name to metres"
+                .to_string(),
+        )
+    })?;
+    Ok(())
+}
+
+/// A list of names (`what` names the option in errors); a lone str is refused.
+fn names_from(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<String>> {
+    if v.extract::<String>().is_ok() {
+        return Err(invalid_input(
+            py,
+            format!("option {what} must be a list of link names, got a str"),
+        ));
+    }
+    v.extract()
+        .map_err(|_| invalid_input(py, format!("option {what} must be a list of link names")))
+}
+
+/// `target=` (a `PointCloud`, or a `Mesh` at `target_pose`) with
+/// `allowed_links=`.
+fn target_from(
+    py: Python<'_>,
+    target: Option<&Bound<'_, PyAny>>,
+    pose: Option<&Bound<'_, PyAny>>,
+    allowed: Option<Vec<String>>,
+) -> PyResult<Option<GraspTarget>> {
+    let Some(target) = target else {
+        if allowed.is_some() || pose.is_some() {
+            return Err(invalid_input(
+                py,
+                "allowed_links and target_pose need a target (a PointCloud or a Mesh)".to_string(),
+            ));
+        }
+        return Ok(None);
+    };
+    let allowed = allowed.unwrap_or_default();
+    if let Ok(c) = target.cast::<PyPointCloud>() {
+        if pose.is_some() {
+            return Err(invalid_input(
+                py,
+                "target_pose places a Mesh target: a PointCloud target is in the cloud's frame \
+                 already (move it with PointCloud.transformed)"
+                    .to_string(),
+            ));
+        }
+        return Ok(Some(GraspTarget::cloud(
+            Arc::clone(&c.get().inner),
+            allowed,
+        )));
+    }
+    if let Ok(m) = target.cast::<PyMesh>() {
+        let pose = pose_from(py, pose, "target_pose")?;
+        return Ok(Some(GraspTarget::mesh(
+            Arc::clone(&m.get().inner),
+            pose,
+            allowed,
+        )));
+    }
+    let ty = target.get_type().name()?;
+    Err(pyo3::exceptions::PyTypeError::new_err(format!(
+        "target must be a PointCloud or a Mesh, got {ty}"
+    )))
 }
 
 /// How the links stand: `mesh_side` by name, or (not given) exact unless a
@@ -808,6 +911,16 @@ impl PyLinkCollision {
             .transpose()
     }
 
+    /// With a grasp target: the link's query against it, as a
+    /// `LinkCollision` (its own `target` is `None`); `None` without a target.
+    #[getter]
+    fn target(&self) -> Option<PyLinkCollision> {
+        self.inner.target.as_ref().map(|t| PyLinkCollision {
+            name: self.name.clone(),
+            inner: (**t).clone(),
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "LinkCollision(link='{}', probability={:.6}, state='{}', queried={})",
@@ -829,7 +942,8 @@ stats_class! {
         /// Links with geometry, and attached objects.
         links_with_geometry: usize,
         /// Links queried against the cloud (the others were skipped by the broad
-        /// phase, or left once the query was decided).
+        /// phase, or left once the query was decided), plus, with a grasp
+        /// target, those queried against it.
         links_queried: usize,
         /// Links left unqueried because an earlier link's probability had reached
         /// the collision threshold (``decide_only`` only).
@@ -853,6 +967,7 @@ pub struct PyRobotCollisionResult {
     state: &'static str,
     links: Vec<Py<PyLinkCollision>>,
     self_collisions: Vec<(String, String)>,
+    target: Option<TargetCollision>,
     stats: RobotStats,
 }
 
@@ -881,6 +996,7 @@ impl PyRobotCollisionResult {
             state: r.state.name(),
             links,
             self_collisions,
+            target: r.target,
             stats: r.stats,
         })
     }
@@ -939,6 +1055,14 @@ impl PyRobotCollisionResult {
         self.self_collisions.clone()
     }
 
+    /// With a grasp target (`target=`): the allowed links' contact with it,
+    /// reported apart from `probability`, and the other links' collision with
+    /// it (counted in `probability`); `None` without a target.
+    #[getter]
+    fn target(&self) -> Option<PyTargetCollision> {
+        self.target.map(|inner| PyTargetCollision { inner })
+    }
+
     /// Counters and timings (a new `RobotStats` each time).
     #[getter]
     fn stats(&self) -> PyRobotStats {
@@ -952,6 +1076,44 @@ impl PyRobotCollisionResult {
             self.state,
             self.links.len(),
             self.self_collisions.len()
+        )
+    }
+}
+
+/// The grasp target's part of a `RobotCollisionResult`.
+#[pyclass(name = "TargetCollision", frozen, module = "cloudprox._native")]
+pub struct PyTargetCollision {
+    inner: TargetCollision,
+}
+
+#[pymethods]
+impl PyTargetCollision {
+    /// The allowed links' contact probability with the target (not counted in
+    /// the robot's probability).
+    #[getter]
+    fn probability(&self) -> f64 {
+        self.inner.probability
+    }
+
+    /// `"free"`, `"contact"` or `"collision"`, from `probability`.
+    #[getter]
+    fn state(&self) -> &'static str {
+        self.inner.state.name()
+    }
+
+    /// The other links' collision probability with the target (counted in
+    /// the robot's probability).
+    #[getter]
+    fn other_probability(&self) -> f64 {
+        self.inner.other_probability
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "TargetCollision(probability={:.6}, state='{}', other_probability={:.6})",
+            self.inner.probability,
+            self.inner.state.name(),
+            self.inner.other_probability
         )
     }
 }
@@ -993,12 +1155,24 @@ pub struct PyRobotBatchResult {
     probabilities: Vec<f64>,
     states: Vec<&'static str>,
     self_colliding: Vec<bool>,
+    /// With a grasp target: per configuration, the allowed links' contact
+    /// probability with it.
+    target_probabilities: Option<Vec<f64>>,
     link_probabilities: Vec<f64>,
     n_links: usize,
 }
 
 /// The pickled form of a `RobotBatchResult`.
-type BatchState = (Vec<f64>, Vec<String>, Vec<bool>, Vec<f64>, usize);
+type BatchState = (
+    Vec<f64>,
+    Vec<String>,
+    Vec<bool>,
+    Vec<f64>,
+    usize,
+    Option<Vec<f64>>,
+);
+/// The state of a batch result pickled before grasp targets.
+type BatchStateV1 = (Vec<f64>, Vec<String>, Vec<bool>, Vec<f64>, usize);
 
 #[pymethods]
 impl PyRobotBatchResult {
@@ -1011,14 +1185,19 @@ impl PyRobotBatchResult {
             me.self_colliding.clone(),
             me.link_probabilities.clone(),
             me.n_links,
+            me.target_probabilities.clone(),
         );
         Ok((slf.getattr("_from_state")?, (state,)))
     }
 
     /// Rebuilds a pickled batch result (see `__reduce__`).
     #[staticmethod]
-    fn _from_state(py: Python<'_>, state: BatchState) -> PyResult<Self> {
-        let (probabilities, states, self_colliding, link_probabilities, n_links) = state;
+    fn _from_state(py: Python<'_>, state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let state: BatchState = match state.extract::<BatchStateV1>() {
+            Ok((p, s, c, l, n)) => (p, s, c, l, n, None),
+            Err(_) => state.extract()?,
+        };
+        let (probabilities, states, self_colliding, link_probabilities, n_links, target) = state;
         let states = states
             .iter()
             .map(|s| crate::result::state_name(py, s))
@@ -1026,6 +1205,9 @@ impl PyRobotBatchResult {
         if states.len() != probabilities.len()
             || self_colliding.len() != probabilities.len()
             || link_probabilities.len() != probabilities.len() * n_links
+            || target
+                .as_ref()
+                .is_some_and(|t| t.len() != probabilities.len())
         {
             return Err(invalid_input(
                 py,
@@ -1036,9 +1218,18 @@ impl PyRobotBatchResult {
             probabilities,
             states,
             self_colliding,
+            target_probabilities: target,
             link_probabilities,
             n_links,
         })
+    }
+
+    /// `(m,)` with a grasp target (`target=`): the allowed links' contact
+    /// probability with it per configuration (not in `probabilities`); `None`
+    /// without a target.
+    #[getter]
+    fn target_probabilities<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.target_probabilities.as_ref().map(|t| vec_to_py(py, t))
     }
 
     /// `(m,)` collision probabilities.
@@ -1096,6 +1287,7 @@ pub fn collide_robot_many(
 ) -> PyResult<PyRobotBatchResult> {
     let robot = robot_arg(robot)?;
     let request = motion_request(py, request, options, false)?.robot;
+    let has_target = request.target.is_some();
     let qs = configs_from(&robot, qs, "qs")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
@@ -1118,6 +1310,12 @@ pub fn collide_robot_many(
             .iter()
             .map(RobotCollisionResult::self_colliding)
             .collect(),
+        target_probabilities: has_target.then(|| {
+            results
+                .iter()
+                .map(|r| r.target.map_or(Real::NAN, |t| t.probability))
+                .collect()
+        }),
         link_probabilities,
         n_links,
     })

@@ -40,6 +40,7 @@ mod io_xyz;
 mod module_layers;
 mod robot_collide;
 mod robot_exact;
+mod robot_grasp;
 mod robot_model;
 mod scan_pipeline;
 mod shape_exact;

@@ -99,7 +99,7 @@ fn broad_phase_changes_the_cost_not_the_answer() {
         };
         let without = RobotRequest {
             broad_phase: false,
-            ..with
+            ..with.clone()
         };
         let mut skipped = 0;
         for q in [
@@ -602,7 +602,7 @@ fn check_motion_answers_as_its_states_queried_one_by_one() {
         let warm = check_motion(&robot, &q0, &q1, &Pose::identity(), &cloud, &req).unwrap();
         let cold_req = MotionRequest {
             warm_start: false,
-            ..req
+            ..req.clone()
         };
         let cold = check_motion(&robot, &q0, &q1, &Pose::identity(), &cloud, &cold_req).unwrap();
         assert_eq!(warm.states_checked, warm.states_total);

@@ -172,7 +172,7 @@ fn a_decide_only_query_answers_the_full_querys_state() {
     let mut decided = 0;
     for model in MODELS {
         let full = request(MeshSide::Exact, model);
-        let mut fast = full;
+        let mut fast = full.clone();
         fast.collide.decide_only = true;
         for i in 0..24 {
             let t = f64::from(i) / 23.0;
@@ -255,7 +255,7 @@ fn the_broad_phase_changes_the_cost_not_the_answer() {
         let with = request(MeshSide::Exact, model);
         let without = RobotRequest {
             broad_phase: false,
-            ..with
+            ..with.clone()
         };
         let mut skipped = 0;
         // Turned links near the wall, grazing it or a few sigma off.
@@ -352,7 +352,7 @@ fn a_tilted_box_near_the_reach_is_skipped_only_where_it_reads_nothing() {
         let with = request(MeshSide::Exact, model);
         let without = RobotRequest {
             broad_phase: false,
-            ..with
+            ..with.clone()
         };
         let (mut skipped, mut read) = (0, 0);
         for i in 0..40 {

@@ -175,7 +175,18 @@ pub(crate) struct LinkSamples {
 /// The cloud sampled from `g`'s merged mesh at `spacing` (`what` names it in
 /// errors), its hierarchy built, and its largest sampling spacing.
 fn sample_geometry(g: &LinkGeometry, spacing: Real, what: &str) -> Result<(PointCloud, Real)> {
-    let cloud = PointCloud::from_mesh(&g.mesh, spacing, LINK_SAMPLING_SEED)
+    sample_padded(g, spacing, 0.0, what)
+}
+
+/// [`sample_geometry`] with the samples moved `padding` metres along their
+/// faces' outward normals (see [`PointCloud::from_mesh_offset`]).
+pub(crate) fn sample_padded(
+    g: &LinkGeometry,
+    spacing: Real,
+    padding: Real,
+    what: &str,
+) -> Result<(PointCloud, Real)> {
+    let cloud = PointCloud::from_mesh_offset(&g.mesh, spacing, LINK_SAMPLING_SEED, padding)
         .map_err(|e| Error::invalid(format!("{what}: {e}")))?;
     let _ = cloud.bvh();
     let spacing_max = cloud.spacing().iter().copied().fold(0.0, Real::max);

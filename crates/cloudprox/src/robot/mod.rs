@@ -11,6 +11,7 @@
 //! | `collide_robot`, `collide_robot_many`, self-collision | `query.rs` |
 //! | `check_motion` | `motion.rs` |
 //! | attached (held) objects: `Robot::attach`, `Robot::detach` | `attached.rs` |
+//! | grasp targets, link padding: resolved against the robot | `target.rs` |
 //!
 //! A robot is prepared once ([`Robot::from_urdf_file`]): every link's collision
 //! elements become one [`Mesh`](crate::shape::Mesh) in the link frame (for
@@ -25,6 +26,7 @@ mod model;
 mod motion;
 mod query;
 mod srdf;
+mod target;
 mod urdf;
 
 pub use attached::{AttachedObject, AttachedShape};
@@ -36,3 +38,4 @@ pub use query::{
     RobotRequest, RobotStats, SelfCollision,
 };
 pub use srdf::{parse_disabled_collisions, DisabledCollision};
+pub use target::{GraspTarget, TargetCollision, TargetObject};

@@ -12,7 +12,7 @@ use crate::Real;
 pub const MAX_MOTION_STATES: usize = 1_000_000;
 
 /// Options of [`check_motion`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MotionRequest {
     /// The query at each state (default [`RobotRequest::default`]).
     pub robot: RobotRequest,

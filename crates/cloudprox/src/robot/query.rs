@@ -6,8 +6,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::attached::AttachedObject;
-use super::geometry::{samples_at, LinkGeometry, LinkSamples};
+use super::geometry::{sample_padded, samples_at, LinkGeometry, LinkSamples};
 use super::model::Robot;
+use super::target::{check_padding, resolve, GraspTarget, TargetCollision};
 use crate::bvh::{Aabb, BvhWorkspace};
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
@@ -18,11 +19,11 @@ use crate::query::collide::{
     CollisionRequest, CollisionResult, MeshSide, QueryModel, WarmStart,
 };
 use crate::query::exact::intersects;
-use crate::query::exact_side::{collide_exact_cloud, exact_side_may_reach};
+use crate::query::exact_side::{collide_exact_cloud_padded, exact_side_may_reach};
 use crate::Real;
 
 /// Options of [`collide_robot`]: the per-link query's options and the robot's own.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RobotRequest {
     /// The query of each link against the cloud (its options as
     /// [`crate::query::collide()`] reads them).
@@ -60,6 +61,27 @@ pub struct RobotRequest {
     pub broad_phase: bool,
     /// Check self-collision between non-adjacent links (default `true`).
     pub self_collision: bool,
+    /// A safety margin (metres, finite and `>= 0`; default 0) added to every
+    /// link's surface: each link is queried as its surface grown by it, its
+    /// signed distance less the padding (exact links); a sampled link's
+    /// samples move that far along their faces' outward normals (the faces'
+    /// offsets, without the exact offset's rounded edges; sampled again for
+    /// each query call, once for a batch or a motion). It is
+    /// deterministic: the sensor noise is already in `P`, so a padding `d`
+    /// shifts `P`'s curve by `d / sigma` standard deviations; keep it for
+    /// model error (kinematic calibration, mesh simplification). Attached
+    /// objects are not padded. Padding 0 is no padding, bit for bit.
+    pub padding: Real,
+    /// Per-link paddings (metres) by link name, overriding `padding` for the
+    /// links they name.
+    pub link_padding: Vec<(String, Real)>,
+    /// An object about to be grasped, still in the scene (default `None`):
+    /// every link (and attached object) not in its
+    /// [`GraspTarget::allowed_links`] is queried against it as against the
+    /// environment, its probability entering the link's and the robot's; the
+    /// allowed links' contacts with it are reported apart
+    /// ([`RobotCollisionResult::target`], [`LinkCollision::target`]).
+    pub target: Option<GraspTarget>,
 }
 
 impl Default for RobotRequest {
@@ -70,6 +92,9 @@ impl Default for RobotRequest {
             mesh_spacing: None,
             broad_phase: true,
             self_collision: true,
+            padding: 0.0,
+            link_padding: Vec::new(),
+            target: None,
         }
     }
 }
@@ -81,9 +106,15 @@ impl RobotRequest {
     /// As [`CollisionRequest::validate`]; a mesh spacing that is not finite
     /// and positive, or given with [`MeshSide::Exact`] (nothing is sampled);
     /// the `surface` aggregation with the points model and an exact side (it
-    /// reads a trained surface around each point).
+    /// reads a trained surface around each point); a padding that is not
+    /// finite and `>= 0`. Link names are checked against the robot by the
+    /// queries.
     pub fn validate(&self) -> Result<()> {
         self.collide.validate()?;
+        check_padding(self.padding, "padding")?;
+        for (name, d) in &self.link_padding {
+            check_padding(*d, &format!("padding of link '{name}'"))?;
+        }
         if let Some(s) = self.mesh_spacing {
             if !(s.is_finite() && s > 0.0) {
                 return Err(Error::invalid(format!(
@@ -129,6 +160,13 @@ pub struct LinkCollision {
     /// surface, no points, with [`MeshSide::Exact`]; its sample, in the link's
     /// frame, with [`MeshSide::Sampled`]; regions in the world frame).
     pub result: Option<CollisionResult>,
+    /// With a grasp target ([`RobotRequest::target`]), the body's query
+    /// against it (its `target` is `None`); `None` without a target, or when
+    /// a `decide_only` query had decided before reaching the body. A body
+    /// not allowed to touch the target has it in `probability` and `state`
+    /// (the request's aggregation of the environment's and the target's);
+    /// an allowed body's `probability` is the environment's alone.
+    pub target: Option<Box<LinkCollision>>,
 }
 
 /// Two links (or a link and an attached object) whose exact shapes intersect.
@@ -148,7 +186,8 @@ pub struct RobotCounters {
     /// Links with geometry, and attached objects.
     pub links_with_geometry: usize,
     /// Links queried against the cloud (the others were skipped by the broad
-    /// phase, or left once the query was decided).
+    /// phase, or left once the query was decided), plus, with a grasp target,
+    /// those queried against it.
     pub links_queried: usize,
     /// Links left unqueried because an earlier link's probability had reached
     /// the collision threshold (`decide_only` only).
@@ -197,6 +236,10 @@ pub struct RobotCollisionResult {
     /// Pairs of non-adjacent links that intersect (exact meshes), empty when
     /// not requested. Reported apart: it does not enter `probability`.
     pub self_collisions: Vec<SelfCollision>,
+    /// With a grasp target ([`RobotRequest::target`]): the allowed links'
+    /// contact with it, reported apart, and the other links' collision with
+    /// it (in `probability`).
+    pub target: Option<TargetCollision>,
     /// Counters and timings.
     pub stats: RobotStats,
 }
@@ -274,6 +317,7 @@ fn after_decision(link: usize) -> LinkCollision {
         state: CollisionState::Contact,
         queried: false,
         result: None,
+        target: None,
     }
 }
 
@@ -322,38 +366,109 @@ impl RobotWorkspace {
 
 /// What stands for the links in a query.
 #[derive(Debug)]
-pub(crate) enum LinkSides {
+enum SideKind {
     /// Their exact surfaces ([`LinkGeometry::distance`]).
     Exact,
     /// Their samples at one spacing.
     Sampled(Arc<LinkSamples>),
 }
 
+/// What stands for the bodies in a query, with the request's padding and
+/// grasp target resolved against the robot.
+#[derive(Debug)]
+pub(crate) struct LinkSides {
+    kind: SideKind,
+    /// Per entry (links, then attached objects): its padding (metres).
+    padding: Vec<Real>,
+    /// The grasp target's cloud and, per entry, whether it may touch it.
+    target: Option<(Arc<PointCloud>, Vec<bool>)>,
+    /// Sampled links only, per link with a positive padding: its padded
+    /// sample.
+    padded: Vec<Option<PaddedSample>>,
+}
+
+/// A sampled link's sample moved along its faces' normals by its padding.
+#[derive(Debug)]
+struct PaddedSample {
+    cloud: PointCloud,
+    /// The link's bounding box grown by the padding.
+    aabb: Aabb,
+    spacing_max: Real,
+}
+
 impl LinkSides {
-    /// The sides `request` asks for against `cloud` (samples cached on the robot).
+    /// The sides `request` asks for against `cloud` (samples cached on the
+    /// robot), its padding and target resolved.
+    ///
+    /// # Errors
+    /// A cloud whose points coincide, with sampled links or a mesh target
+    /// and no `mesh_spacing`; a link that cannot be sampled; a padding or
+    /// allowed link naming nothing of the robot; a mesh target that cannot
+    /// be sampled.
     pub(crate) fn new(robot: &Robot, request: &RobotRequest, cloud: &PointCloud) -> Result<Self> {
-        match request.mesh_side {
-            MeshSide::Exact => Ok(LinkSides::Exact),
-            MeshSide::Sampled => Ok(LinkSides::Sampled(samples_at(
-                robot,
-                link_spacing(request, cloud)?,
-            )?)),
+        let kind = match request.mesh_side {
+            MeshSide::Exact => SideKind::Exact,
+            MeshSide::Sampled => {
+                SideKind::Sampled(samples_at(robot, link_spacing(request, cloud)?)?)
+            }
+        };
+        let resolved = resolve(
+            robot,
+            (request.padding, &request.link_padding),
+            request.target.as_ref(),
+            || link_spacing(request, cloud),
+        )?;
+        let mut padded: Vec<Option<PaddedSample>> = Vec::new();
+        if matches!(kind, SideKind::Sampled(_)) {
+            let spacing = link_spacing(request, cloud)?;
+            for (link, &d) in robot.links.iter().zip(&resolved.padding) {
+                let sample = match &link.geometry {
+                    Some(g) if d > 0.0 => {
+                        let what = format!("link '{}'", link.name);
+                        let (cloud, spacing_max) = sample_padded(g, spacing, d, &what)?;
+                        let _ = cloud.bvh();
+                        Some(PaddedSample {
+                            cloud,
+                            aabb: grown(&g.aabb, d),
+                            spacing_max,
+                        })
+                    }
+                    _ => None,
+                };
+                padded.push(sample);
+            }
+        }
+        Ok(LinkSides {
+            kind,
+            padding: resolved.padding,
+            target: resolved.target,
+            padded,
+        })
+    }
+
+    /// Builds what every query of the sides against `cloud` (and the grasp
+    /// target) reads, so that parallel queries do not race to build it.
+    pub(crate) fn prepare(&self, cloud: &PointCloud, request: &CollisionRequest) {
+        self.prepare_cloud(cloud, request);
+        if let Some((target, _)) = &self.target {
+            self.prepare_cloud(target, request);
         }
     }
 
-    /// Builds what every query of the sides against `cloud` reads, so that
-    /// parallel queries do not race to build it.
-    pub(crate) fn prepare(&self, cloud: &PointCloud, request: &CollisionRequest) {
+    fn prepare_cloud(&self, cloud: &PointCloud, request: &CollisionRequest) {
         prepare(cloud, request);
-        match self {
-            LinkSides::Exact => {
+        match &self.kind {
+            SideKind::Exact => {
                 for s in 0..request.segmentations {
                     let _ = cloud.segmentation_after(s).hulls();
                 }
             }
-            LinkSides::Sampled(samples) => {
+            SideKind::Sampled(samples) => {
                 for link_cloud in samples.clouds.iter().flatten() {
                     prepare(link_cloud, request);
+                }
+                for p in self.padded.iter().flatten() {
+                    prepare(&p.cloud, request);
                 }
                 for (object_cloud, _) in samples.attached.iter().flatten() {
                     prepare(object_cloud, request);
@@ -364,9 +479,17 @@ impl LinkSides {
 
     /// What stands for link `l` (with geometry `g`) in a query.
     fn link_body<'a>(&'a self, l: usize, g: &'a LinkGeometry) -> Body<'a> {
-        match self {
-            LinkSides::Exact => Body::Exact(g),
-            LinkSides::Sampled(samples) => match &samples.clouds[l] {
+        if let Some(Some(p)) = self.padded.get(l) {
+            return Body::Cloud {
+                cloud: &p.cloud,
+                aabb: &p.aabb,
+                spacing_max: p.spacing_max,
+                sigma_max: 0.0,
+            };
+        }
+        match &self.kind {
+            SideKind::Exact => Body::Exact(g, self.padding[l]),
+            SideKind::Sampled(samples) => match &samples.clouds[l] {
                 Some(cloud) => Body::Cloud {
                     cloud,
                     aabb: &g.aabb,
@@ -374,7 +497,7 @@ impl LinkSides {
                     sigma_max: 0.0,
                 },
                 // Never: every link with geometry has a sample.
-                None => Body::Exact(g),
+                None => Body::Exact(g, 0.0),
             },
         }
     }
@@ -392,16 +515,16 @@ impl LinkSides {
                 sigma_max,
             };
         }
-        match self {
-            LinkSides::Exact => Body::Exact(g),
-            LinkSides::Sampled(samples) => match &samples.attached[k] {
+        match &self.kind {
+            SideKind::Exact => Body::Exact(g, 0.0),
+            SideKind::Sampled(samples) => match &samples.attached[k] {
                 Some((cloud, spacing_max)) => Body::Cloud {
                     cloud,
                     aabb: &g.aabb,
                     spacing_max: *spacing_max,
                     sigma_max: 0.0,
                 },
-                None => Body::Exact(g),
+                None => Body::Exact(g, 0.0),
             },
         }
     }
@@ -411,8 +534,9 @@ impl LinkSides {
 /// its query against the environment, in the body's frame.
 #[derive(Debug, Clone, Copy)]
 enum Body<'a> {
-    /// Its exact surface ([`LinkGeometry::distance`]).
-    Exact(&'a LinkGeometry),
+    /// Its exact surface ([`LinkGeometry::distance`]), grown by a padding
+    /// (metres).
+    Exact(&'a LinkGeometry, Real),
     /// A cloud: a link's or mesh object's sample, or a cloud object's own.
     Cloud {
         /// The cloud.
@@ -433,6 +557,9 @@ struct Scene<'a> {
     request: &'a RobotRequest,
     /// The noise's reach in standard deviations (`-Phi^-1(epsilon / 2)`).
     reach: Real,
+    /// Added to a body's entry index for its classifier hint: the queries
+    /// against the environment and against a grasp target keep apart hints.
+    warm_offset: usize,
 }
 
 /// [`collide_robot`] with prepared link sides and a workspace; `q` checked.
@@ -447,11 +574,26 @@ pub(crate) fn collide_robot_prepared(
 ) -> RobotCollisionResult {
     let start = Instant::now();
     let poses = robot.link_poses_unchecked(q, base);
+    let reach = -normal_quantile(0.5 * request.collide.prune_epsilon);
     let scene = Scene {
         cloud,
         request,
-        reach: -normal_quantile(0.5 * request.collide.prune_epsilon),
+        reach,
+        warm_offset: 0,
     };
+    let entries = robot.links.len() + robot.attached.len();
+    let target = sides.target.as_ref().map(|(target, allowed)| {
+        (
+            Scene {
+                cloud: target,
+                request,
+                reach,
+                warm_offset: entries,
+            },
+            allowed,
+        )
+    });
+    let aggregation = request.collide.aggregation;
     let mut stats = RobotStats::default();
     let mut links = Vec::new();
     // Every aggregation is at least the largest link probability: once a link
@@ -476,7 +618,15 @@ pub(crate) fn collide_robot_prepared(
             links.push(after_decision(l));
             continue;
         }
-        let entry = query_link(&scene, (l, body, pose), ws, &mut stats.counters);
+        let mut entry = query_link(&scene, (l, body, pose), ws, &mut stats.counters);
+        if let Some((target_scene, allowed)) = &target {
+            let t = query_link(target_scene, (l, body, pose), ws, &mut stats.counters);
+            if !allowed[l] {
+                entry.probability = aggregate(aggregation, &[entry.probability, t.probability]);
+                entry.state = request.collide.thresholds.state(entry.probability);
+            }
+            entry.target = Some(Box::new(t));
+        }
         decided = request.collide.decide_only
             && entry.queried
             && entry.probability >= request.collide.thresholds.collision;
@@ -487,7 +637,8 @@ pub(crate) fn collide_robot_prepared(
         .map(|l| l.probability)
         .filter(|p| !p.is_nan())
         .collect();
-    let probability = aggregate(request.collide.aggregation, &p);
+    let probability = aggregate(aggregation, &p);
+    let target = target.map(|(_, allowed)| target_collision(request, &links, allowed));
     let self_collisions = if request.self_collision {
         stats.counters.self_pairs_checked = robot.self_pairs.len() + robot.attached_pairs();
         self_collisions(robot, &poses)
@@ -500,7 +651,37 @@ pub(crate) fn collide_robot_prepared(
         state: request.collide.thresholds.state(probability),
         links,
         self_collisions,
+        target,
         stats,
+    }
+}
+
+/// The grasp target's summary: the allowed bodies' contact with it, the
+/// others' collision with it, each aggregated as the robot's probability.
+fn target_collision(
+    request: &RobotRequest,
+    links: &[LinkCollision],
+    allowed: &[bool],
+) -> TargetCollision {
+    let (mut touch, mut other) = (Vec::new(), Vec::new());
+    for l in links {
+        if let Some(t) = &l.target {
+            if !t.probability.is_nan() {
+                if allowed[l.link] {
+                    &mut touch
+                } else {
+                    &mut other
+                }
+                .push(t.probability);
+            }
+        }
+    }
+    let aggregation = request.collide.aggregation;
+    let probability = aggregate(aggregation, &touch);
+    TargetCollision {
+        probability,
+        state: request.collide.thresholds.state(probability),
+        other_probability: aggregate(aggregation, &other),
     }
 }
 
@@ -520,6 +701,7 @@ fn query_link(
             state: request.collide.thresholds.state(0.0),
             queried: false,
             result: None,
+            target: None,
         };
     }
     counters.links_queried += 1;
@@ -533,6 +715,7 @@ fn query_link(
                 state: r.state,
                 queried: true,
                 result: Some(r),
+                target: None,
             }
         }
         // The request was validated by the caller; a query error cannot occur.
@@ -542,6 +725,7 @@ fn query_link(
             state: CollisionState::Collision,
             queried: true,
             result: None,
+            target: None,
         },
     }
 }
@@ -557,9 +741,9 @@ fn link_near(
 ) -> bool {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
     let (link_cloud, aabb, spacing_max, sigma_max) = match body {
-        Body::Exact(geometry) => {
+        Body::Exact(geometry, padding) => {
             let (near, visited) = exact_side_may_reach(
-                (&geometry.aabb, pose),
+                (&grown(&geometry.aabb, padding), pose),
                 cloud,
                 (collide, scene.reach),
                 &mut ws.stack,
@@ -619,16 +803,23 @@ fn link_query(
 ) -> Result<CollisionResult> {
     let (cloud, collide) = (scene.cloud, &scene.request.collide);
     let link_cloud = match body {
-        Body::Exact(geometry) => {
-            return collide_exact_cloud(pose, &geometry.distance, &Pose::identity(), cloud, collide)
+        Body::Exact(geometry, padding) => {
+            return collide_exact_cloud_padded(
+                pose,
+                (&geometry.distance, padding),
+                &Pose::identity(),
+                cloud,
+                collide,
+            )
         }
         Body::Cloud { cloud, .. } => cloud,
     };
+    let slot = l + scene.warm_offset;
     let warm = ws.warm.as_mut().map(|w| {
-        if w.len() <= l {
-            w.resize_with(l + 1, WarmStart::default);
+        if w.len() <= slot {
+            w.resize_with(slot + 1, WarmStart::default);
         }
-        &mut w[l]
+        &mut w[slot]
     });
     collide_with_workspace(
         pose,

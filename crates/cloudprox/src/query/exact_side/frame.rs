@@ -12,7 +12,10 @@ use crate::Real;
 /// signed distance is read (so a rigid motion of both sides changes nothing).
 pub(crate) struct Frame<'a> {
     /// The mesh's signed distance.
-    pub mesh: &'a MeshDistance,
+    mesh: &'a MeshDistance,
+    /// The padding (metres, `>= 0`): the surface read is the mesh's grown by
+    /// it, its signed distance `sd - padding` (see [`Frame::padded`]).
+    padding: Real,
     /// The cloud's frame in the mesh's frame.
     pub rel: Pose,
     /// The rotation of `rel` as a matrix (cloud to mesh).
@@ -40,13 +43,80 @@ impl<'a> Frame<'a> {
     /// The frame of a cloud at `rel` in the mesh's frame, for a request's
     /// `prune_epsilon`.
     pub fn new(mesh: &'a MeshDistance, rel: Pose, prune_epsilon: Real) -> Self {
+        Self::padded(mesh, rel, prune_epsilon, 0.0)
+    }
+
+    /// [`Frame::new`] for the mesh's surface grown by `padding` (metres,
+    /// `>= 0`): every signed distance read is the mesh's less `padding`, every
+    /// closest point moved `padding` along its outward normal, the support
+    /// points and the bounding box grown alike. Padding 0 reads the mesh
+    /// itself, bit for bit.
+    pub fn padded(mesh: &'a MeshDistance, rel: Pose, prune_epsilon: Real, padding: Real) -> Self {
         let (mins, maxs) = mesh.bounds();
+        let d = Vector3::repeat(padding);
         Self {
             mesh,
+            padding,
             rel,
             rotation: *rel.rotation.to_rotation_matrix().matrix(),
             reach: -normal_quantile(0.5 * prune_epsilon),
-            bounds: Aabb { mins, maxs },
+            bounds: Aabb {
+                mins: mins - d,
+                maxs: maxs + d,
+            },
+        }
+    }
+
+    /// The mesh's closest point `c` read on the padded surface.
+    fn pad(&self, mut c: ClosestPoint) -> ClosestPoint {
+        if self.padding != 0.0 {
+            c.signed_distance -= self.padding;
+            c.point += c.normal * self.padding;
+        }
+        c
+    }
+
+    /// The (padded) surface's closest point to `x` (mesh frame).
+    pub fn closest(&self, x: &Point3) -> ClosestPoint {
+        self.pad(self.mesh.closest(x))
+    }
+
+    /// The (padded) surface's closest point to `x` (mesh frame) if its
+    /// unsigned distance is within `radius` (see
+    /// [`MeshDistance::closest_within`]; the mesh is searched within
+    /// `radius + padding`, so a padded answer may lie farther than `radius`).
+    pub fn closest_within(&self, x: &Point3, radius: Real) -> Option<ClosestPoint> {
+        self.mesh
+            .closest_within(x, radius + self.padding)
+            .map(|c| self.pad(c))
+    }
+
+    /// The (padded) surface's signed distance at `x` (mesh frame).
+    pub fn signed_distance(&self, x: &Point3) -> Real {
+        self.closest(x).signed_distance
+    }
+
+    /// Whether `x` (mesh frame) lies inside the (padded) surface.
+    pub fn contains(&self, x: &Point3) -> bool {
+        self.mesh.contains(x)
+            || (self.padding > 0.0
+                && self
+                    .mesh
+                    .closest_within(x, self.padding)
+                    .is_some_and(|c| c.signed_distance < self.padding))
+    }
+
+    /// The (padded) surface's support point along `dir` (mesh frame).
+    pub fn support(&self, dir: &Vector3) -> Point3 {
+        let s = self.mesh.support(dir);
+        if self.padding == 0.0 {
+            return s;
+        }
+        let n = dir.norm();
+        if n > 0.0 {
+            s + dir * (self.padding / n)
+        } else {
+            s
         }
     }
 
@@ -82,11 +152,11 @@ impl<'a> Frame<'a> {
     /// farther than `radius` (a bounded search: a point far from the surface
     /// costs a few box tests).
     pub fn closest_near(&self, x: &Point3, radius: Real) -> Option<ClosestPoint> {
-        if let Some(c) = self.mesh.closest_within(x, radius) {
+        if let Some(c) = self.closest_within(x, radius) {
             return Some(c);
         }
-        let inside = self.bounds.distance_squared_to_point(x) == 0.0 && self.mesh.contains(x);
-        inside.then(|| self.mesh.closest(x))
+        let inside = self.bounds.distance_squared_to_point(x) == 0.0 && self.contains(x);
+        inside.then(|| self.closest(x))
     }
 
     /// The elements of `els` whose mean may lie within `radius + margin +
@@ -113,9 +183,9 @@ impl<'a> Frame<'a> {
         if to_box > limit * limit {
             return Standing::Beyond;
         }
-        if let Some(c) = self.mesh.closest_within(&centre, limit) {
+        if let Some(c) = self.closest_within(&centre, limit) {
             Standing::Near(centre, c)
-        } else if to_box == 0.0 && self.mesh.contains(&centre) {
+        } else if to_box == 0.0 && self.contains(&centre) {
             Standing::Deep
         } else {
             Standing::Beyond

@@ -37,6 +37,7 @@ mod readings;
 mod tests;
 
 pub(crate) use nearest::nearest_to_mesh;
+pub(crate) use query::collide_exact_cloud_padded;
 pub use query::{
     collide_cloud_exact, collide_cloud_exact_many, collide_exact_cloud, collide_exact_cloud_many,
 };

@@ -93,7 +93,7 @@ fn element_nearest(frame: &Frame<'_>, cloud: &PointCloud, k: u32) -> Option<Mesh
     let e = &els.elements()[k as usize];
     if e.is_point() || e.probes.is_empty() {
         let r = point_reading(frame, e, k);
-        let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
+        let c = frame.closest(&frame.to_mesh(&e.mean));
         return Some(gap_of(frame, r.gap, r.std, &e.mean, c));
     }
     let first = e

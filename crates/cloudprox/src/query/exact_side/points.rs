@@ -68,12 +68,11 @@ pub(crate) fn point_probabilities(
 /// than `hint` (a point of the surface) when given.
 fn closest_from(frame: &Frame<'_>, x: &Point3, hint: Option<&Point3>) -> ClosestPoint {
     let Some(q) = hint else {
-        return frame.mesh.closest(x);
+        return frame.closest(x);
     };
     // A margin over the rounding.
     let bound = (x - q).norm() * (1.0 + 1e-9) + 1e-12;
     frame
-        .mesh
         .closest_within(x, bound)
-        .unwrap_or_else(|| frame.mesh.closest(x))
+        .unwrap_or_else(|| frame.closest(x))
 }

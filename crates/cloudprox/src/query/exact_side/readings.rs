@@ -55,7 +55,7 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
 /// the distance's gradient (Eq. 3). Always within reach (the broad phase
 /// found the surface within reach of it).
 pub(super) fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> ElementReading {
-    let c = frame.mesh.closest(&frame.to_mesh(&e.mean));
+    let c = frame.closest(&frame.to_mesh(&e.mean));
     let n = frame.to_cloud(&c.normal);
     let var = n.dot(&(e.cov_mean * n));
     reading(k, c.signed_distance, var, var)
@@ -65,7 +65,7 @@ pub(super) fn point_reading(frame: &Frame<'_>, e: &SurfaceElement, k: u32) -> El
 /// hull's radius above its mean, still beyond the reach inside.
 fn deep_reading(frame: &Frame<'_>, els: &SurfaceElements, k: u32) -> ElementReading {
     let hull = els.hulls().hull(k);
-    let sd = frame.mesh.signed_distance(&frame.to_mesh(&hull.mean));
+    let sd = frame.signed_distance(&frame.to_mesh(&hull.mean));
     let var = hull.sigma * hull.sigma;
     reading(k, sd + hull.radius, var, var)
 }
@@ -149,7 +149,7 @@ fn support_reading(
 ) -> Option<Nearest> {
     let normal = frame.to_mesh_direction(&e.normal);
     let above = (start.point - frame.to_mesh(&e.mean)).dot(&normal) >= 0.0;
-    let deepest = frame.mesh.support(&(if above { -normal } else { normal }));
+    let deepest = frame.support(&(if above { -normal } else { normal }));
     let q = frame.to_cloud_point(&deepest) - e.mean;
     let (mut u, mut v) = (q.dot(&e.tangents[0]), q.dot(&e.tangents[1]));
     let [[u0, u1], [v0, v1]] = e.extent;
