@@ -56,6 +56,7 @@ os.environ.setdefault("RAYON_NUM_THREADS", "1")
 
 import argparse
 import json
+import math
 import subprocess
 import sys
 import time
@@ -321,44 +322,37 @@ def us(x: np.ndarray) -> str:
 def occlusion_row(
     robot: cp.Robot,
     cloud: cp.PointCloud,
-    exact: FclChecker,
-    near_q: np.ndarray,
-    near_d: np.ndarray,
-    sigma: float,
-    missed: np.ndarray,
+    queries: tuple[np.ndarray, np.ndarray, np.ndarray],
+    model: str,
+    side: str,
 ) -> None:
-    """Print what the scan's shadow (``filters.Occlusion``) says of missed and free configurations.
+    """Print what reading the scan's shadow (``shadow=``) does to missed and free configurations.
 
-    A configuration is in the shadow when a link's surface sample (each
-    link's mesh sampled at 1 cm) lies behind the observed surface (hidden
-    probability > 0.5), anywhere or within a stated object thickness: how
-    many of the missed deep collisions the shadow would catch, and how many
-    free configurations beyond 3 sigma reading the shadow as contact would
-    cost.
+    ``queries``: the near configurations, the missed deep collisions among them
+    and the free ones beyond 3 sigma (indices). Each is queried again with
+    ``shadow=filters.Occlusion(cloud, camera)`` at the default prior and a
+    shadow depth of infinity, 5 cm and 2 cm: how many missed collisions no
+    longer read free, and how many free configurations that read free without
+    the shadow read contact with it (what the shadow costs).
     """
+    near_q, missed, free = queries
     occ = cp.filters.Occlusion(cloud, CAMERA_AT)
-    samples = {
-        name: np.asarray(mesh.sample(density=1e4).points)
-        for name in robot.link_names
-        if (mesh := robot.link_mesh(name)) is not None
-    }
 
-    def in_shadow(q: np.ndarray, depth: float | None) -> bool:
-        poses = robot.link_poses(q)
-        return any(
-            occ.hidden_probability(pts @ poses[n][:3, :3].T + poses[n][:3, 3], depth).max() > 0.5
-            for n, pts in samples.items()
+    def free_with(i: int, **shadow: object) -> bool:
+        r = cp.collide_robot(
+            robot, near_q[i], cloud, self_collision=False, model=model, mesh_side=side, **shadow
         )
+        return r.state == "free"
 
-    free = np.flatnonzero(near_d > 3 * sigma)
-    for depth in (None, 0.05, 0.02):
-        shadowed = sum(1 for i in missed if in_shadow(near_q[i], depth))
-        flagged = sum(1 for i in free if in_shadow(near_q[i], depth))
-        within = "anywhere" if depth is None else f"within {depth * 1e2:.0f} cm"
+    was_free = [i for i in free if free_with(i)]
+    for depth in (math.inf, 0.05, 0.02):
+        caught = sum(1 for i in missed if not free_with(i, shadow=occ, shadow_depth=depth))
+        flagged = sum(1 for i in was_free if not free_with(i, shadow=occ, shadow_depth=depth))
+        within = "anywhere" if math.isinf(depth) else f"within {depth * 1e2:.0f} cm"
         print(
-            f"  a link surface in the scan's shadow ({within} behind the observed surface, "
-            f"cell {occ.cell * 1e3:.1f} mrad): {shadowed} of the {len(missed)} missed, "
-            f"{flagged} of {len(free)} free configurations beyond 3 sigma."
+            f"  shadow= ({within} behind the observed surface, prior 0.5, cell "
+            f"{occ.cell * 1e3:.1f} mrad): {caught} of the {len(missed)} missed no longer free; "
+            f"{flagged} of the {len(was_free)} free configurations beyond 3 sigma read contact."
         )
 
 
@@ -580,7 +574,8 @@ def main() -> None:
             f"{len(missed)}; of these, {unseen} meet the exact scene where no scan point lies "
             f"within 1 cm (a surface the camera does not see); missed too: {also}."
         )
-        occlusion_row(robot, cloud, exact, near_q, near_d, sigma, missed)
+        free = np.flatnonzero(beyond)
+        occlusion_row(robot, cloud, (near_q, missed, free), model, side)
     log(f"({time.perf_counter() - t_start:.0f} s)")
 
 

@@ -99,3 +99,42 @@ def test_a_stated_thickness_bounds_the_shadow(wall: cp.PointCloud) -> None:
     assert np.all(p <= everywhere + 1e-15)
     with pytest.raises(cp.InvalidInputError, match="depth"):
         occ.hidden_probability(pts, depth=-0.01)
+
+
+def test_a_robot_link_in_the_shadow_reads_contact_not_free(arm: cp.Robot) -> None:
+    # The arm's link3 sphere (radius 0.03, centre (0.3, 0, 0.3) at q = 0) lies
+    # 3 cm before a wall at x = 0.36: free. Seen from x = 1 it is 3-9 cm behind
+    # the wall, in its shadow; seen from x = -1 it is in front of it.
+    from tests.robots import wall as wall_points
+
+    scan = cp.PointCloud(wall_points(0.36, 0.3, 0.2, SIGMA, 11), sigma=SIGMA)
+    q = np.zeros(arm.dof)
+    bare = cp.collide_robot(arm, q, scan, self_collision=False)
+    assert bare.state == "free"
+    behind = Occlusion(scan, [1.0, 0.0, 0.3])
+    r = cp.collide_robot(arm, q, scan, self_collision=False, shadow=behind)
+    assert r.links["link3"].shadow == pytest.approx(0.5, abs=1e-6)
+    assert r.state == "contact"
+    thin = cp.collide_robot(
+        arm, q, scan, self_collision=False, shadow=behind, shadow_depth=0.01, shadow_prior=0.9
+    )
+    assert thin.links["link3"].shadow < 1e-9 and thin.state == "free"
+    front = cp.collide_robot(
+        arm, q, scan, self_collision=False, shadow=Occlusion(scan, [-1.0, 0.0, 0.3])
+    )
+    assert front.state == "free"
+    many = cp.collide_robot_many(arm, [q, q], scan, self_collision=False, shadow=behind)
+    assert np.allclose(many.probabilities, r.probability)
+
+
+def test_bad_shadow_options_are_named(arm: cp.Robot, wall: cp.PointCloud) -> None:
+    q = np.zeros(arm.dof)
+    occ = Occlusion(wall, [0.0, 0.0, 0.0])
+    for kwargs, words in (
+        ({"shadow": "not an occlusion"}, "Occlusion"),
+        ({"shadow_depth": 0.05}, "need a shadow"),
+        ({"shadow": occ, "shadow_prior": 2.0}, "prior"),
+        ({"shadow": occ, "shadow_depth": 0.0}, "depth"),
+    ):
+        with pytest.raises(cp.InvalidInputError, match=words):
+            cp.collide_robot(arm, q, wall, **kwargs)

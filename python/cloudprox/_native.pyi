@@ -2075,6 +2075,9 @@ class LinkCollision:
     def state(self) -> _StateName:
         """The link's state."""
     @property
+    def shadow(self) -> float:
+        """With ``shadow=``, the link's shadow probability (already in ``probability``); 0 without."""
+    @property
     def queried(self) -> bool:
         """Whether the link was queried (it passed the broad phase, before any decision)."""
     @property
@@ -2258,9 +2261,9 @@ def collide_robot(
     ``options`` are the keyword options of :class:`CollisionRequest`
     (overriding ``request``'s) plus ``mesh_side`` (``"exact"`` or ``"sampled"``),
     ``mesh_spacing`` (with sampled links only), ``broad_phase``,
-    ``self_collision``, ``padding``, ``target``, ``target_pose`` and
-    ``allowed_links``; unknown names raise :class:`InvalidInputError`. The GIL
-    is released.
+    ``self_collision``, ``padding``, ``target``, ``target_pose``,
+    ``allowed_links``, ``shadow``, ``shadow_depth`` and ``shadow_prior``;
+    unknown names raise :class:`InvalidInputError`. The GIL is released.
 
     ``padding`` (metres, default 0) grows each link's surface by a safety margin
     (an exact link's signed distance less it; a sampled link's samples moved
@@ -2277,6 +2280,16 @@ def collide_robot(
     against the cloud, and counts. Unknown link names, a negative or NaN
     padding, ``allowed_links`` without a ``target`` raise
     :class:`InvalidInputError`.
+
+    ``shadow`` (a :class:`cloudprox.filters.Occlusion` of the scan, from its
+    sensor's origin) reads what the sensor did not see: each link's surface,
+    sampled at the occlusion's footprint, has a shadow probability,
+    ``shadow_prior`` (default 0.5) times the largest probability of a sample
+    lying behind the observed surface by at most ``shadow_depth`` (metres,
+    default 0.05: the thickness of the objects seen from the front), and the
+    link's probability is the aggregation of its query's and that
+    (:attr:`LinkCollision.shadow`). A link reaching into the scan's shadow
+    then reads ``contact`` rather than ``free``.
     """
 
 def collide_robot_many(

@@ -1,5 +1,7 @@
 //! `Occlusion`: what a scan did not see.
 
+use std::sync::Arc;
+
 use cloudprox::filter::{Occlusion, Visibility};
 use cloudprox::math::Point3;
 use numpy::PyArray1;
@@ -14,7 +16,7 @@ use crate::error::{invalid_input, CoreResultExt};
 /// ([`cloudprox::filter::Occlusion`]).
 #[pyclass(name = "Occlusion", frozen, module = "cloudprox._native")]
 pub struct PyOcclusion {
-    inner: Occlusion,
+    pub(crate) inner: Arc<Occlusion>,
 }
 
 #[pymethods]
@@ -44,7 +46,9 @@ impl PyOcclusion {
             cell,
         )
         .or_py(py)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner: Arc::new(inner),
+        })
     }
 
     /// The angular cell in radians.

@@ -9,7 +9,8 @@ use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
     collide_robot_many as core_collide_robot_many, AttachedShape, GraspTarget, LinkCollision,
-    MotionRequest, Robot, RobotCollisionResult, RobotCounters, RobotStats, TargetCollision,
+    MotionRequest, Robot, RobotCollisionResult, RobotCounters, RobotShadow, RobotStats,
+    TargetCollision,
 };
 use cloudprox::Real;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -21,11 +22,12 @@ use crate::convert::{check_shape, pose_from, pose_to_py, to_f64_array, vec_to_py
 use crate::error::{invalid_input, run_detached, CoreResultExt};
 use crate::filter::PySelfFilter;
 use crate::mesh::PyMesh;
+use crate::occlusion::PyOcclusion;
 use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, PyContactPatch};
 
 /// The keywords of `collide_robot` that are not request options.
-const ROBOT_KEYWORDS: [&str; 9] = [
+const ROBOT_KEYWORDS: [&str; 12] = [
     "request",
     "mesh_side",
     "mesh_spacing",
@@ -35,6 +37,9 @@ const ROBOT_KEYWORDS: [&str; 9] = [
     "target",
     "target_pose",
     "allowed_links",
+    "shadow",
+    "shadow_depth",
+    "shadow_prior",
 ];
 /// The keywords of `check_motion` beyond those of `collide_robot`.
 const MOTION_KEYWORDS: [&str; 3] = ["resolution", "max_probability", "warm_start"];
@@ -64,6 +69,7 @@ fn motion_request(
     let mut target: Option<Bound<'_, PyAny>> = None;
     let mut target_pose: Option<Bound<'_, PyAny>> = None;
     let mut allowed: Option<Vec<String>> = None;
+    let mut shadow: (Option<Bound<'_, PyAny>>, Option<f64>, Option<f64>) = (None, None, None);
     if let Some(options) = options {
         for (k, v) in options.iter() {
             let key: String = k.extract()?;
@@ -81,6 +87,9 @@ fn motion_request(
                 "target" => target = Some(v),
                 "target_pose" => target_pose = Some(v),
                 "allowed_links" => allowed = Some(names_from(py, &v, "allowed_links")?),
+                "shadow" => shadow.0 = Some(v),
+                "shadow_depth" => shadow.1 = Some(extract(py, &v, &key, "a float (metres)")?),
+                "shadow_prior" => shadow.2 = Some(extract(py, &v, &key, "a float in [0, 1]")?),
                 "resolution" if motion => {
                     out.resolution = Some(extract(py, &v, &key, "a float")?);
                 }
@@ -97,10 +106,37 @@ fn motion_request(
         also_valid.extend(MOTION_KEYWORDS);
     }
     out.robot.target = target_from(py, target.as_ref(), target_pose.as_ref(), allowed)?;
+    out.robot.shadow = shadow_from(py, shadow)?;
     out.robot.mesh_side = link_side(py, mesh_side.as_deref(), out.robot.mesh_spacing)?;
     out.robot.collide = request_from(py, request, Some(&collide_options), &also_valid)?;
     out.robot.validate().or_py(py)?;
     Ok(out)
+}
+
+/// `shadow=` (an `Occlusion`) with `shadow_depth=` and `shadow_prior=`.
+fn shadow_from(
+    py: Python<'_>,
+    (occlusion, depth, prior): (Option<Bound<'_, PyAny>>, Option<f64>, Option<f64>),
+) -> PyResult<Option<RobotShadow>> {
+    let Some(occlusion) = occlusion else {
+        if depth.is_some() || prior.is_some() {
+            return Err(invalid_input(
+                py,
+                "shadow_depth and shadow_prior need a shadow (a filters.Occlusion)".to_string(),
+            ));
+        }
+        return Ok(None);
+    };
+    let occ = occlusion.cast::<PyOcclusion>().map_err(|_| {
+        invalid_input(
+            py,
+            "option shadow must be a filters.Occlusion of the scan".to_string(),
+        )
+    })?;
+    let mut s = RobotShadow::new(Arc::clone(&occ.get().inner));
+    s.depth = depth.unwrap_or(s.depth);
+    s.prior = prior.unwrap_or(s.prior);
+    Ok(Some(s))
 }
 
 /// `padding=`: a float for every link, or a mapping from link name to metres.
@@ -885,6 +921,14 @@ impl PyLinkCollision {
     #[getter]
     fn probability(&self) -> f64 {
         self.inner.probability
+    }
+
+    /// With ``shadow=``, the link's shadow probability (the prior times the
+    /// largest probability of a surface sample lying in the scan's shadow),
+    /// already in ``probability``; 0 without.
+    #[getter]
+    fn shadow(&self) -> f64 {
+        self.inner.shadow
     }
 
     /// `"free"`, `"contact"` or `"collision"`.

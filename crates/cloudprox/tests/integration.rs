@@ -42,6 +42,7 @@ mod robot_collide;
 mod robot_exact;
 mod robot_grasp;
 mod robot_model;
+mod robot_shadow;
 mod scan_pipeline;
 mod shape_exact;
 mod shape_signed_distance;

@@ -55,6 +55,7 @@ pub struct Occlusion {
     origin: Point3,
     cell: Real,
     cells: HashMap<(u8, i32, i32), Return>,
+    median_range: Real,
 }
 
 /// The cube-map face and its coordinates `(a / |k|, b / |k|)` of direction `d`
@@ -116,11 +117,21 @@ impl Occlusion {
                 })
                 .or_insert(here);
         }
+        let mut ranges: Vec<Real> = points.iter().map(|p| (p - origin).norm()).collect();
+        let k = ranges.len() / 2;
+        let median_range = *ranges.select_nth_unstable_by(k, Real::total_cmp).1;
         Ok(Self {
             origin,
             cell,
             cells,
+            median_range,
         })
+    }
+
+    /// A cell's footprint at the scan's median range (metres): the spacing
+    /// at which a surface's samples each meet a cell of their own.
+    pub fn footprint(&self) -> Real {
+        self.cell * self.median_range
     }
 
     /// The cell of unit direction `dir`.

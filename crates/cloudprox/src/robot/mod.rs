@@ -10,6 +10,7 @@
 //! | link collision geometry: meshes, URDF primitives, samples, exact shapes | `geometry.rs` |
 //! | `collide_robot`, `collide_robot_many`, self-collision | `query.rs` |
 //! | `check_motion` | `motion.rs` |
+//! | reading the scan's shadow (`RobotRequest::shadow`) | `shadow.rs` |
 //! | attached (held) objects: `Robot::attach`, `Robot::detach` | `attached.rs` |
 //! | grasp targets, link padding: resolved against the robot | `target.rs` |
 //!
@@ -25,6 +26,7 @@ mod kinematics;
 mod model;
 mod motion;
 mod query;
+mod shadow;
 mod srdf;
 mod target;
 mod urdf;
@@ -37,5 +39,6 @@ pub use query::{
     collide_robot, collide_robot_many, LinkCollision, RobotCollisionResult, RobotCounters,
     RobotRequest, RobotStats, SelfCollision,
 };
+pub use shadow::{RobotShadow, SHADOW_DEFAULT_DEPTH, SHADOW_DEFAULT_PRIOR};
 pub use srdf::{parse_disabled_collisions, DisabledCollision};
 pub use target::{GraspTarget, TargetCollision, TargetObject};

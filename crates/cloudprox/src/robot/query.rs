@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use super::attached::AttachedObject;
 use super::geometry::{sample_padded, samples_at, LinkGeometry, LinkSamples};
 use super::model::Robot;
+use super::shadow::{RobotShadow, ShadowSamples};
 use super::target::{check_padding, resolve, GraspTarget, TargetCollision};
 use crate::bvh::{Aabb, BvhWorkspace};
 use crate::cloud::PointCloud;
@@ -82,6 +83,10 @@ pub struct RobotRequest {
     /// allowed links' contacts with it are reported apart
     /// ([`RobotCollisionResult::target`], [`LinkCollision::target`]).
     pub target: Option<GraspTarget>,
+    /// Read the scan's shadow (default `None`): a link whose surface reaches
+    /// into space behind the observed surfaces reads at least the stated
+    /// prior's probability ([`RobotShadow`], [`LinkCollision::shadow`]).
+    pub shadow: Option<RobotShadow>,
 }
 
 impl Default for RobotRequest {
@@ -95,6 +100,7 @@ impl Default for RobotRequest {
             padding: 0.0,
             link_padding: Vec::new(),
             target: None,
+            shadow: None,
         }
     }
 }
@@ -111,6 +117,9 @@ impl RobotRequest {
     /// queries.
     pub fn validate(&self) -> Result<()> {
         self.collide.validate()?;
+        if let Some(shadow) = &self.shadow {
+            shadow.validate()?;
+        }
         check_padding(self.padding, "padding")?;
         for (name, d) in &self.link_padding {
             check_padding(*d, &format!("padding of link '{name}'"))?;
@@ -167,6 +176,10 @@ pub struct LinkCollision {
     /// (the request's aggregation of the environment's and the target's);
     /// an allowed body's `probability` is the environment's alone.
     pub target: Option<Box<LinkCollision>>,
+    /// With [`RobotRequest::shadow`], the body's shadow probability (the
+    /// prior times the largest probability of a surface sample lying in the
+    /// scan's shadow), already in `probability`; 0 without.
+    pub shadow: Real,
 }
 
 /// Two links (or a link and an attached object) whose exact shapes intersect.
@@ -318,6 +331,7 @@ fn after_decision(link: usize) -> LinkCollision {
         queried: false,
         result: None,
         target: None,
+        shadow: 0.0,
     }
 }
 
@@ -385,6 +399,8 @@ pub(crate) struct LinkSides {
     /// Sampled links only, per link with a positive padding: its padded
     /// sample.
     padded: Vec<Option<PaddedSample>>,
+    /// With [`RobotRequest::shadow`], every entry's surface samples.
+    shadow: Option<ShadowSamples>,
 }
 
 /// A sampled link's sample moved along its faces' normals by its padding.
@@ -438,11 +454,16 @@ impl LinkSides {
                 padded.push(sample);
             }
         }
+        let shadow = match &request.shadow {
+            Some(s) => Some(ShadowSamples::new(robot, s)?),
+            None => None,
+        };
         Ok(LinkSides {
             kind,
             padding: resolved.padding,
             target: resolved.target,
             padded,
+            shadow,
         })
     }
 
@@ -627,6 +648,13 @@ pub(crate) fn collide_robot_prepared(
             }
             entry.target = Some(Box::new(t));
         }
+        if let Some(shadow) = &sides.shadow {
+            entry.shadow = shadow.probability(l, pose);
+            if entry.shadow > 0.0 {
+                entry.probability = aggregate(aggregation, &[entry.probability, entry.shadow]);
+                entry.state = request.collide.thresholds.state(entry.probability);
+            }
+        }
         decided = request.collide.decide_only
             && entry.queried
             && entry.probability >= request.collide.thresholds.collision;
@@ -702,6 +730,7 @@ fn query_link(
             queried: false,
             result: None,
             target: None,
+            shadow: 0.0,
         };
     }
     counters.links_queried += 1;
@@ -716,6 +745,7 @@ fn query_link(
                 queried: true,
                 result: Some(r),
                 target: None,
+                shadow: 0.0,
             }
         }
         // The request was validated by the caller; a query error cannot occur.
@@ -726,6 +756,7 @@ fn query_link(
             queried: true,
             result: None,
             target: None,
+            shadow: 0.0,
         },
     }
 }
