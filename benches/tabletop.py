@@ -65,12 +65,18 @@ def scene_meshes() -> dict[str, cp.Mesh]:
     return out
 
 
-def scan(meshes: dict[str, cp.Mesh], seed: int, scale: float = 1.0) -> tuple[cp.PointCloud, float]:
+def scan(
+    meshes: dict[str, cp.Mesh],
+    seed: int,
+    scale: float = 1.0,
+    camera: tuple[np.ndarray, np.ndarray] = (CAMERA_AT, CAMERA_LOOK),
+) -> tuple[cp.PointCloud, float]:
     """Ray-cast the scene from the camera, add Kinect noise.
 
     ``scale`` multiplies the image size and the focal length (the same view,
-    ``scale^2`` as many points). Returns the cloud and the sensor's resolution: a
-    pixel's footprint at the median depth.
+    ``scale^2`` as many points); ``camera`` is where the camera is and the point
+    it looks at. Returns the cloud and the sensor's resolution: a pixel's
+    footprint at the median depth.
     """
     import open3d as o3d
 
@@ -79,7 +85,7 @@ def scan(meshes: dict[str, cp.Mesh], seed: int, scale: float = 1.0) -> tuple[cp.
         rc.add_triangles(
             np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32)
         )
-    pose = cp.pose.look_at(CAMERA_AT, CAMERA_LOOK)  # optical frame: x right, y down, z forward
+    pose = cp.pose.look_at(*camera)  # optical frame: x right, y down, z forward
     width, height, focal = round(WIDTH * scale), round(HEIGHT * scale), FOCAL * scale
     u, v = np.meshgrid(np.arange(width), np.arange(height))
     cam = np.stack(
