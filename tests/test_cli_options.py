@@ -191,3 +191,49 @@ def test_thresholds_at_their_limits_are_accepted(
     limits = ["--threshold-free", "0.5", "--threshold-collision", "0.5"]
     doc = _collide_json(capsys, a, b, "--pose-b", str(pose_file), *limits)
     assert doc["state"] == ("free" if doc["probability"] <= 0.5 else "collision")
+
+
+def test_robot_padding_and_shadow_reach_the_query(
+    capsys: pytest.CaptureFixture[str], arm_path: Path, wall_scan: Path
+) -> None:
+    q = np.array([0.0, 0.0, 0.05, 0.0])
+    argv = ["robot", str(arm_path), str(wall_scan), "--sigma", str(SIGMA), "--q", "0,0,0.05,0"]
+    robot = cp.Robot.from_urdf(arm_path)
+    cloud = cp.PointCloud(np.load(wall_scan), sigma=SIGMA)
+    origin = [1.0, 0.0, 0.3]
+    shadow = cp.filters.Occlusion(cloud, origin)
+    for options, kwargs in (
+        (["--padding", "0.02"], {"padding": 0.02}),
+        (["--shadow", "--origin", "1,0,0.3"], {"shadow": shadow}),
+        (
+            ["--shadow", "--origin", "1,0,0.3", "--shadow-depth", "0.5"],
+            {"shadow": shadow, "shadow_depth": 0.5},
+        ),
+    ):
+        assert main([*argv, *options, "--json"]) == 0
+        doc = json.loads(capsys.readouterr().out)
+        expected = cp.collide_robot(robot, q, cloud, **kwargs)  # type: ignore[arg-type]
+        assert doc["probability"] == pytest.approx(expected.probability, rel=1e-9, abs=1e-12)
+    bare = cp.collide_robot(robot, q, cloud).probability
+    deep = cp.collide_robot(robot, q, cloud, shadow=shadow, shadow_depth=0.5).probability
+    assert deep > bare  # the links behind the wall, seen from x = 1, are in its shadow
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--shadow"], "the sensor origin is unknown"),
+        (["--shadow-depth", "0.1"], "--shadow-depth needs --shadow"),
+    ],
+)
+def test_robot_shadow_without_what_it_needs_exits_2(
+    capsys: pytest.CaptureFixture[str],
+    arm_path: Path,
+    wall_scan: Path,
+    options: list[str],
+    message: str,
+) -> None:
+    argv = ["robot", str(arm_path), str(wall_scan), "--sigma", str(SIGMA), "--q", "0,0,0,0"]
+    assert main([*argv, *options]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err

@@ -198,6 +198,9 @@ class LoadedSide:
     skipped: int = 0
     filters: list[dict[str, Any]] = field(default_factory=list)
     fields: list[str] = field(default_factory=list)
+    #: The sensor's origin in the cloud's frame (given, or the file's
+    #: ``VIEWPOINT``), or ``None`` where it is unknown.
+    origin: FloatArray | None = None
 
     @property
     def obj(self) -> PointCloud | Mesh:
@@ -301,6 +304,7 @@ def load_side(
         emptied = steps[result.emptied_by].describe()
         raise PipelineError(f"{path}: filter {emptied} removed every point")
     side.cloud = result.cloud
+    side.origin = spec.sensor_origin(scan)
     return side
 
 

@@ -105,7 +105,7 @@ def _cmd_robot(args: argparse.Namespace) -> int:
     from cloudprox import Robot
 
     request = request_from_args(args)
-    robot = Robot.from_urdf(args.urdf, package_dirs=args.package_dir or None)
+    robot = Robot.from_urdf(args.urdf, package_dirs=args.package_dir or None, srdf=args.srdf)
     qs = read_configurations(args.q, args.q_file, robot.dof)
     side, base = _load(args)
     check_view_arguments(args)
@@ -115,10 +115,27 @@ def _cmd_robot(args: argparse.Namespace) -> int:
         "request": request,
         "mesh_side": args.mesh_side,
         "mesh_spacing": args.mesh_spacing,
-    }
+        "padding": args.padding,
+    } | _shadow_options(args, side)
     if args.q is not None:
         return _one_configuration(args, robot, qs[0], side, base, options)
     return _many_configurations(args, robot, qs, side, base, options)
+
+
+def _shadow_options(args: argparse.Namespace, side: Any) -> dict[str, Any]:
+    """Return the ``shadow=`` options of ``--shadow`` / ``--shadow-depth`` (none without)."""
+    from cloudprox.filters import Occlusion
+
+    if not args.shadow:
+        if args.shadow_depth is not None:
+            raise CliError("--shadow-depth needs --shadow")
+        return {}
+    if side.origin is None:
+        raise CliError(
+            f"--shadow on {args.scan}: the sensor origin is unknown (the file has no "
+            "VIEWPOINT): give --origin or --sensor-pose"
+        )
+    return {"shadow": Occlusion(side.cloud, side.origin), "shadow_depth": args.shadow_depth}
 
 
 def _one_configuration(
@@ -150,8 +167,9 @@ def _one_configuration(
         f"time: {1e3 * result.stats.time_seconds:.2f} ms"
     )
     for name, link in result.links.items():
-        if link.queried:
-            out.print(f"  {name}: P = {link.probability:.3g} ({link.state})")
+        if link.queried or link.shadow > 0:
+            shadow = f", in the scan's shadow: {link.shadow:.3g}" if link.shadow > 0 else ""
+            out.print(f"  {name}: P = {link.probability:.3g} ({link.state}{shadow})")
     if result.self_collisions:
         pairs = ", ".join(f"{a}-{b}" for a, b in result.self_collisions)
         out.print(f"self-collision: {pairs}")
@@ -262,6 +280,12 @@ def add_parsers(sub: Any) -> None:
         help="pose of the robot's root link in the scan's frame (as --pose-a of collide)",
     )
     rob.add_argument(
+        "--srdf",
+        default=None,
+        metavar="FILE",
+        help="an SRDF whose <disable_collisions> pairs leave the self-collision check",
+    )
+    rob.add_argument(
         "--package-dir",
         action="append",
         default=[],
@@ -278,7 +302,7 @@ def add_parsers(sub: Any) -> None:
 
 
 def _add_link_arguments(rob: argparse.ArgumentParser) -> None:
-    """Add ``--mesh-side`` and ``--mesh-spacing``: how the links stand in the queries."""
+    """Add ``--mesh-side``, ``--mesh-spacing``, ``--padding`` and the shadow options."""
     rob.add_argument(
         "--mesh-side",
         choices=["exact", "sampled"],
@@ -293,4 +317,26 @@ def _add_link_arguments(rob: argparse.ArgumentParser) -> None:
         type=float,
         default=None,
         help="sampling spacing of sampled links (m; default half the scan's spacing)",
+    )
+    rob.add_argument(
+        "--padding",
+        type=float,
+        default=None,
+        metavar="M",
+        help="grow every link's surface by M metres (a margin for model error; default 0)",
+    )
+    rob.add_argument(
+        "--shadow",
+        action="store_true",
+        help=(
+            "read the scan's shadow: a link reaching behind what the sensor saw reads at "
+            "least contact (needs the sensor origin: the file's VIEWPOINT or --origin)"
+        ),
+    )
+    rob.add_argument(
+        "--shadow-depth",
+        type=float,
+        default=None,
+        metavar="M",
+        help="with --shadow: how far behind a seen surface space counts (m; default 0.05)",
     )
