@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
+use cloudprox::math::{Matrix3, Point3};
 use cloudprox::uncertainty::DiscretizationSettings;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2, PyArray3};
@@ -25,7 +26,7 @@ pub(crate) enum Noise {
     ),
     Sigma(f64),
     Sigmas(Vec<f64>),
-    Covariances(Vec<cloudprox::math::Matrix3>),
+    Covariances(Vec<Matrix3>),
 }
 
 pub(crate) fn noise_from(
@@ -188,7 +189,7 @@ impl PyPointCloud {
     /// (`k` neighbours), built without the GIL.
     pub(crate) fn build(
         py: Python<'_>,
-        points: Vec<cloudprox::math::Point3>,
+        points: Vec<Point3>,
         noise: Noise,
         discretization: bool,
         k: Option<i64>,
@@ -373,18 +374,7 @@ impl PyPointCloud {
             .collect();
         let rho = self.inner.element_settings().noise_correlation;
         let disc_k = self.recipe.disc_k;
-        let root = run_detached(py, move || {
-            let mut root = PointCloud::from_covariances(points, sensor)?;
-            if let Some(k) = disc_k {
-                let settings = DiscretizationSettings {
-                    k,
-                    ..DiscretizationSettings::default()
-                };
-                root = root.with_discretization(&settings)?;
-            }
-            root.set_noise_correlation(rho)?;
-            Ok(root)
-        })?;
+        let root = run_detached(py, move || root_cloud(points, sensor, disc_k, rho))?;
         let root = Arc::new(root);
         Ok(Self {
             inner: Arc::clone(&root),
@@ -443,16 +433,7 @@ impl PyPointCloud {
         let poses: Vec<_> = poses.iter().map(pose_from_7).collect();
         let moves = poses.clone();
         let (root, cloud) = run_detached(py, move || {
-            let mut root = PointCloud::from_covariances(points, sensor)?;
-            if let Some(k) = disc_k {
-                let settings = DiscretizationSettings {
-                    k,
-                    ..DiscretizationSettings::default()
-                };
-                root = root.with_discretization(&settings)?;
-            }
-            root.set_noise_correlation(rho)?;
-            let root = Arc::new(root);
+            let root = Arc::new(root_cloud(points, sensor, disc_k, rho)?);
             let mut cloud = Arc::clone(&root);
             for pose in &moves {
                 cloud = Arc::new(cloud.transformed(pose)?);
@@ -476,4 +457,25 @@ impl PyPointCloud {
     fn __repr__(&self) -> String {
         format!("PointCloud with {} points.", self.inner.len())
     }
+}
+
+/// A root cloud (no moves) from its points and sensor covariances, with the
+/// discretization of `disc_k` neighbours (when given) and noise correlation
+/// `rho`: what `select_by_index` and unpickling rebuild.
+fn root_cloud(
+    points: Vec<Point3>,
+    sensor: Vec<Matrix3>,
+    disc_k: Option<usize>,
+    rho: f64,
+) -> cloudprox::Result<PointCloud> {
+    let mut root = PointCloud::from_covariances(points, sensor)?;
+    if let Some(k) = disc_k {
+        let settings = DiscretizationSettings {
+            k,
+            ..DiscretizationSettings::default()
+        };
+        root = root.with_discretization(&settings)?;
+    }
+    root.set_noise_correlation(rho)?;
+    Ok(root)
 }

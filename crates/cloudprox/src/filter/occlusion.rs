@@ -197,11 +197,12 @@ impl Occlusion {
         }
     }
 
-    /// Where `x` lies as the scan saw it ([`Visibility`]).
+    /// Where `x` lies as the scan saw it ([`Visibility`]): hidden where its
+    /// range exceeds the return's (its hidden probability above 1/2).
     pub fn visibility(&self, x: &Point3) -> Visibility {
         match self.nearest(x) {
             (None, _) => Visibility::Unobserved,
-            _ if self.hidden_probability(x) > 0.5 => Visibility::Hidden,
+            (Some(r), range) if range > r.range => Visibility::Hidden,
             _ => Visibility::Seen,
         }
     }

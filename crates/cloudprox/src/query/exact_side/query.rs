@@ -73,22 +73,7 @@ pub fn collide_exact_cloud(
     validate(request)?;
     validate_pose(pose_mesh, "pose_mesh")?;
     validate_pose(pose_cloud, "pose_cloud")?;
-    exact_side_query(pose_mesh, (mesh, 0.0), pose_cloud, cloud, request)
-}
-
-/// [`collide_exact_cloud`] of the mesh's surface grown by `padding` (metres,
-/// finite and `>= 0`, checked by the caller): every signed distance read is
-/// the mesh's less `padding` (a robot link's safety margin). Padding 0 is
-/// [`collide_exact_cloud`] bit for bit. The request and poses are not
-/// validated.
-pub(crate) fn collide_exact_cloud_padded(
-    pose_mesh: &Pose,
-    (mesh, padding): (&MeshDistance, Real),
-    pose_cloud: &Pose,
-    cloud: &PointCloud,
-    request: &CollisionRequest,
-) -> Result<CollisionResult> {
-    exact_side_query(pose_mesh, (mesh, padding), pose_cloud, cloud, request)
+    collide_exact_cloud_padded(pose_mesh, (mesh, 0.0), pose_cloud, cloud, request)
 }
 
 /// [`collide_exact_cloud`] with the sides in the other order: the cloud is
@@ -132,7 +117,7 @@ pub fn collide_exact_cloud_many(
     }
     poses_mesh
         .par_iter()
-        .map(|p| exact_side_query(p, (mesh, 0.0), pose_cloud, cloud, request))
+        .map(|p| collide_exact_cloud_padded(p, (mesh, 0.0), pose_cloud, cloud, request))
         .collect()
 }
 
@@ -186,8 +171,12 @@ fn segmentations(request: &CollisionRequest) -> u32 {
     }
 }
 
-/// The query on validated arguments.
-fn exact_side_query(
+/// [`collide_exact_cloud`] of the mesh's surface grown by `padding` (metres,
+/// finite and `>= 0`, checked by the caller): every signed distance read is
+/// the mesh's less `padding` (a robot link's safety margin). Padding 0 is
+/// [`collide_exact_cloud`] bit for bit. The request and poses are not
+/// validated.
+pub(crate) fn collide_exact_cloud_padded(
     pose_mesh: &Pose,
     (mesh, padding): (&MeshDistance, Real),
     pose_cloud: &Pose,
