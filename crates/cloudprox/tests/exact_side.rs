@@ -408,3 +408,37 @@ fn a_corner_pressed_into_a_wide_floor_beside_a_hole_collides() {
         );
     }
 }
+
+#[test]
+fn per_point_probabilities_of_a_mesh_pressed_deep_match_brute_force() {
+    // The cube pressed 3 cm into the sphere, and just touching it: every
+    // point's stored p against Eq. 3 at its exact closest point, point by
+    // point. Far outside and deep inside the search is skipped: p below
+    // epsilon / 2 is stored as 0, above 1 - epsilon / 2 as 1.
+    use cloudprox::probability::point_probability;
+    let (cloud, mesh) = sphere_scene();
+    let cube = MeshDistance::new(&mesh).unwrap();
+    let req = CollisionRequest::default();
+    let half = 0.5 * req.prune_epsilon;
+    for gap in [-0.03, 0.0] {
+        let pose = cube_pose(gap);
+        let r = collide_exact_cloud(&pose, &cube, &Pose::identity(), &cloud, &req).unwrap();
+        let got = r.probabilities_b.to_dense();
+        let (mut deep, mut near) = (0, 0);
+        for (i, (p, cov)) in cloud.points().iter().zip(cloud.covariances()).enumerate() {
+            let c = cube.closest(&(pose.inverse() * p));
+            let n = pose.rotation * c.normal;
+            let want = point_probability(c.signed_distance, &n, cov, 1.0);
+            assert!(
+                (got[i] - want).abs() <= half + 1e-12,
+                "gap {gap}, point {i}: {} vs {want}",
+                got[i]
+            );
+            deep += usize::from(want > 1.0 - half);
+            near += usize::from(want > half && want <= 1.0 - half);
+        }
+        if gap < 0.0 {
+            assert!(deep > 100 && near > 10, "{deep} deep, {near} near");
+        }
+    }
+}

@@ -319,10 +319,8 @@ impl Robot {
     /// Drops what depends on the objects held: the cached samples and the
     /// motion bound's weights.
     fn attached_changed(&mut self) {
-        match self.samples.get_mut() {
-            Ok(s) => s.clear(),
-            Err(poisoned) => poisoned.into_inner().clear(),
-        }
+        self.samples.clear();
+        self.shadow_samples.clear();
         self.compute_motion_weights();
     }
 }

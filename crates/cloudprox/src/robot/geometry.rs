@@ -2,14 +2,14 @@
 //! signed distance or the cloud that stands for a link in a query, and the
 //! exact shape for self-collision.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::bvh::Aabb;
 use crate::cloud::PointCloud;
 use crate::error::{Error, Result};
 use crate::math::Point3;
 use crate::query::exact::ExactShape;
-use crate::shape::{Mesh, MeshDistance};
+use crate::shape::{DistanceField, Mesh, MeshDistance};
 use crate::Real;
 
 /// Segments around the axis of URDF cylinders, spheres and capsules (the
@@ -119,7 +119,17 @@ pub struct LinkGeometry {
     pub aabb: Aabb,
     /// Largest distance of a vertex from the link frame's origin.
     pub radius: Real,
+    /// The distance field of `distance`, built on the first query that
+    /// reads it ([`LinkGeometry::field`]; shared by the clones).
+    field: Arc<OnceLock<Option<DistanceField>>>,
 }
+
+/// The cells of a link's distance field across its bounding box's diagonal.
+const FIELD_CELLS: Real = 48.0;
+/// The finest and coarsest cell of a link's distance field (metres).
+const FIELD_CELL_RANGE: (Real, Real) = (0.002, 0.01);
+/// A link's distance field is exact within this many cells of its surface.
+const FIELD_BAND_CELLS: Real = 6.0;
 
 impl LinkGeometry {
     /// Prepares the parts of one link (`link` names it in errors).
@@ -151,7 +161,25 @@ impl LinkGeometry {
             distance,
             aabb,
             radius,
+            field: Arc::new(OnceLock::new()),
         })
+    }
+
+    /// The link's distance field, built on first use: cells of a 48th of
+    /// the bounding box's diagonal (from 2 mm to 1 cm), exact within six
+    /// cells of the surface. Its bounds let the exact-side query pass over elements and
+    /// points that the noise cannot bring to the surface, or that lie deep
+    /// inside, without a closest-point search. `None` where it cannot be
+    /// built (a grid too large): the queries search as without one.
+    pub fn field(&self) -> Option<&DistanceField> {
+        self.field
+            .get_or_init(|| {
+                let diagonal = (self.aabb.maxs - self.aabb.mins).norm();
+                let (fine, coarse) = FIELD_CELL_RANGE;
+                let cell = (diagonal / FIELD_CELLS).clamp(fine, coarse);
+                DistanceField::new(Arc::clone(&self.distance), cell, FIELD_BAND_CELLS * cell).ok()
+            })
+            .as_ref()
     }
 }
 
@@ -232,28 +260,7 @@ impl LinkSamples {
 /// Cached samples of every link (and attached mesh object) at `spacing`,
 /// sampled on first use.
 pub(crate) fn samples_at(robot: &super::Robot, spacing: Real) -> Result<Arc<LinkSamples>> {
-    let key = spacing.to_bits();
-    {
-        let cache = robot
-            .samples
-            .lock()
-            .map_err(|_| Error::invalid("robot sample cache poisoned by an earlier panic"))?;
-        if let Some((_, s)) = cache.iter().find(|(k, _)| *k == key) {
-            return Ok(Arc::clone(s));
-        }
-    }
-    let s = Arc::new(LinkSamples::new(robot, spacing)?);
-    let mut cache = robot
+    robot
         .samples
-        .lock()
-        .map_err(|_| Error::invalid("robot sample cache poisoned by an earlier panic"))?;
-    if let Some((_, existing)) = cache.iter().find(|(k, _)| *k == key) {
-        return Ok(Arc::clone(existing));
-    }
-    // Keep a few spacings only: a planner queries one scene at a time.
-    if cache.len() >= 4 {
-        cache.remove(0);
-    }
-    cache.push((key, Arc::clone(&s)));
-    Ok(s)
+        .get_or_build(spacing, || LinkSamples::new(robot, spacing))
 }

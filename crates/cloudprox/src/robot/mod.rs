@@ -11,6 +11,7 @@
 //! | `collide_robot`, `collide_robot_many`, self-collision | `query.rs` |
 //! | `check_motion` | `motion.rs` |
 //! | reading the scan's shadow (`RobotRequest::shadow`) | `shadow.rs` |
+//! | the caches per sampling spacing (link samples, shadow samples) | `cache.rs` |
 //! | attached (held) objects: `Robot::attach`, `Robot::detach` | `attached.rs` |
 //! | grasp targets, link padding: resolved against the robot | `target.rs` |
 //!
@@ -21,6 +22,7 @@
 //! sampled once per sampling spacing and cached on the robot.
 
 mod attached;
+mod cache;
 mod geometry;
 mod kinematics;
 mod model;

@@ -1,11 +1,10 @@
 //! The robot model: links, joints, limits; checks of configurations.
 
-use std::sync::{Arc, Mutex};
-
 use super::attached::AttachedObject;
+use super::cache::SpacingCache;
 use super::geometry::{LinkGeometry, LinkSamples};
 use crate::error::{Error, Result};
-use crate::math::{Pose, Vector3};
+use crate::math::{Point3, Pose, Vector3};
 use crate::Real;
 
 /// Tolerance (radians or metres) by which a configuration may leave a joint's
@@ -142,18 +141,16 @@ pub struct Robot {
     pub(crate) motion_weights: Vec<Vec<(usize, Real)>>,
     /// Objects held by links ([`Robot::attach`]), in the order attached.
     pub(crate) attached: Vec<AttachedObject>,
-    /// Link samples per sampling spacing (bit pattern of the spacing).
-    pub(crate) samples: Mutex<Vec<(u64, Arc<LinkSamples>)>>,
+    /// Link samples per sampling spacing.
+    pub(crate) samples: SpacingCache<LinkSamples>,
+    /// Every entry's surface samples for the shadow, per footprint spacing.
+    pub(crate) shadow_samples: SpacingCache<Vec<Vec<Point3>>>,
 }
 
 impl Clone for Robot {
     /// A copy of the robot, its cached link samples shared with the original
     /// (none if a thread panicked while holding the cache: it is only a cache).
     fn clone(&self) -> Self {
-        let samples = self
-            .samples
-            .lock()
-            .map_or_else(|_| Vec::new(), |s| s.clone());
         Robot {
             name: self.name.clone(),
             links: self.links.clone(),
@@ -165,7 +162,8 @@ impl Clone for Robot {
             ignored_pairs: self.ignored_pairs.clone(),
             motion_weights: self.motion_weights.clone(),
             attached: self.attached.clone(),
-            samples: Mutex::new(samples),
+            samples: self.samples.clone(),
+            shadow_samples: self.shadow_samples.clone(),
         }
     }
 }

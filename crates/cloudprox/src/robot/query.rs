@@ -458,6 +458,9 @@ impl LinkSides {
             Some(s) => Some(ShadowSamples::new(robot, s)?),
             None => None,
         };
+        if matches!(kind, SideKind::Exact) {
+            build_fields(robot);
+        }
         Ok(LinkSides {
             kind,
             padding: resolved.padding,
@@ -549,6 +552,27 @@ impl LinkSides {
             },
         }
     }
+}
+
+/// Builds the distance field of every exact body of `robot` not built yet
+/// ([`LinkGeometry::field`]), in parallel: before the first query, so that no
+/// query pays for one.
+fn build_fields(robot: &Robot) {
+    let bodies: Vec<&LinkGeometry> = robot
+        .links
+        .iter()
+        .filter_map(|l| l.geometry.as_ref())
+        .chain(
+            robot
+                .attached
+                .iter()
+                .filter(|o| o.cloud.is_none())
+                .map(|o| &o.geometry),
+        )
+        .collect();
+    bodies.par_iter().for_each(|g| {
+        let _ = g.field();
+    });
 }
 
 /// What stands for one body of the robot (a link, or an attached object) in
@@ -837,7 +861,7 @@ fn link_query(
         Body::Exact(geometry, padding) => {
             return collide_exact_cloud_padded(
                 pose,
-                (&geometry.distance, padding),
+                (&geometry.distance, padding, geometry.field()),
                 &Pose::identity(),
                 cloud,
                 collide,

@@ -2,8 +2,8 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
+use super::cache::SpacingCache;
 use super::geometry::{capsule_mesh, sphere_mesh, LinkGeometry, CIRCLE_SEGMENTS};
 use super::model::{Joint, JointKind, Link, Mimic, Robot};
 use crate::error::{Error, Result};
@@ -385,7 +385,8 @@ impl Robot {
             ignored_pairs: Vec::new(),
             motion_weights: Vec::new(),
             attached: Vec::new(),
-            samples: Mutex::new(Vec::new()),
+            samples: SpacingCache::default(),
+            shadow_samples: SpacingCache::default(),
         };
         robot.compute_motion_weights();
         robot.compute_self_pairs();

@@ -95,8 +95,11 @@ pub struct CollisionRequest {
     /// Return as soon as the state is decided (default `false`): no per-point
     /// probabilities, no separation estimates, and with the `max` aggregation the
     /// query stops at the first patch whose probability reaches the collision
-    /// threshold. The state (and, when no patch is skipped, `P`) is that of the
-    /// full query.
+    /// threshold (against an exact mesh side with the elements model and one
+    /// segmentation: at the first element whose readings reach it, elements
+    /// deep inside the mesh looked at first). The state (and, when nothing is
+    /// skipped, `P`) is that of the full query; `P` is otherwise at most the
+    /// full query's.
     pub decide_only: bool,
     /// With the elements model, how many segmentations of the two clouds the
     /// query averages over (default 1, at most

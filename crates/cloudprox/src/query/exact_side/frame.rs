@@ -5,7 +5,7 @@ use crate::bvh::Aabb;
 use crate::element::{Hull, SurfaceElements};
 use crate::math::{Matrix3, Point3, Pose, Vector3};
 use crate::probability::normal_quantile;
-use crate::shape::{ClosestPoint, MeshDistance};
+use crate::shape::{ClosestPoint, DistanceField, FieldValue, MeshDistance};
 use crate::Real;
 
 /// One query's view of the cloud from the mesh's own frame, where every
@@ -13,6 +13,9 @@ use crate::Real;
 pub(crate) struct Frame<'a> {
     /// The mesh's signed distance.
     mesh: &'a MeshDistance,
+    /// A distance field of the mesh (its own frame), when it has one: bounds
+    /// on the signed distance without a search ([`Frame::bounds`]).
+    field: Option<&'a DistanceField>,
     /// The padding (metres, `>= 0`): the surface read is the mesh's grown by
     /// it, its signed distance `sd - padding` (see [`Frame::padded`]).
     padding: Real,
@@ -56,6 +59,7 @@ impl<'a> Frame<'a> {
         let d = Vector3::repeat(padding);
         Self {
             mesh,
+            field: None,
             padding,
             rel,
             rotation: *rel.rotation.to_rotation_matrix().matrix(),
@@ -65,6 +69,47 @@ impl<'a> Frame<'a> {
                 maxs: maxs + d,
             },
         }
+    }
+
+    /// The frame with `field` (a distance field of the same mesh) bounding
+    /// the signed distances before any search ([`Frame::bounds`]).
+    pub fn with_field(mut self, field: Option<&'a DistanceField>) -> Self {
+        self.field = field;
+        self
+    }
+
+    /// Bounds `[lo, hi]` on the (padded) surface's signed distance at `x`
+    /// (mesh frame) from the distance field, without a search (an
+    /// interpolation and its error bound, or the band's lower bound and the
+    /// side); `None` without a field.
+    pub fn bounds(&self, x: &Point3) -> Option<(Real, Real)> {
+        let (lo, hi) = match self.field?.evaluate_in_band(x) {
+            FieldValue::Near(s) if s.distance.is_nan() => return None,
+            FieldValue::Near(s) => (s.distance - s.bound, s.distance + s.bound),
+            FieldValue::Beyond {
+                lower_bound,
+                inside: true,
+            } => (Real::NEG_INFINITY, -lower_bound),
+            FieldValue::Beyond { lower_bound, .. } => (lower_bound, Real::INFINITY),
+        };
+        Some((lo - self.padding, hi - self.padding))
+    }
+
+    /// The padding (metres).
+    pub fn padding(&self) -> Real {
+        self.padding
+    }
+
+    /// A bound on the mesh's own (unpadded) unsigned distance from bounds
+    /// `[lo, hi]` on the padded signed distance ([`Frame::bounds`]).
+    pub fn reach_of(&self, (lo, hi): (Real, Real)) -> Real {
+        (lo + self.padding).abs().max((hi + self.padding).abs())
+    }
+
+    /// The (padded) surface's closest point to `x` (mesh frame) if the
+    /// mesh's own (unpadded) surface lies within `limit` of it.
+    pub fn mesh_within(&self, x: &Point3, limit: Real) -> Option<ClosestPoint> {
+        self.mesh.closest_within(x, limit).map(|c| self.pad(c))
     }
 
     /// The mesh's closest point `c` read on the padded surface.
@@ -173,7 +218,8 @@ impl<'a> Frame<'a> {
     /// Where element `e` of `els` stands: its hull (every point of its
     /// surface within `radius` of its mean, every standard deviation below
     /// `sigma`) is first tested against the mesh's box, then against the
-    /// surface within its reach, `radius + margin + reach sigma`; an element
+    /// surface within its reach, `radius + margin + reach sigma` (by the
+    /// distance field's bounds first, where the mesh has one); an element
     /// whose mean is farther inside than that is deep.
     pub fn standing(&self, els: &SurfaceElements, e: u32) -> Standing {
         let hull: &Hull = els.hulls().hull(e);
@@ -182,6 +228,11 @@ impl<'a> Frame<'a> {
         let to_box = self.bounds.distance_squared_to_point(&centre);
         if to_box > limit * limit {
             return Standing::Beyond;
+        }
+        match self.bounds(&centre) {
+            Some((lo, _)) if lo > limit => return Standing::Beyond,
+            Some((_, hi)) if hi < -limit => return Standing::Deep,
+            _ => {}
         }
         if let Some(c) = self.closest_within(&centre, limit) {
             Standing::Near(centre, c)

@@ -15,16 +15,19 @@ use crate::Real;
 /// other point of `cloud`.
 ///
 /// Only points within the noise's reach of the surface (`reach` times the
-/// point's largest standard deviation) or inside are read exactly; the
-/// others have `p < epsilon / 2`, stored as 0. A point farther than its
+/// point's largest standard deviation) are read exactly; the others outside
+/// have `p < epsilon / 2`, stored as 0, and those inside deeper than their
+/// reach `p > 1 - epsilon / 2`, stored as 1 where they are passed over (below). A point farther than its
 /// reach from the mesh's bounding box is passed over first (a wide floor's
 /// element near a small link holds thousands of such points). An element's points lie
 /// together: each search is bounded by the previous point's closest point
 /// (the surface lies at most that far), and a point is passed over without
 /// one when the previous point's distance `d`, less the step between them,
-/// exceeds its reach while the previous point was outside (the ball of
-/// radius `d` about it holds no surface, so the point lies outside too,
-/// beyond its reach).
+/// exceeds its reach (the ball of radius `d` about the previous point holds
+/// no surface, so the point lies on its side, beyond its reach): a link
+/// pressed into a scan reads the thousands of points deep inside it from a
+/// few searches. With a distance field of the mesh, its bounds place a point
+/// beyond its reach, outside or inside, before any search.
 pub(crate) fn point_probabilities(
     frame: &Frame<'_>,
     cloud: &PointCloud,
@@ -41,12 +44,28 @@ pub(crate) fn point_probabilities(
             if frame.beyond_box(&x, radius) {
                 continue;
             }
+            let bounds = frame.bounds(&x);
+            match bounds {
+                Some((lo, _)) if lo > radius => continue,
+                Some((_, hi)) if hi < -radius => {
+                    pairs.push((i, 1.0));
+                    continue;
+                }
+                _ => {}
+            }
             if let Some((xr, cr)) = &last {
-                if !cr.is_inside() && cr.distance() - (x - xr).norm() > radius {
+                if cr.distance() - (x - xr).norm() > radius {
+                    if cr.is_inside() {
+                        pairs.push((i, 1.0));
+                    }
                     continue;
                 }
             }
-            let c = closest_from(frame, &x, last.as_ref().map(|(_, c)| &c.point));
+            // The padded surface's point `c` lies `padding` off the mesh's.
+            let hint = last
+                .as_ref()
+                .map(|(_, c)| (x - c.point).norm() + frame.padding());
+            let c = closest_from(frame, &x, [hint, bounds.map(|b| frame.reach_of(b))]);
             last = Some((x, c));
             if !c.is_inside() && c.distance() > radius {
                 continue;
@@ -65,14 +84,15 @@ pub(crate) fn point_probabilities(
 }
 
 /// The surface's closest point to `x` (mesh frame), searched no farther
-/// than `hint` (a point of the surface) when given.
-fn closest_from(frame: &Frame<'_>, x: &Point3, hint: Option<&Point3>) -> ClosestPoint {
-    let Some(q) = hint else {
+/// than the smaller of `limits` (bounds on the mesh's unsigned distance at
+/// `x`: the previous point's closest point's distance, the distance
+/// field's) when there are any.
+fn closest_from(frame: &Frame<'_>, x: &Point3, limits: [Option<Real>; 2]) -> ClosestPoint {
+    let Some(limit) = limits.into_iter().flatten().reduce(Real::min) else {
         return frame.closest(x);
     };
     // A margin over the rounding.
-    let bound = (x - q).norm() * (1.0 + 1e-9) + 1e-12;
     frame
-        .closest_within(x, bound)
+        .mesh_within(x, limit * (1.0 + 1e-9) + 1e-12)
         .unwrap_or_else(|| frame.closest(x))
 }

@@ -15,7 +15,7 @@ use crate::query::collide::{
 use crate::query::exact_side::frame::Frame;
 use crate::query::exact_side::points::point_probabilities;
 use crate::query::exact_side::readings::{element_readings, ElementScan};
-use crate::shape::MeshDistance;
+use crate::shape::{DistanceField, MeshDistance};
 use crate::Real;
 
 /// The probabilistic collision query between an exact mesh (its signed
@@ -36,6 +36,11 @@ use crate::Real;
 /// model), no patches (nothing is trained) and counters: `node_pairs_visited`
 /// the elements tested against the surface, `leaf_pairs` the readings within
 /// reach, `near_regions` the elements within reach.
+///
+/// With `decide_only` (elements model, one segmentation) the elements are
+/// read until the first whose own readings reach the collision threshold
+/// (the elements deep inside the mesh first, one closest-point search each):
+/// `P` is then that element's, at most the full query's, with the same state.
 ///
 /// A cloud whose every element is beyond the noise's reach of the surface
 /// (each element's hull against the mesh's box, then against the surface
@@ -73,7 +78,7 @@ pub fn collide_exact_cloud(
     validate(request)?;
     validate_pose(pose_mesh, "pose_mesh")?;
     validate_pose(pose_cloud, "pose_cloud")?;
-    collide_exact_cloud_padded(pose_mesh, (mesh, 0.0), pose_cloud, cloud, request)
+    collide_exact_cloud_padded(pose_mesh, (mesh, 0.0, None), pose_cloud, cloud, request)
 }
 
 /// [`collide_exact_cloud`] with the sides in the other order: the cloud is
@@ -117,7 +122,7 @@ pub fn collide_exact_cloud_many(
     }
     poses_mesh
         .par_iter()
-        .map(|p| collide_exact_cloud_padded(p, (mesh, 0.0), pose_cloud, cloud, request))
+        .map(|p| collide_exact_cloud_padded(p, (mesh, 0.0, None), pose_cloud, cloud, request))
         .collect()
 }
 
@@ -174,11 +179,13 @@ fn segmentations(request: &CollisionRequest) -> u32 {
 /// [`collide_exact_cloud`] of the mesh's surface grown by `padding` (metres,
 /// finite and `>= 0`, checked by the caller): every signed distance read is
 /// the mesh's less `padding` (a robot link's safety margin). Padding 0 is
-/// [`collide_exact_cloud`] bit for bit. The request and poses are not
-/// validated.
+/// [`collide_exact_cloud`] bit for bit. With `field`, a distance field of
+/// the same mesh, its bounds place elements and points beyond reach or deep
+/// inside before any search (the same result: a bound only decides what
+/// the search would). The request and poses are not validated.
 pub(crate) fn collide_exact_cloud_padded(
     pose_mesh: &Pose,
-    (mesh, padding): (&MeshDistance, Real),
+    (mesh, padding, field): (&MeshDistance, Real, Option<&DistanceField>),
     pose_cloud: &Pose,
     cloud: &PointCloud,
     request: &CollisionRequest,
@@ -189,12 +196,17 @@ pub(crate) fn collide_exact_cloud_padded(
         pose_mesh.inverse() * pose_cloud,
         request.prune_epsilon,
         padding,
-    );
+    )
+    .with_field(field);
     let k = segmentations(request);
-    let scans: Vec<ElementScan> = (0..k)
-        .map(|s| element_readings(&frame, cloud.segmentation_after(s)))
-        .collect();
     let points_model = request.model == QueryModel::Points;
+    // One segmentation's P is the largest of its elements': decide_only stops
+    // at the first element that reaches the collision threshold.
+    let decisive =
+        (request.decide_only && !points_model && k == 1).then_some(request.thresholds.collision);
+    let scans: Vec<ElementScan> = (0..k)
+        .map(|s| element_readings(&frame, cloud.segmentation_after(s), decisive))
+        .collect();
     let probabilities_b = if request.decide_only && !points_model {
         PointProbabilities::zeros(cloud.len())
     } else {

@@ -2,7 +2,7 @@
 
 use crate::element::{across_normal, SurfaceElement, SurfaceElements, HALF_SPACING};
 use crate::math::{Point3, Vector3};
-use crate::probability::ElementReading;
+use crate::probability::{contact_probability, ElementReading};
 use crate::query::exact_side::frame::{Frame, Standing};
 use crate::shape::ClosestPoint;
 use crate::Real;
@@ -23,8 +23,19 @@ pub(crate) struct ElementScan {
 /// The readings of every element of `els` within reach of the surface
 /// (see the [module docs](crate::query::exact_side)), in the order of the
 /// elements: those the hierarchy finds near the mesh's box
-/// ([`Frame::candidates`]), each then as [`Frame::standing`] places it.
-pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> ElementScan {
+/// ([`Frame::candidates`]), each then as [`Frame::standing`] places it;
+/// with `decisive`, stopped at the first element whose own readings
+/// reach that probability ([`contact_probability`] of them): the
+/// exact side's `P` is the largest of its elements' (one contact, each
+/// element its own pair), so the full scan's `P` is at least that. Elements
+/// deep inside the surface are then looked for first (no probes): a link
+/// pressed into a scan is decided by the first of them, whatever the size
+/// of the overlap.
+pub(crate) fn element_readings(
+    frame: &Frame<'_>,
+    els: &SurfaceElements,
+    decisive: Option<Real>,
+) -> ElementScan {
     let mut scan = ElementScan {
         readings: Vec::new(),
         near: Vec::new(),
@@ -32,11 +43,24 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
     };
     let mut candidates = Vec::new();
     frame.candidates(els, &mut candidates);
+    let mut standings = Vec::with_capacity(candidates.len());
     for k in candidates {
-        let e = &els.elements()[k as usize];
         scan.tested += 1;
+        let standing = frame.standing(els, k);
+        if standing == Standing::Deep && decisive.is_some() {
+            let r = deep_reading(frame, els, k);
+            if decisive.is_some_and(|p| contact_probability(&[r]) >= p) {
+                scan.readings.push(r);
+                scan.near.push((k, r.gap <= 0.0));
+                return scan;
+            }
+        }
+        standings.push((k, standing));
+    }
+    for (k, standing) in standings {
+        let e = &els.elements()[k as usize];
         let before = scan.readings.len();
-        match frame.standing(els, k) {
+        match standing {
             Standing::Beyond => continue,
             Standing::Deep => scan.readings.push(deep_reading(frame, els, k)),
             Standing::Near(..) if e.is_point() => scan.readings.push(point_reading(frame, e, k)),
@@ -45,8 +69,11 @@ pub(crate) fn element_readings(frame: &Frame<'_>, els: &SurfaceElements) -> Elem
                 probe_readings(frame, e, k, (radius, centre, start), &mut scan.readings);
             }
         }
-        let touching = scan.readings[before..].iter().any(|r| r.gap <= 0.0);
-        scan.near.push((k, touching));
+        let own = &scan.readings[before..];
+        scan.near.push((k, own.iter().any(|r| r.gap <= 0.0)));
+        if decisive.is_some_and(|p| contact_probability(own) >= p) {
+            break;
+        }
     }
     scan
 }

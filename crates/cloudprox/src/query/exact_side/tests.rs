@@ -34,7 +34,7 @@ fn readings_are_the_gap_with_its_fit_error() {
     for seed in 0..120 {
         let cloud = PointCloud::from_sigma(add_noise(&plane(gap), sigma, seed), sigma).unwrap();
         let els = cloud.elements();
-        let scan = element_readings(&frame, els);
+        let scan = element_readings(&frame, els, None);
         assert!(!scan.readings.is_empty());
         // One reading per element: its most critical probe is what P reads.
         for (k, _) in &scan.near {
@@ -67,7 +67,11 @@ fn readings_are_the_gap_with_its_fit_error() {
 fn a_cloud_beyond_reach_reads_nothing() {
     let cube = MeshDistance::new(&Mesh::cuboid(0.5, 0.5, 0.5).unwrap()).unwrap();
     let cloud = PointCloud::from_sigma(add_noise(&plane(0.05), 0.002, 1), 0.002).unwrap();
-    let scan = element_readings(&Frame::new(&cube, Pose::identity(), 1e-3), cloud.elements());
+    let scan = element_readings(
+        &Frame::new(&cube, Pose::identity(), 1e-3),
+        cloud.elements(),
+        None,
+    );
     // (The hull of the 30 cm wide element reaches the face: it is tested,
     // and its probes are beyond reach.)
     assert!(scan.readings.is_empty());
@@ -77,6 +81,7 @@ fn a_cloud_beyond_reach_reads_nothing() {
     let scan = element_readings(
         &Frame::new(&cube, Pose::identity(), 1e-3),
         inside.elements(),
+        None,
     );
     assert!(!scan.readings.is_empty());
     assert!(scan.readings.iter().all(|r| r.gap < -10.0 * r.std));
@@ -124,4 +129,112 @@ fn the_hierarchy_finds_every_element_the_one_by_one_test_keeps() {
         found > 50,
         "only {found} elements near the box over all poses"
     );
+}
+
+#[test]
+fn decide_only_stops_at_a_decisive_element_with_the_full_querys_state() {
+    // A 10 cm cube about a noisy sphere of radius 0.1 m (3000 points,
+    // sigma 1 mm), its centre from 15 cm outside the sphere to 6 cm inside,
+    // turned at random: the state of a decide_only query is the full
+    // query's, its P at most the full P; where the cube is pressed through
+    // the shell, the elements deep inside it decide before the rest are read.
+    use crate::query::exact_side::collide_exact_cloud;
+    use crate::query::CollisionRequest;
+    use crate::sample::sphere;
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    let cube = MeshDistance::new(&Mesh::cuboid(0.05, 0.05, 0.05).unwrap()).unwrap();
+    let shell = sphere(&Point3::origin(), 0.1, 3000);
+    let cloud = PointCloud::from_sigma(add_noise(&shell, 0.001, 5), 0.001).unwrap();
+    let full = CollisionRequest::default();
+    let decide = CollisionRequest {
+        decide_only: true,
+        ..CollisionRequest::default()
+    };
+    let mut rng = 11_u64;
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (rng >> 11) as Real / (1_u64 << 53) as Real
+    };
+    let (mut states, mut fewer) = ([0; 3], 0);
+    for i in 0..100 {
+        // The cube's centre at radius 0.25 (its farthest corner 6 cm out of
+        // the shell) down to 0.04.
+        let radius = 0.25 - 0.21 * Real::from(i) / 99.0;
+        let dir = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+        let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+        let pose = Pose::from_parts(
+            Translation3::from(dir * radius),
+            UnitQuaternion::from_scaled_axis(axis * 3.0),
+        );
+        let a = collide_exact_cloud(&pose, &cube, &Pose::identity(), &cloud, &full).unwrap();
+        let d = collide_exact_cloud(&pose, &cube, &Pose::identity(), &cloud, &decide).unwrap();
+        assert_eq!(
+            a.state, d.state,
+            "radius {radius}: P {} vs {}",
+            a.probability, d.probability
+        );
+        assert!(d.probability <= a.probability + 1e-12);
+        states[a.state as usize] += 1;
+        let (ta, td) = (a.stats.counters.leaf_pairs, d.stats.counters.leaf_pairs);
+        assert!(td <= ta, "{td} readings against {ta}");
+        if td < ta {
+            fewer += 1;
+        }
+    }
+    assert!(states[0] > 10 && states[2] > 10, "states {states:?}");
+    assert!(
+        fewer > states[2] / 2,
+        "{fewer} of {} collisions decided early",
+        states[2]
+    );
+}
+
+#[test]
+fn a_distance_field_changes_nothing_but_the_searches() {
+    // The cube about the noisy sphere, from well outside to pressed deep,
+    // with and without its distance field (and a padding): the same P and
+    // state, each point's p within epsilon / 2 (a point the field places
+    // beyond reach is stored as 0 or 1).
+    use super::query::collide_exact_cloud_padded;
+    use crate::query::CollisionRequest;
+    use crate::sample::sphere;
+    use crate::shape::DistanceField;
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    use std::sync::Arc;
+    let cube = Arc::new(MeshDistance::new(&Mesh::cuboid(0.05, 0.05, 0.05).unwrap()).unwrap());
+    let field = DistanceField::new(Arc::clone(&cube), 0.004, 0.024).unwrap();
+    let shell = sphere(&Point3::origin(), 0.1, 3000);
+    let cloud = PointCloud::from_sigma(add_noise(&shell, 0.001, 9), 0.001).unwrap();
+    let req = CollisionRequest::default();
+    let half = 0.5 * req.prune_epsilon;
+    let mut rng = 3_u64;
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (rng >> 11) as Real / (1_u64 << 53) as Real
+    };
+    for i in 0..40 {
+        let radius = 0.25 - 0.21 * Real::from(i) / 39.0;
+        let dir = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+        let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+        let pose = Pose::from_parts(
+            Translation3::from(dir * radius),
+            UnitQuaternion::from_scaled_axis(axis * 3.0),
+        );
+        let padding = if i % 3 == 0 { 0.003 } else { 0.0 };
+        let query = |f: Option<&DistanceField>| {
+            collide_exact_cloud_padded(&pose, (&cube, padding, f), &Pose::identity(), &cloud, &req)
+                .unwrap()
+        };
+        let (a, b) = (query(None), query(Some(&field)));
+        assert_eq!(a.probability, b.probability, "radius {radius}");
+        assert_eq!(a.state, b.state);
+        let (pa, pb) = (a.probabilities_b.to_dense(), b.probabilities_b.to_dense());
+        for (x, y) in pa.iter().zip(&pb) {
+            assert!((x - y).abs() <= half, "radius {radius}: {x} vs {y}");
+        }
+    }
 }
