@@ -16,6 +16,7 @@ from cloudprox.pose import from_translation
 from tests.robots import wall
 
 SIGMA = 0.002
+STATES = ("free", "contact", "collision")
 #: The flags of a CollisionRequest that every querying command takes.
 REQUEST_FLAGS = {
     "--model",
@@ -84,6 +85,45 @@ def test_every_querying_command_takes_the_request_options(command: str) -> None:
     flags = _flags(_subcommands(build_parser())[command])
     assert flags >= REQUEST_FLAGS
     assert flags >= {"--sigma", "--sensor", "--axial-offset", "--sigma-range", "--filter"}
+
+
+def test_the_demo_takes_the_request_options() -> None:
+    assert _flags(_subcommands(build_parser())["demo"]) >= REQUEST_FLAGS
+
+
+def _demo_states(capsys: pytest.CaptureFixture[str], out: Path, *flags: str) -> list[str]:
+    """The state column of ``cloudprox demo --points 2000``'s table."""
+    assert main(["demo", "--points", "2000", "--out", str(out), *flags]) == 0
+    rows = [line.strip().strip("│").split("│") for line in capsys.readouterr().out.splitlines()]
+    return [row[4].strip() for row in rows if len(row) == 7 and row[4].strip() in STATES]
+
+
+def test_demo_thresholds_and_model_change_the_states_as_the_api_does(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from cloudprox.cli.demo import DEMO_FAR_GAP, DEMO_GAPS_SIGMA
+    from cloudprox.scenes import build_scene
+
+    s = 0.005  # the demo's default noise
+    scene = build_scene(sigma=s, points=2000, seed=0)
+    piano = cp.PointCloud(scene.piano_points, sigma=s)
+    room = cp.PointCloud(scene.room_points, sigma=s)
+    gaps = [g * s for g in DEMO_GAPS_SIGMA] + [DEMO_FAR_GAP]
+
+    def expected(request: cp.CollisionRequest) -> list[str]:
+        return [
+            cp.collide(piano, room, pose_a=scene.piano_pose(g), request=request).state for g in gaps
+        ]
+
+    default = _demo_states(capsys, tmp_path)
+    assert default == expected(cp.CollisionRequest())
+    flags = ["--threshold-free", "0.4", "--threshold-collision", "0.5"]
+    loose = _demo_states(capsys, tmp_path, *flags)
+    assert loose == expected(cp.CollisionRequest(threshold_free=0.4, threshold_collision=0.5))
+    assert loose != default  # some contacts of the default thresholds read free or collision
+    points = _demo_states(capsys, tmp_path, "--model", "points", *flags)
+    request = cp.CollisionRequest(model="points", threshold_free=0.4, threshold_collision=0.5)
+    assert points == expected(request)
 
 
 def test_thresholds_decide_the_state(capsys: pytest.CaptureFixture[str], spheres) -> None:
@@ -161,7 +201,7 @@ def test_robot_query_options_reach_the_query(
         (["--threshold-collision", "nan"], "--threshold-collision must be a number"),
     ],
 )
-@pytest.mark.parametrize("command", ["collide", "robot"])
+@pytest.mark.parametrize("command", ["collide", "robot", "demo"])
 def test_bad_thresholds_exit_2_with_one_message(
     capsys: pytest.CaptureFixture[str],
     spheres,
@@ -173,12 +213,15 @@ def test_bad_thresholds_exit_2_with_one_message(
 ) -> None:
     if command == "collide":
         argv = ["collide", *spheres, "--sigma", str(SIGMA)]
+    elif command == "demo":  # refused before the scene is built or anything written
+        argv = ["demo", "--points", "50", "--out", str(wall_scan.parent / "no-demo")]
     else:
         argv = ["robot", str(arm_path), str(wall_scan), "--sigma", str(SIGMA), "--q", "0,0,0,0"]
     assert main([*argv, *options]) == 2
     err = capsys.readouterr().err
     assert message in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not (wall_scan.parent / "no-demo").exists()
 
 
 def test_thresholds_at_their_limits_are_accepted(

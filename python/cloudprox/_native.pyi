@@ -36,6 +36,7 @@ __all__ = [
     "Mesh",
     "MeshDistance",
     "MeshSample",
+    "MotionRequest",
     "MotionResult",
     "Occlusion",
     "PointCloud",
@@ -45,6 +46,7 @@ __all__ = [
     "Robot",
     "RobotBatchResult",
     "RobotCollisionResult",
+    "RobotRequest",
     "RobotStats",
     "ScanResult",
     "ScanStep",
@@ -108,6 +110,7 @@ _ModelName = Literal["elements", "points"]
 _RobustModelName = Literal["gaussian", "chebyshev"]
 _SolverName = Literal["primal_dual", "clarabel"]
 _StateName = Literal["free", "contact", "collision"]
+_MeshSideName = Literal["exact", "sampled"]
 _CloudFormatName = Literal[
     "auto", "ply", "pcd", "xyz", "xyzn", "xyzrgb", "txt", "pts", "csv", "npy", "las", "laz"
 ]
@@ -2226,13 +2229,203 @@ class MotionResult:
     def solver_iterations(self) -> int:
         """Interior-point iterations of the classifiers of every state checked, summed."""
 
+@final
+class RobotRequest:
+    """The options of a robot query, as one immutable value.
+
+    Accepted by :func:`collide_robot`, :func:`collide_robot_many` (and, as every
+    state's query, :func:`check_motion`) as ``request=``, where a keyword option
+    given beside it overrides its value: ``collide_robot(robot, q, cloud,
+    request=r, padding=0.01)`` is ``collide_robot(robot, q, cloud,
+    request=r.replace(padding=0.01))``. Each option is parsed and checked as the
+    same keyword option of :func:`collide_robot` is (the same code): one left
+    out (or ``None``) takes the core's default, and a value of the wrong type or
+    out of its domain raises :class:`InvalidInputError` (a ``ValueError``)
+    naming the option; a ``target`` of another type raises ``TypeError``.
+    Requests are frozen and pickle (with their target and shadow objects);
+    :meth:`replace` gives a modified copy.
+
+    Parameters
+    ----------
+    collide : CollisionRequest, optional
+        The options of each link's query (default ``CollisionRequest()``).
+    mesh_side : {"exact", "sampled"}, optional
+        How each link stands: its exact surface (the default), or its mesh
+        sampled into a cloud (the default when ``mesh_spacing`` is given).
+    mesh_spacing : float, optional
+        Sampling spacing of sampled links (metres; default half the cloud's
+        median spacing).
+    broad_phase : bool, optional
+        Skip links that cannot reach the cloud (default ``True``).
+    self_collision : bool, optional
+        Check self-collision between non-adjacent links (default ``True``).
+    padding : float or dict of str to float, optional
+        Safety margin (metres) of every link, or of the links a dict names.
+    target : PointCloud or Mesh, optional
+        An object about to be grasped, still in the scene.
+    target_pose : array_like, shape (4, 4), optional
+        Pose of a :class:`Mesh` target.
+    allowed_links : list of str, optional
+        The links that may touch ``target``.
+    shadow : cloudprox.filters.Occlusion, optional
+        The scan's occlusion, whose shadow the links read.
+    shadow_depth : float, optional
+        With ``shadow``: the thickness (metres) behind the observed surface that
+        counts (default 0.05).
+    shadow_prior : float, optional
+        With ``shadow``: the prior probability of a shadowed sample, in
+        ``[0, 1]`` (default 0.5).
+
+    Examples
+    --------
+    >>> import cloudprox as cp
+    >>> request = cp.RobotRequest(collide=cp.CollisionRequest(model="points"), padding=0.01)
+    >>> request.replace(threshold_free=0.05).collide.threshold_free
+    0.05
+    """
+
+    def __new__(
+        cls,
+        *,
+        collide: CollisionRequest | None = None,
+        mesh_side: _MeshSideName | None = None,
+        mesh_spacing: float | None = None,
+        broad_phase: bool | None = None,
+        self_collision: bool | None = None,
+        padding: float | Mapping[str, float] | None = None,
+        target: PointCloud | Mesh | None = None,
+        target_pose: npt.ArrayLike | None = None,
+        allowed_links: Sequence[str] | None = None,
+        shadow: Occlusion | None = None,
+        shadow_depth: float | None = None,
+        shadow_prior: float | None = None,
+    ) -> RobotRequest: ...
+    @property
+    def collide(self) -> CollisionRequest:
+        """The options of each link's query."""
+    @property
+    def mesh_side(self) -> _MeshSideName:
+        """How each link stands: its exact surface or its mesh sampled."""
+    @property
+    def mesh_spacing(self) -> float | None:
+        """Sampling spacing of sampled links (metres), or ``None``: from the cloud."""
+    @property
+    def broad_phase(self) -> bool:
+        """Whether links that cannot reach the cloud are skipped."""
+    @property
+    def self_collision(self) -> bool:
+        """Whether self-collision between non-adjacent links is checked."""
+    @property
+    def padding(self) -> float | dict[str, float]:
+        """The links' safety margin (metres): one for every link, or by link name."""
+    @property
+    def target(self) -> PointCloud | Mesh | None:
+        """The object about to be grasped, or ``None``."""
+    @property
+    def target_pose(self) -> Any | None:
+        """The pose of a :class:`Mesh` target, as given, or ``None``."""
+    @property
+    def allowed_links(self) -> Sequence[str] | None:
+        """The links that may touch the target, as given, or ``None``."""
+    @property
+    def shadow(self) -> Occlusion | None:
+        """The scan's occlusion whose shadow the links read, or ``None``."""
+    @property
+    def shadow_depth(self) -> float | None:
+        """With a shadow: the thickness behind the observed surface that counts."""
+    @property
+    def shadow_prior(self) -> float | None:
+        """With a shadow: the prior probability of a shadowed sample."""
+    def replace(self, **changes: Any) -> RobotRequest:
+        """Return a copy with the given options changed (``None`` leaves one as it is).
+
+        ``changes`` are the options of :class:`RobotRequest` and of
+        :class:`CollisionRequest` (applied to :attr:`collide`).
+
+        Raises
+        ------
+        InvalidInputError
+            On an unknown option name or a value out of its domain.
+        """
+    def to_dict(self) -> dict[str, Any]:
+        """Return every option as a dict; ``RobotRequest(**d)`` rebuilds the request."""
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+@final
+class MotionRequest:
+    """The options of :func:`check_motion`, as one immutable value.
+
+    Accepted by :func:`check_motion` as ``request=``, keyword options given
+    beside it overriding its values, as :class:`RobotRequest` is by
+    :func:`collide_robot`; each option is parsed and checked as the same keyword
+    option of :func:`check_motion` is. Requests are frozen and pickle;
+    :meth:`replace` gives a modified copy.
+
+    Parameters
+    ----------
+    robot : RobotRequest, optional
+        Every state's query (default ``RobotRequest()``).
+    resolution : float, optional
+        The largest distance (metres) a link point may move between two checked
+        states (default: the cloud's median noise standard deviation, or half its
+        median spacing without noise).
+    max_probability : float, optional
+        A state is unsafe above this probability, in ``[0, 1]`` (default: the
+        free threshold).
+    warm_start : bool, optional
+        Start each state's classifier from the previous state's samples
+        (default ``True``).
+
+    Examples
+    --------
+    >>> import cloudprox as cp
+    >>> request = cp.MotionRequest(robot=cp.RobotRequest(padding=0.01), resolution=0.005)
+    >>> request.replace(warm_start=False).warm_start
+    False
+    """
+
+    def __new__(
+        cls,
+        *,
+        robot: RobotRequest | None = None,
+        resolution: float | None = None,
+        max_probability: float | None = None,
+        warm_start: bool | None = None,
+    ) -> MotionRequest: ...
+    @property
+    def robot(self) -> RobotRequest:
+        """Every state's query."""
+    @property
+    def resolution(self) -> float | None:
+        """The largest displacement of a link point between two states, or ``None``."""
+    @property
+    def max_probability(self) -> float | None:
+        """A state is unsafe above this probability, or ``None``: the free threshold."""
+    @property
+    def warm_start(self) -> bool:
+        """Whether each state's classifier starts from the previous state's samples."""
+    def replace(self, **changes: Any) -> MotionRequest:
+        """Return a copy with the given options changed (``None`` leaves one as it is).
+
+        ``changes`` are the options of :class:`MotionRequest`, of
+        :class:`RobotRequest` and of :class:`CollisionRequest`.
+
+        Raises
+        ------
+        InvalidInputError
+            On an unknown option name or a value out of its domain.
+        """
+    def to_dict(self) -> dict[str, Any]:
+        """Return every option as a dict; ``MotionRequest(**d)`` rebuilds the request."""
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
 def collide_robot(
     robot: Robot,
     q: _Configuration,
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,
-    request: CollisionRequest | None = None,
+    request: CollisionRequest | RobotRequest | None = None,
     **options: Any,
 ) -> RobotCollisionResult:
     """Query the robot at configuration ``q`` (root at ``base_pose``) against a cloud.
@@ -2257,9 +2450,11 @@ def collide_robot(
     left (probability NaN, ``stats.links_after_decision``): the state is
     collision whatever they hold. Self-collision between non-adjacent links
     (exact meshes, ``self_collision=True``) is reported apart.
-    ``request`` is a :class:`CollisionRequest` (the link queries' options);
-    ``options`` are the keyword options of :class:`CollisionRequest`
-    (overriding ``request``'s) plus ``mesh_side`` (``"exact"`` or ``"sampled"``),
+    ``request`` is a :class:`RobotRequest` (every option typed), or a
+    :class:`CollisionRequest` (the link queries' options, the robot's at their
+    defaults); ``options`` are the keyword options of :class:`CollisionRequest`
+    and :class:`RobotRequest` (overriding ``request``'s, as
+    ``request.replace(**options)`` does): ``mesh_side`` (``"exact"`` or ``"sampled"``),
     ``mesh_spacing`` (with sampled links only), ``broad_phase``,
     ``self_collision``, ``padding``, ``target``, ``target_pose``,
     ``allowed_links``, ``shadow``, ``shadow_depth`` and ``shadow_prior``;
@@ -2298,7 +2493,7 @@ def collide_robot_many(
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,
-    request: CollisionRequest | None = None,
+    request: CollisionRequest | RobotRequest | None = None,
     **options: Any,
 ) -> RobotBatchResult:
     """:func:`collide_robot` for each row of the ``(m, dof)`` array ``qs`` (or each configuration of a list, arrays or joint-name mappings), in parallel, GIL released."""
@@ -2310,7 +2505,7 @@ def check_motion(
     cloud: PointCloud,
     base_pose: npt.ArrayLike | None = None,
     *,
-    request: CollisionRequest | None = None,
+    request: CollisionRequest | RobotRequest | MotionRequest | None = None,
     **options: Any,
 ) -> MotionResult:
     """Check the straight joint-space motion from ``q0`` to ``q1`` against the cloud.
@@ -2320,8 +2515,11 @@ def check_motion(
     between two states (default: the cloud's median noise standard deviation, or half
     its median spacing without noise); the check stops at the first unsafe state
     (probability above ``max_probability``, default ``threshold_free``, or
-    self-collision). ``options``: those of :func:`collide_robot` plus
-    ``resolution``, ``max_probability`` and ``warm_start`` (default ``True``: each
+    self-collision). ``request`` is a :class:`MotionRequest`, or the
+    :class:`RobotRequest` or :class:`CollisionRequest` of every state (the
+    motion's own options at their defaults). ``options``: those of
+    :func:`collide_robot` plus ``resolution``, ``max_probability`` and
+    ``warm_start`` (the options of :class:`MotionRequest`; default ``True``: each
     state's classifier starts from the samples that supported the previous state's
     surfaces (sampled links only: exact links train nothing), which saves solver iterations (``solver_iterations``) and finds the
     same surfaces to the solver's tolerance, ``P`` within about 1e-5, so only a

@@ -37,6 +37,7 @@ from cloudprox._native import (
     CollisionRequest,
     PointCloud,
     Robot,
+    RobotRequest,
     check_motion,
     collide_robot,
 )
@@ -103,7 +104,8 @@ class ChanceConstraint:
         probability at most this (and no self-collision).
     **options
         Options of :func:`cloudprox.collide_robot` (``request=`` a
-        :class:`cloudprox.CollisionRequest` and keyword options), plus
+        :class:`cloudprox.RobotRequest` or a :class:`cloudprox.CollisionRequest`,
+        and keyword options), plus
         ``resolution`` of :func:`cloudprox.check_motion`. Unless a ``request``
         or ``decide_only`` is given, ``decide_only`` is on
         when ``max_probability`` is below 0.5, with ``threshold_collision`` 0.5
@@ -129,13 +131,14 @@ class ChanceConstraint:
     ) -> None:
         if not (np.isfinite(max_probability) and 0.0 <= max_probability < 1.0):
             raise ValueError(f"max_probability must be in [0, 1), got {max_probability}")
-        request: CollisionRequest | None = options.get("request")
+        request: CollisionRequest | RobotRequest | None = options.get("request")
         if max_probability < 0.5 and "decide_only" not in options and request is None:
             # A query may stop at the first patch whose probability reaches the
             # collision threshold: 0.5 (its lowest) unless given, above the constraint.
             options.setdefault("threshold_collision", 0.5)
             options["decide_only"] = True
-        effective = (request or CollisionRequest()).replace(
+        collision = request.collide if isinstance(request, RobotRequest) else request
+        effective = (collision or CollisionRequest()).replace(
             **{k: options[k] for k in ("threshold_collision", "decide_only") if k in options}
         )
         threshold = effective.threshold_collision

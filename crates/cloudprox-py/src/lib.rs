@@ -21,6 +21,7 @@
 //! | `side.rs` | a query side: a cloud, or a mesh sampled into one |
 //! | `exact_side.rs` | which query a pair of sides takes: two clouds, or an exact mesh against a cloud |
 //! | `robot.rs` | `Robot`, `collide_robot`, `collide_robot_many`, `check_motion` |
+//! | `robot_request.rs` | `RobotRequest`, `MotionRequest`: the robot queries' options |
 //!
 //! The Python package `cloudprox` re-exports everything (the filters, pose
 //! constructors and synthetic samplers through its `filters`, `pose` and
@@ -46,6 +47,7 @@ mod pose;
 mod request;
 mod result;
 mod robot;
+mod robot_request;
 mod sample;
 mod scan;
 mod sensor;
@@ -121,6 +123,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyRobotStats>()?;
     m.add_class::<robot::PyRobotBatchResult>()?;
     m.add_class::<robot::PyMotionResult>()?;
+    m.add_class::<robot_request::PyRobotRequest>()?;
+    m.add_class::<robot_request::PyMotionRequest>()?;
     m.add_function(wrap_pyfunction!(robot::collide_robot, m)?)?;
     m.add_function(wrap_pyfunction!(robot::collide_robot_many, m)?)?;
     m.add_function(wrap_pyfunction!(robot::check_motion, m)?)?;

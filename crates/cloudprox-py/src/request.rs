@@ -336,7 +336,7 @@ impl PyCollisionRequest {
 /// `base` with the options in `changes` applied (`None` values skipped); a name
 /// that is neither an option nor in `also_valid` is an `InvalidInputError`
 /// listing the valid names.
-fn with_changes(
+pub fn with_changes(
     py: Python<'_>,
     base: &PyCollisionRequest,
     changes: Option<&Bound<'_, PyDict>>,

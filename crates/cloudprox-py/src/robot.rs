@@ -5,12 +5,10 @@ use std::sync::Arc;
 
 use cloudprox::cloud::PointCloud;
 use cloudprox::math::Pose;
-use cloudprox::query::MeshSide;
 use cloudprox::robot::{
     check_motion as core_check_motion, collide_robot as core_collide_robot,
-    collide_robot_many as core_collide_robot_many, AttachedShape, GraspTarget, LinkCollision,
-    MotionRequest, Robot, RobotCollisionResult, RobotCounters, RobotShadow, RobotStats,
-    TargetCollision,
+    collide_robot_many as core_collide_robot_many, AttachedShape, LinkCollision, Robot,
+    RobotCollisionResult, RobotCounters, RobotStats, TargetCollision,
 };
 use cloudprox::Real;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -22,224 +20,8 @@ use crate::convert::{check_shape, pose_from, pose_to_py, to_f64_array, vec_to_py
 use crate::error::{invalid_input, run_detached, CoreResultExt};
 use crate::filter::PySelfFilter;
 use crate::mesh::PyMesh;
-use crate::occlusion::PyOcclusion;
-use crate::request::{request_from, PyCollisionRequest};
 use crate::result::{PyCollisionResult, PyContactPatch};
-
-/// The keywords of `collide_robot` that are not request options.
-const ROBOT_KEYWORDS: [&str; 12] = [
-    "request",
-    "mesh_side",
-    "mesh_spacing",
-    "broad_phase",
-    "self_collision",
-    "padding",
-    "target",
-    "target_pose",
-    "allowed_links",
-    "shadow",
-    "shadow_depth",
-    "shadow_prior",
-];
-/// The keywords of `check_motion` beyond those of `collide_robot`.
-const MOTION_KEYWORDS: [&str; 3] = ["resolution", "max_probability", "warm_start"];
-
-fn extract<'py, T: FromPyObjectOwned<'py>>(
-    py: Python<'py>,
-    v: &Bound<'py, PyAny>,
-    key: &str,
-    kind: &str,
-) -> PyResult<T> {
-    v.extract::<T>()
-        .map_err(|_| invalid_input(py, format!("option {key} must be {kind}")))
-}
-
-/// The request of a robot query: `request` with the keyword options applied
-/// (the request options of `CollisionRequest`, overriding its fields, and the
-/// robot's own; unknown names are errors).
-fn motion_request(
-    py: Python<'_>,
-    request: Option<&Bound<'_, PyCollisionRequest>>,
-    options: Option<&Bound<'_, PyDict>>,
-    motion: bool,
-) -> PyResult<MotionRequest> {
-    let mut out = MotionRequest::default();
-    let collide_options = PyDict::new(py);
-    let mut mesh_side: Option<String> = None;
-    let mut target: Option<Bound<'_, PyAny>> = None;
-    let mut target_pose: Option<Bound<'_, PyAny>> = None;
-    let mut allowed: Option<Vec<String>> = None;
-    let mut shadow: (Option<Bound<'_, PyAny>>, Option<f64>, Option<f64>) = (None, None, None);
-    if let Some(options) = options {
-        for (k, v) in options.iter() {
-            let key: String = k.extract()?;
-            if v.is_none() {
-                continue;
-            }
-            match key.as_str() {
-                "mesh_side" => mesh_side = Some(extract(py, &v, &key, "a str")?),
-                "mesh_spacing" => {
-                    out.robot.mesh_spacing = Some(extract(py, &v, &key, "a float")?);
-                }
-                "broad_phase" => out.robot.broad_phase = extract(py, &v, &key, "a bool")?,
-                "self_collision" => out.robot.self_collision = extract(py, &v, &key, "a bool")?,
-                "padding" => padding_from(py, &v, &mut out.robot)?,
-                "target" => target = Some(v),
-                "target_pose" => target_pose = Some(v),
-                "allowed_links" => allowed = Some(names_from(py, &v, "allowed_links")?),
-                "shadow" => shadow.0 = Some(v),
-                "shadow_depth" => shadow.1 = Some(extract(py, &v, &key, "a float (metres)")?),
-                "shadow_prior" => shadow.2 = Some(extract(py, &v, &key, "a float in [0, 1]")?),
-                "resolution" if motion => {
-                    out.resolution = Some(extract(py, &v, &key, "a float")?);
-                }
-                "max_probability" if motion => {
-                    out.max_probability = Some(extract(py, &v, &key, "a float")?);
-                }
-                "warm_start" if motion => out.warm_start = extract(py, &v, &key, "a bool")?,
-                _ => collide_options.set_item(key, v)?,
-            }
-        }
-    }
-    let mut also_valid = ROBOT_KEYWORDS.to_vec();
-    if motion {
-        also_valid.extend(MOTION_KEYWORDS);
-    }
-    out.robot.target = target_from(py, target.as_ref(), target_pose.as_ref(), allowed)?;
-    out.robot.shadow = shadow_from(py, shadow)?;
-    out.robot.mesh_side = link_side(py, mesh_side.as_deref(), out.robot.mesh_spacing)?;
-    out.robot.collide = request_from(py, request, Some(&collide_options), &also_valid)?;
-    out.robot.validate().or_py(py)?;
-    Ok(out)
-}
-
-/// `shadow=` (an `Occlusion`) with `shadow_depth=` and `shadow_prior=`.
-fn shadow_from(
-    py: Python<'_>,
-    (occlusion, depth, prior): (Option<Bound<'_, PyAny>>, Option<f64>, Option<f64>),
-) -> PyResult<Option<RobotShadow>> {
-    let Some(occlusion) = occlusion else {
-        if depth.is_some() || prior.is_some() {
-            return Err(invalid_input(
-                py,
-                "shadow_depth and shadow_prior need a shadow (a filters.Occlusion)".to_string(),
-            ));
-        }
-        return Ok(None);
-    };
-    let occ = occlusion.cast::<PyOcclusion>().map_err(|_| {
-        invalid_input(
-            py,
-            "option shadow must be a filters.Occlusion of the scan".to_string(),
-        )
-    })?;
-    let mut s = RobotShadow::new(Arc::clone(&occ.get().inner));
-    s.depth = depth.unwrap_or(s.depth);
-    s.prior = prior.unwrap_or(s.prior);
-    Ok(Some(s))
-}
-
-/// `padding=`: a float for every link, or a mapping from link name to metres.
-fn padding_from(
-    py: Python<'_>,
-    v: &Bound<'_, PyAny>,
-    robot: &mut cloudprox::robot::RobotRequest,
-) -> PyResult<()> {
-    if let Ok(map) = v.cast::<PyMapping>() {
-        for item in map.items()?.iter() {
-            let (name, d): (Bound<'_, PyAny>, Bound<'_, PyAny>) = item.extract()?;
-            let name: String = name.extract().map_err(|_| {
-                invalid_input(py, "padding's keys must be link names (str)".to_string())
-            })?;
-            let d: f64 = d.extract().map_err(|_| {
-                invalid_input(
-                    py,
-                    format!("padding of link '{name}' must be a float (metres)"),
-                )
-            })?;
-            robot.link_padding.push((name, d));
-        }
-        return Ok(());
-    }
-    robot.padding = v.extract().map_err(|_| {
-        invalid_input(
-            py,
-            "option padding must be a float (metres) or a dict from link name to metres"
-                .to_string(),
-        )
-    })?;
-    Ok(())
-}
-
-/// A list of names (`what` names the option in errors); a lone str is refused.
-fn names_from(py: Python<'_>, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<String>> {
-    if v.extract::<String>().is_ok() {
-        return Err(invalid_input(
-            py,
-            format!("option {what} must be a list of link names, got a str"),
-        ));
-    }
-    v.extract()
-        .map_err(|_| invalid_input(py, format!("option {what} must be a list of link names")))
-}
-
-/// `target=` (a `PointCloud`, or a `Mesh` at `target_pose`) with
-/// `allowed_links=`.
-fn target_from(
-    py: Python<'_>,
-    target: Option<&Bound<'_, PyAny>>,
-    pose: Option<&Bound<'_, PyAny>>,
-    allowed: Option<Vec<String>>,
-) -> PyResult<Option<GraspTarget>> {
-    let Some(target) = target else {
-        if allowed.is_some() || pose.is_some() {
-            return Err(invalid_input(
-                py,
-                "allowed_links and target_pose need a target (a PointCloud or a Mesh)".to_string(),
-            ));
-        }
-        return Ok(None);
-    };
-    let allowed = allowed.unwrap_or_default();
-    if let Ok(c) = target.cast::<PyPointCloud>() {
-        if pose.is_some() {
-            return Err(invalid_input(
-                py,
-                "target_pose places a Mesh target: a PointCloud target is in the cloud's frame \
-                 already (move it with PointCloud.transformed)"
-                    .to_string(),
-            ));
-        }
-        return Ok(Some(GraspTarget::cloud(
-            Arc::clone(&c.get().inner),
-            allowed,
-        )));
-    }
-    if let Ok(m) = target.cast::<PyMesh>() {
-        let pose = pose_from(py, pose, "target_pose")?;
-        return Ok(Some(GraspTarget::mesh(
-            Arc::clone(&m.get().inner),
-            pose,
-            allowed,
-        )));
-    }
-    let ty = target.get_type().name()?;
-    Err(pyo3::exceptions::PyTypeError::new_err(format!(
-        "target must be a PointCloud or a Mesh, got {ty}"
-    )))
-}
-
-/// How the links stand: `mesh_side` by name, or (not given) exact unless a
-/// `mesh_spacing` is given, which samples them, as `collide` reads a mesh.
-fn link_side(py: Python<'_>, name: Option<&str>, spacing: Option<f64>) -> PyResult<MeshSide> {
-    match name {
-        None if spacing.is_some() => Ok(MeshSide::Sampled),
-        None => Ok(MeshSide::Exact),
-        Some(name) => name
-            .parse::<MeshSide>()
-            .map_err(|e| invalid_input(py, e.to_string())),
-    }
-}
+use crate::robot_request::{motion_request_from, robot_request_from};
 
 /// A configuration of `robot`: a float64 array of shape `(dof,)` (its length
 /// is checked by the core), or a mapping from joint name to value, the joints
@@ -1178,11 +960,11 @@ pub fn collide_robot(
     q: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
-    request: Option<&Bound<'_, PyCollisionRequest>>,
+    request: Option<&Bound<'_, PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRobotCollisionResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, request, options, false)?.robot;
+    let request = robot_request_from(py, request, options)?;
     let q = config_from(&robot, q, "q")?;
     let base = pose_from(py, base_pose, "base_pose")?;
     let cloud = cloud_from(cloud)?;
@@ -1326,11 +1108,11 @@ pub fn collide_robot_many(
     qs: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
-    request: Option<&Bound<'_, PyCollisionRequest>>,
+    request: Option<&Bound<'_, PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyRobotBatchResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, request, options, false)?.robot;
+    let request = robot_request_from(py, request, options)?;
     let has_target = request.target.is_some();
     let qs = configs_from(&robot, qs, "qs")?;
     let base = pose_from(py, base_pose, "base_pose")?;
@@ -1445,11 +1227,11 @@ pub fn check_motion(
     q1: &Bound<'_, PyAny>,
     cloud: &Bound<'_, PyAny>,
     base_pose: Option<&Bound<'_, PyAny>>,
-    request: Option<&Bound<'_, PyCollisionRequest>>,
+    request: Option<&Bound<'_, PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyMotionResult> {
     let robot = robot_arg(robot)?;
-    let request = motion_request(py, request, options, true)?;
+    let request = motion_request_from(py, request, options)?;
     let q0 = config_from(&robot, q0, "q0")?;
     let q1 = config_from(&robot, q1, "q1")?;
     let base = pose_from(py, base_pose, "base_pose")?;

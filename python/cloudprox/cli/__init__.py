@@ -19,7 +19,7 @@ The user's commands:
 ``cloudprox example [DIR]``
     Example files: a depth-camera scan (PCD), a gripper (STL) and two grasp poses.
 
-The commands that query (``collide``, ``view``, ``robot``) take the same options
+The commands that query (``demo``, ``collide``, ``view``, ``robot``) take the same options
 of the query: ``--model``, ``--surface``, ``--aggregation``, ``--solver``,
 ``--decide-only``, ``--segmentations``, ``--near-context`` and the thresholds of
 the states, ``--threshold-free`` and ``--threshold-collision``

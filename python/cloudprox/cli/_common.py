@@ -1,8 +1,8 @@
 """What the commands share: the user error, the console, and the options of every query.
 
-The commands that query (``collide``, ``view``, ``robot``) take the same noise
-options (``--sigma``, ``--sensor`` and its parameters, ``--filter``), the same
-options of the query (:func:`add_request_arguments`, read back into a
+The commands that query scans (``collide``, ``view``, ``robot``) take the same
+noise options (``--sigma``, ``--sensor`` and its parameters, ``--filter``); they
+and ``demo`` take the same options of the query (:func:`add_request_arguments`, read back into a
 :class:`~cloudprox.CollisionRequest` by :func:`request_from_args`) and the same
 view options (``--html``, ``--rerun``).
 """

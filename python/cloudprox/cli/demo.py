@@ -8,8 +8,14 @@ import time
 from pathlib import Path
 from typing import Any
 
-from cloudprox._native import PointCloud, collide
-from cloudprox.cli._common import CliError, console, styled_state
+from cloudprox._native import CollisionRequest, PointCloud, collide
+from cloudprox.cli._common import (
+    CliError,
+    add_request_arguments,
+    console,
+    request_from_args,
+    styled_state,
+)
 
 __all__ = ["DEMO_FAR_GAP", "DEMO_GAPS_SIGMA", "add_demo_parser", "add_example_parser"]
 
@@ -26,6 +32,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         raise CliError(f"--sigma must be finite and > 0, got {args.sigma}")
     if args.points < 50:
         raise CliError(f"--points must be >= 50, got {args.points}")
+    request = request_from_args(args)
     out = console()
     t_start = time.perf_counter()
     s = args.sigma
@@ -36,7 +43,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         f"Piano ({len(piano)} points) lowered over {scene.table} in a room ({len(room)} points), "
         f"noise sigma = {1e3 * s:g} mm, seed {args.seed}."
     )
-    runs = _demo_runs(out, scene, piano, room, s)
+    runs = _demo_runs(out, scene, piano, room, s, request)
     out.print(
         "P: the probability, under the noise, that the two sampled surfaces cross "
         "(of poses read P = 0.3, about 3 in 10 collide)."
@@ -47,7 +54,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _demo_runs(out: Any, scene: Any, piano: PointCloud, room: PointCloud, s: float) -> list[Any]:
+def _demo_runs(
+    out: Any, scene: Any, piano: PointCloud, room: PointCloud, s: float, request: CollisionRequest
+) -> list[Any]:
     """Query the piano at every gap of the demo; print the table; return (gap, pose, result)."""
     from rich.table import Table
 
@@ -60,7 +69,7 @@ def _demo_runs(out: Any, scene: Any, piano: PointCloud, room: PointCloud, s: flo
         per_group = scene.gaps(pose)
         nearest = min(per_group, key=per_group.__getitem__)
         exact = per_group[nearest]
-        result = collide(piano, room, pose_a=pose)
+        result = collide(piano, room, pose_a=pose, request=request)
         runs.append((gap, pose, result))
         table.add_row(
             f"{1e3 * exact:+.1f}",
@@ -131,6 +140,7 @@ def add_demo_parser(sub: Any) -> None:
         default=10_000,
         help="approximate number of piano points (default: %(default)s)",
     )
+    add_request_arguments(demo)
     demo.set_defaults(func=_cmd_demo)
 
 

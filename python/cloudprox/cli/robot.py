@@ -102,7 +102,7 @@ def _load(args: argparse.Namespace) -> tuple[Any, Any]:
 
 
 def _cmd_robot(args: argparse.Namespace) -> int:
-    from cloudprox import Robot
+    from cloudprox import Robot, RobotRequest
 
     request = request_from_args(args)
     robot = Robot.from_urdf(args.urdf, package_dirs=args.package_dir or None, srdf=args.srdf)
@@ -112,11 +112,14 @@ def _cmd_robot(args: argparse.Namespace) -> int:
     if args.q is None and (args.html is not None or args.rerun is not None):
         raise CliError("--html and --rerun show one configuration: give --q, not --q-file")
     options: dict[str, Any] = {
-        "request": request,
-        "mesh_side": args.mesh_side,
-        "mesh_spacing": args.mesh_spacing,
-        "padding": args.padding,
-    } | _shadow_options(args, side)
+        "request": RobotRequest(
+            collide=request,
+            mesh_side=args.mesh_side,
+            mesh_spacing=args.mesh_spacing,
+            padding=args.padding,
+            **_shadow_options(args, side),
+        )
+    }
     if args.q is not None:
         return _one_configuration(args, robot, qs[0], side, base, options)
     return _many_configurations(args, robot, qs, side, base, options)
