@@ -34,6 +34,12 @@ const CROSSED_SDS: Real = 4.0;
 /// The selection criterion's cost per term of the field (2: Akaike's).
 const CRITERION_PER_TERM: Real = 2.0;
 
+/// How many of its own standard deviations the field's `chi^2` must exceed
+/// its degrees of freedom by for the readings' excess spread to count as the
+/// gap's own variation about the field ([`Averaged::misfit_variance`]): 2, a
+/// one-sided test at about 2 %.
+const MISFIT_SDS: Real = 2.0;
+
 /// Huber's tuning constant of the robust fit (in scaled standard deviations).
 const HUBER: Real = 2.0;
 
@@ -47,9 +53,17 @@ const HUBER: Real = 2.0;
 /// it), each fit's covariance scaled by its reduced `chi^2` where it exceeds 1
 /// (readings spread more than their stated deviations), and the three are
 /// averaged with their Akaike weights ([`Averaged`]; a flat contact reads
-/// mostly as a constant, two spheres as a quadric). `P` is the largest `Phi(-g / s)` of
-/// the field at the readings' places, and of every reading lying more than
-/// [`BELOW_FIELD_SDS`] below it or reading a crossing of more than
+/// mostly as a constant, two spheres as a quadric). Where the readings
+/// spread about the field significantly more than their stated deviations
+/// ([`MISFIT_SDS`]), the excess is the gap's own variation about the smooth
+/// field (a corner pressed towards a face rises as a cone, which no quadric
+/// follows): a random effect of variance `tau^2` per place, estimated by the
+/// method of moments, so that at a reading's place the gap is the field
+/// shrunk towards the reading (`k = tau^2 / (tau^2 + s^2)`; variance `(1 -
+/// k)^2 v + k s^2`), and where no reading lies the field's variance gains
+/// `tau^2`. `P` is the largest `Phi(-g / s)` of the field where the quadric
+/// is lowest and at the readings' places, and of every reading lying more than
+/// [`BELOW_FIELD_SDS`] below the field or reading a crossing of more than
 /// [`CROSSED_SDS`] (where the surfaces truly come closer than a smooth field
 /// says, it reads the contact).
 ///
@@ -108,12 +122,26 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
             .filter_map(|k| Fit::robust(&design(&coords, k), &r, &w0))
             .collect(),
     )?;
+    let tau2 = field.misfit_variance(&w0);
     let at = |u: [Real; 2], sample: usize| {
         let (gap, var) = field.at(u);
         FieldTerm {
             gap,
-            std: var.max(0.0).sqrt(),
+            std: (var + tau2).max(0.0).sqrt(),
             sample,
+        }
+    };
+    // At a reading's place the local misfit is read by the reading itself:
+    // the field shrunk towards it (the best linear predictor of a random
+    // effect of variance tau2 seen through a reading of variance s^2).
+    let at_reading = |i: usize| {
+        let (m, var) = field.at(coords[i]);
+        let s2 = samples[i].std * samples[i].std;
+        let k = if tau2 > 0.0 { tau2 / (tau2 + s2) } else { 0.0 };
+        FieldTerm {
+            gap: m + k * (r[i] - m),
+            std: ((1.0 - k) * (1.0 - k) * var + k * s2).max(0.0).sqrt(),
+            sample: i,
         }
     };
     let mut terms = Vec::with_capacity(n + 1);
@@ -128,16 +156,16 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
     }
     let scale = field.best_scale();
     for i in 0..n {
-        let term = at(coords[i], i);
+        let below = r[i] - field.at(coords[i]).0;
         let s = samples[i].std;
-        if (r[i] - term.gap) / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
+        if below / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
             terms.push(FieldTerm {
                 gap: r[i],
                 std: s,
                 sample: i,
             });
         }
-        terms.push(term);
+        terms.push(at_reading(i));
     }
     Some(terms)
 }
@@ -226,6 +254,25 @@ impl Averaged {
             .map(|((g, v), w)| w * (v + (g - mean) * (g - mean)))
             .sum();
         (mean, var)
+    }
+
+    /// The variance of the gap about the smooth field beyond the readings'
+    /// own noise (a random effect per place), by the method of moments on
+    /// the best fit: `(chi^2 - dof) / sum(w0)` where `chi^2` exceeds its
+    /// degrees of freedom by more than [`MISFIT_SDS`] of its standard
+    /// deviations (`sqrt(2 dof)`), else 0 (readings that spread as their
+    /// stated deviations say: the smooth field describes them).
+    fn misfit_variance(&self, w0: &DVector<Real>) -> Real {
+        let best = (0..self.fits.len())
+            .max_by(|&i, &j| self.weights[i].total_cmp(&self.weights[j]))
+            .unwrap_or(0);
+        let f = &self.fits[best];
+        let excess = f.chi2 - f.dof;
+        if excess > MISFIT_SDS * (2.0 * f.dof).sqrt() {
+            excess / w0.sum()
+        } else {
+            0.0
+        }
     }
 
     /// The variance scale (reduced `chi^2`, at least 1) of the best fit.
@@ -391,6 +438,34 @@ mod tests {
             p > pooled && p < 1e-3 * one,
             "P {p}: pooled {pooled}, one reading {one}"
         );
+    }
+
+    #[test]
+    fn a_cone_shaped_contact_is_read_at_its_apex_reading() {
+        // A corner pressed towards a face: the gap rises as a cone from the
+        // grid's centre (1 mm), which no constant, plane or quadric follows;
+        // the readings' excess spread is the gap's own variation about the
+        // field, so the apex is read from its own reading (within a few of
+        // its standard deviations), not from the smooth field above it.
+        let s = 1e-4;
+        let cone = |x: Real, y: Real| 1e-3 + 0.2 * (x - 0.03).hypot(y - 0.03);
+        let r = grid(7, cone, s);
+        let min = field_minimum(&r).unwrap();
+        assert!((min.gap - 1e-3).abs() < 3.0 * s, "{min:?}");
+        assert!(min.std >= 0.9 * s && min.std < 3.0 * s, "{min:?}");
+        // The smooth field alone reads the apex more than 1 mm too far.
+        let coords = contact_coordinates(&r);
+        let g = DVector::from_iterator(r.len(), r.iter().map(|x| x.gap));
+        let w0 = DVector::from_element(r.len(), 1.0 / (s * s));
+        let fits = [1usize, 3, 6]
+            .into_iter()
+            .filter_map(|k| Fit::robust(&design(&coords, k), &g, &w0))
+            .collect();
+        let field = Averaged::new(fits).unwrap();
+        let above = field.at(coords[24]).0 - 1e-3;
+        assert!(above > 10.0 * s, "{above}");
+        let tau2 = field.misfit_variance(&w0);
+        assert!(tau2 > 4.0 * s * s, "{tau2}");
     }
 
     #[test]
