@@ -71,12 +71,19 @@ where
 {
     use rayon::prelude::*;
     if points.len() > GRID_KNN_MIN_POINTS {
+        thread_local! {
+            /// The neighbourhood handed to `f`, reused by the thread's points.
+            static NEIGHBOURS: std::cell::RefCell<Vec<(f64, u32)>> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
         return for_each_knn(points, k, |i, others| {
-            let mut neighbours = Vec::with_capacity(others.len() + 1);
-            neighbours.push((0.0, i as u32));
-            neighbours.extend_from_slice(others);
-            neighbours.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            f(i, &neighbours)
+            NEIGHBOURS.with_borrow_mut(|neighbours| {
+                neighbours.clear();
+                neighbours.push((0.0, i as u32));
+                neighbours.extend_from_slice(others);
+                neighbours.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                f(i, neighbours)
+            })
         });
     }
     points

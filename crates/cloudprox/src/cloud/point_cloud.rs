@@ -8,9 +8,7 @@ use crate::bvh::{knn_of_every_point, Bvh, BvhSettings};
 use crate::element::{ElementSettings, SurfaceElements};
 use crate::error::{Error, Result};
 use crate::math::{Matrix3, Point3, Pose};
-use crate::uncertainty::{
-    discretization_covariances, max_std, min_std, DiscretizationSettings, NoiseModel,
-};
+use crate::uncertainty::{max_std, DiscretizationSettings, NoiseModel};
 use crate::Real;
 
 /// Points with a 3x3 covariance each, in the cloud's own frame.
@@ -59,6 +57,31 @@ struct Spacing {
     /// count): its median, read by every query that samples a mesh or a
     /// robot's links against the cloud, without a pass over the cloud each.
     middle: (Real, Real),
+}
+
+impl Spacing {
+    /// The spacing of every point, its maximum per node of `bvh` and its
+    /// two middle values.
+    fn new(per_point: Vec<Real>, bvh: &Bvh) -> Self {
+        let per_node = bvh.node_max(&per_point);
+        let mut sorted = per_point.clone();
+        let mid = sorted.len() / 2;
+        sorted.select_nth_unstable_by(mid, Real::total_cmp);
+        let upper = sorted[mid];
+        let lower = if sorted.len() % 2 == 1 {
+            upper
+        } else {
+            sorted[..mid]
+                .iter()
+                .copied()
+                .fold(Real::NEG_INFINITY, Real::max)
+        };
+        Spacing {
+            per_point,
+            per_node,
+            middle: (lower, upper),
+        }
+    }
 }
 
 /// Neighbours behind the spacing estimate: the distance to the 6th nearest.
@@ -179,8 +202,14 @@ impl PointCloud {
     }
 
     fn from_parts(points: Vec<Point3>, covariances: Vec<Matrix3>) -> Self {
-        let sigma_max: Vec<Real> = covariances.par_iter().map(max_std).collect();
-        let sensor_sigma_min = covariances.par_iter().map(min_std).collect();
+        // `max_std` and `min_std` from one eigen decomposition each.
+        let (sigma_max, sensor_sigma_min): (Vec<Real>, Vec<Real>) = covariances
+            .par_iter()
+            .map(|c| {
+                let ev = c.symmetric_eigenvalues();
+                (ev.max().max(0.0).sqrt(), ev.min().max(0.0).sqrt())
+            })
+            .unzip();
         Self {
             points,
             covariances,
@@ -269,14 +298,21 @@ impl PointCloud {
     }
 
     /// Adds the k-nearest-neighbour discretization covariance to every point's
-    /// covariance (see [`discretization_covariances`]).
+    /// covariance (see [`crate::uncertainty::discretization_covariances`]).
     pub fn with_discretization(mut self, settings: &DiscretizationSettings) -> Result<Self> {
-        let disc = discretization_covariances(
+        // The spacing's neighbours are among the discretization's: both
+        // from one k-NN pass.
+        let (disc, spacing) = settings.covariances_and_nth_distance(
             &self.points,
             self.sensor_covariances(),
             self.bvh(),
-            settings,
+            SPACING_NEIGHBOURS,
         )?;
+        if let Some(per_point) = spacing {
+            if self.spacing.get().is_none() {
+                let _ = self.spacing.set(Spacing::new(per_point, self.bvh()));
+            }
+        }
         if self.sensor.is_none() {
             self.sensor = Some(self.covariances.clone());
         }
@@ -394,31 +430,13 @@ impl PointCloud {
 
     fn spacing_data(&self) -> &Spacing {
         self.spacing.get_or_init(|| {
-            let bvh = self.bvh();
             let k = SPACING_NEIGHBOURS.min(self.points.len() - 1);
             // The distance to the k-th neighbour does not depend on how
             // ties are broken.
-            let per_point: Vec<Real> = knn_of_every_point(&self.points, bvh, k, |_, nb| {
+            let per_point: Vec<Real> = knn_of_every_point(&self.points, self.bvh(), k, |_, nb| {
                 nb.last().map_or(0.0, |&(d2, _)| d2.sqrt())
             });
-            let per_node = bvh.node_max(&per_point);
-            let mut sorted = per_point.clone();
-            let mid = sorted.len() / 2;
-            sorted.select_nth_unstable_by(mid, Real::total_cmp);
-            let upper = sorted[mid];
-            let lower = if sorted.len() % 2 == 1 {
-                upper
-            } else {
-                sorted[..mid]
-                    .iter()
-                    .copied()
-                    .fold(Real::NEG_INFINITY, Real::max)
-            };
-            Spacing {
-                per_point,
-                per_node,
-                middle: (lower, upper),
-            }
+            Spacing::new(per_point, self.bvh())
         })
     }
 
@@ -519,6 +537,49 @@ mod spacing_tests {
             .transformed(&Pose::translation(1.0, 0.0, 0.0))
             .unwrap();
         assert_eq!(moved.points()[1], Point3::new(1.1, 0.0, 0.0));
+    }
+
+    /// The spacing that the discretization's k-NN pass leaves behind is the
+    /// one the spacing's own pass finds, bit for bit, on the grid (large
+    /// clouds) and on the tree (small ones), and on clouds smaller than the
+    /// neighbourhoods.
+    #[test]
+    fn spacing_from_the_discretization_is_the_spacing() {
+        let big = add_noise(
+            &box_surface(
+                &Point3::origin(),
+                &crate::math::Vector3::new(0.3, 0.2, 0.1),
+                0.004,
+            ),
+            0.001,
+            3,
+        );
+        assert!(big.len() > GRID_KNN_MIN_POINTS);
+        for n in [big.len(), 3000, 8, 5, 2] {
+            let pts = big[..n].to_vec();
+            let own = PointCloud::from_sigma(pts.clone(), 0.001).unwrap();
+            let disc = PointCloud::from_sigma(pts, 0.001)
+                .unwrap()
+                .with_discretization(&DiscretizationSettings::default())
+                .unwrap();
+            assert!(disc.spacing.get().is_some(), "{n} points: not left behind");
+            assert_eq!(own.spacing(), disc.spacing(), "{n} points");
+            assert_eq!(own.node_spacing(), disc.node_spacing(), "{n} points");
+            assert_eq!(own.cell_side().to_bits(), disc.cell_side().to_bits());
+        }
+        // Neighbourhoods smaller than the spacing's: its own pass.
+        let few = DiscretizationSettings {
+            k: 3,
+            ..DiscretizationSettings::default()
+        };
+        let pts = big[..3000].to_vec();
+        let own = PointCloud::from_sigma(pts.clone(), 0.001).unwrap();
+        let disc = PointCloud::from_sigma(pts, 0.001)
+            .unwrap()
+            .with_discretization(&few)
+            .unwrap();
+        assert!(disc.spacing.get().is_none());
+        assert_eq!(own.spacing(), disc.spacing());
     }
 
     /// The grid path (large clouds) and the tree path give the same spacing.

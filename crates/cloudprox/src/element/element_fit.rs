@@ -7,7 +7,6 @@ use crate::element::element_types::footprint_cell;
 use crate::element::{ElementSettings, FootprintPoint, SurfaceElement};
 use crate::math::{Matrix3, Point3, PrincipalAxes, Vector3};
 use crate::probability::normal_quantile;
-use crate::uncertainty::directional_std_of;
 use crate::Real;
 
 /// The `p`-quantile of the chi-square law with `dof` degrees of freedom, by the
@@ -102,73 +101,203 @@ pub(crate) fn fit_element(
     first: u32,
     settings: &ElementSettings,
 ) -> Fit {
-    let pa = PrincipalAxes::of(idx.iter().map(|&i| points[i as usize]));
-    let normal = pa.least();
-    let t1 = pa.largest();
-    let t2: Vector3 = pa.axes.column(1).into_owned();
-    let m = idx.len();
-    // A floor under the variances: exact samples (no sensor noise) still have
-    // coordinates rounded to double precision.
-    let scale = pa.variances[2].sqrt() + pa.mean.coords.amax();
-    let floor = (1e-9 * scale).powi(2).max(Real::MIN_POSITIVE);
-    let local: Vec<(Real, Real, Real, Real)> = idx
-        .iter()
-        .map(|&i| {
-            let d = points[i as usize] - pa.mean;
-            let var = directional_std_of(&sensor[i as usize], &normal)
-                .powi(2)
-                .max(floor);
-            (d.dot(&t1), d.dot(&t2), d.dot(&normal), var)
-        })
-        .collect();
-    let median = || {
-        Fit::Split(SplitRule::Median {
-            mean: pa.mean,
-            axis: t1,
-        })
+    let group = Group {
+        points,
+        sensor,
+        spacing,
+        idx,
+        first,
+        settings,
     };
-    let confidence = 1.0 - settings.significance;
-    if m < settings.min_points {
-        return median();
+    group.fit(true)
+}
+
+/// The element the points `idx` make, or `None` where [`fit_element`] would
+/// split them: the same tests, for a caller that does not split a group
+/// that fails (the merge), so the search for two surfaces in a failed
+/// group's residuals is left out.
+pub(crate) fn element_of(
+    points: &[Point3],
+    sensor: &[Matrix3],
+    spacing: &[Real],
+    idx: &[u32],
+    first: u32,
+    settings: &ElementSettings,
+) -> Option<Box<SurfaceElement>> {
+    if idx.len() < settings.min_points {
+        return None;
     }
-    let Some(f) = weighted_fit(&local, quadric_row) else {
-        return median();
+    let group = Group {
+        points,
+        sensor,
+        spacing,
+        idx,
+        first,
+        settings,
     };
-    // Each point within its own noise too: one point far off a surface that
-    // the others fit (a flying pixel, the corner of another face) adds less
-    // to the sum than the sum's own spread over hundreds of points, but it
-    // samples no part of that surface. The largest standardized residual is
-    // tested against the largest of `m` standard normals (a Bonferroni bound
-    // at the same significance); the residuals' own variance is below the
-    // points', so the test errs towards keeping a group.
-    let residuals: Vec<(Real, Real)> = local
-        .iter()
-        .map(|&(u, v, h, var)| (h - quadric_row(u, v).dot(&f.coef), var))
-        .collect();
+    match group.fit(false) {
+        Fit::Element(e) => Some(e),
+        Fit::Split(_) => None,
+    }
+}
+
+/// A group of points under test, with what the tests read.
+struct Group<'a> {
+    points: &'a [Point3],
+    sensor: &'a [Matrix3],
+    spacing: &'a [Real],
+    idx: &'a [u32],
+    first: u32,
+    settings: &'a ElementSettings,
+}
+
+/// Tangential coordinates, height and variance along the normal of each point.
+type Local = Vec<(Real, Real, Real, Real)>;
+
+impl Group<'_> {
+    /// [`fit_element`]; a failed group's split rule is searched for between
+    /// two surfaces only when `want_rule`.
+    fn fit(&self, want_rule: bool) -> Fit {
+        let pa = PrincipalAxes::of(self.idx.iter().map(|&i| self.points[i as usize]));
+        let local = self.local(&pa);
+        let t1 = pa.largest();
+        let median = || {
+            Fit::Split(SplitRule::Median {
+                mean: pa.mean,
+                axis: t1,
+            })
+        };
+        let (m, settings) = (self.idx.len(), self.settings);
+        let confidence = 1.0 - settings.significance;
+        if m < settings.min_points {
+            return median();
+        }
+        let Some((f, residuals)) = weighted_fit_residuals(&local, quadric_row) else {
+            return median();
+        };
+        if !fits_one_surface(&f, &residuals, m, settings) {
+            if !want_rule {
+                return median();
+            }
+            return two_surface_rule(&pa, &f, &residuals).unwrap_or_else(median);
+        }
+        if !curvature_allows_a_plane(&f, m, settings.min_points, confidence) {
+            return median();
+        }
+        self.planar_element(&pa, &local).unwrap_or_else(median)
+    }
+
+    /// Each point's coordinates in the principal frame of `pa`, with its
+    /// sensor variance along the normal.
+    fn local(&self, pa: &PrincipalAxes) -> Local {
+        let normal = pa.least();
+        let t1 = pa.largest();
+        let t2: Vector3 = pa.axes.column(1).into_owned();
+        // A floor under the variances: exact samples (no sensor noise) still have
+        // coordinates rounded to double precision.
+        let scale = pa.variances[2].sqrt() + pa.mean.coords.amax();
+        let floor = (1e-9 * scale).powi(2).max(Real::MIN_POSITIVE);
+        self.idx
+            .iter()
+            .map(|&i| {
+                let d = self.points[i as usize] - pa.mean;
+                let var = directional_std(&self.sensor[i as usize], &normal)
+                    .powi(2)
+                    .max(floor);
+                (d.dot(&t1), d.dot(&t2), d.dot(&normal), var)
+            })
+            .collect()
+    }
+
+    /// The element of a group that passed the residual test and the
+    /// curvature rule, if its plane is determined and its points cover its
+    /// extent.
+    fn planar_element(&self, pa: &PrincipalAxes, local: &Local) -> Option<Fit> {
+        // Curvature small enough that a plane would describe the points about as
+        // well: the element stays this size. Its surface is still the quadric
+        // (fitted over the element's own tangent axes below): a plane lies outside
+        // a convex surface near the element's edges by a fraction of the noise,
+        // where two surfaces first meet.
+        let p = weighted_fit(local, plane_row).filter(spans_a_plane)?;
+        let (t1, t2): (Vector3, Vector3) = (pa.largest(), pa.axes.column(1).into_owned());
+        // The tangent axes of the points' tightest bounding rectangle (a
+        // square face gets axes along its sides, not along its diagonals).
+        let (c, s) = tightest_rectangle_axes(local);
+        let local: Local = local
+            .iter()
+            .map(|&(u, v, h, var)| (c * u + s * v, -s * u + c * v, h, var))
+            .collect();
+        let tangents = [c * t1 + s * t2, -s * t1 + c * t2];
+        let p = p.rotated(c, s);
+        let e = element(
+            pa,
+            self.idx,
+            self.sensor,
+            self.spacing,
+            &local,
+            tangents,
+            self.first,
+            self.settings,
+            &p,
+        );
+        covers_its_extent(&e, &local).then(|| Fit::Element(Box::new(e)))
+    }
+}
+
+/// Where the residuals of a failed group fall into two groups, they
+/// sample two surfaces (the fit runs between them): the rule splitting
+/// them.
+fn two_surface_rule(
+    pa: &PrincipalAxes,
+    f: &HeightFit<6>,
+    residuals: &[(Real, Real)],
+) -> Option<Fit> {
+    let m = residuals.len();
+    let at = two_surfaces(residuals).filter(|&t| {
+        let below = residuals.iter().filter(|(r, _)| *r < t).count();
+        below >= 3 && m - below >= 3
+    })?;
+    let t2: Vector3 = pa.axes.column(1).into_owned();
+    Some(Fit::Split(SplitRule::TwoSurfaces {
+        mean: pa.mean,
+        frame: [pa.largest(), t2, pa.least()],
+        coef: f.coef.into(),
+        at,
+    }))
+}
+
+/// The residual test: each point within its own noise, and the weighted
+/// residual sum within the chi-square quantile.
+///
+/// Each point within its own noise too: one point far off a surface that
+/// the others fit (a flying pixel, the corner of another face) adds less
+/// to the sum than the sum's own spread over hundreds of points, but it
+/// samples no part of that surface. The largest standardized residual is
+/// tested against the largest of `m` standard normals (a Bonferroni bound
+/// at the same significance); the residuals' own variance is below the
+/// points', so the test errs towards keeping a group.
+fn fits_one_surface(
+    f: &HeightFit<6>,
+    residuals: &[(Real, Real)],
+    m: usize,
+    settings: &ElementSettings,
+) -> bool {
     let z_max = -normal_quantile(0.5 * settings.significance / m as Real);
     let outlier = residuals
         .iter()
         .any(|&(r, var)| r * r > z_max * z_max * var);
-    if outlier || f.residual > chi_square_quantile(m - 6, confidence) {
-        // No smooth surface explains the points: where the residuals fall into
-        // two groups, they sample two surfaces (the fit runs between them).
-        let at = two_surfaces(&residuals).filter(|&t| {
-            let below = residuals.iter().filter(|(r, _)| *r < t).count();
-            below >= 3 && m - below >= 3
-        });
-        return match at {
-            Some(at) => Fit::Split(SplitRule::TwoSurfaces {
-                mean: pa.mean,
-                frame: [t1, t2, normal],
-                coef: f.coef.into(),
-                at,
-            }),
-            None => median(),
-        };
-    }
-    // The extent stays below the curvature scale: the plane is kept only where
-    // it describes the points' surface as well as the quadric is expected to
-    // (Mallows' Cp, see [`CURVATURE_SPLIT`]); otherwise the group splits.
+    !(outlier || f.residual > chi_square_quantile(m - 6, 1.0 - settings.significance))
+}
+
+/// The curvature rule: the extent stays below the curvature scale, the
+/// plane is kept only where it describes the points' surface as well as
+/// the quadric is expected to (Mallows' Cp, see [`CURVATURE_SPLIT`]).
+fn curvature_allows_a_plane(
+    f: &HeightFit<6>,
+    m: usize,
+    min_points: usize,
+    confidence: Real,
+) -> bool {
     let curvature = f.coef.fixed_rows::<3>(3).into_owned();
     let cov_curvature: Mat3 = f.cov.fixed_view::<3, 3>(3, 3).into_owned();
     let wald = match cov_curvature.cholesky() {
@@ -178,41 +307,22 @@ pub(crate) fn fit_element(
     // A group too small for both halves to be elements would leave at least
     // one half as single points, each with its full noise: there only a
     // significant curvature splits it.
-    let split_at = if m >= 2 * settings.min_points {
+    let split_at = if m >= 2 * min_points {
         CURVATURE_SPLIT
     } else {
         chi_square_quantile(3, confidence)
     };
-    if !wald.is_finite() || wald > split_at {
-        return median();
-    }
-    // Curvature small enough that a plane would describe the points about as
-    // well: the element stays this size. Its surface is still the quadric
-    // (fitted over the element's own tangent axes below): a plane lies outside
-    // a convex surface near the element's edges by a fraction of the noise,
-    // where two surfaces first meet.
-    match weighted_fit(&local, plane_row) {
-        Some(p) if spans_a_plane(&p) => {
-            // The tangent axes of the points' tightest bounding rectangle (a
-            // square face gets axes along its sides, not along its diagonals).
-            let (c, s) = tightest_rectangle_axes(&local);
-            let local: Vec<(Real, Real, Real, Real)> = local
-                .iter()
-                .map(|&(u, v, h, var)| (c * u + s * v, -s * u + c * v, h, var))
-                .collect();
-            let tangents = [c * t1 + s * t2, -s * t1 + c * t2];
-            let p = p.rotated(c, s);
-            let e = element(
-                &pa, idx, sensor, spacing, &local, tangents, first, settings, &p,
-            );
-            if covers_its_extent(&e, &local) {
-                Fit::Element(Box::new(e))
-            } else {
-                median()
-            }
-        }
-        _ => median(),
-    }
+    wald.is_finite() && wald <= split_at
+}
+
+/// `sqrt(v^T cov v)`: [`crate::uncertainty::directional_std_of`] written
+/// out, the same operations in the same order (nalgebra's `cov * v` sums the
+/// columns scaled by `v`'s entries, left to right), for the fits' passes over
+/// every point.
+fn directional_std(cov: &Matrix3, v: &Vector3) -> Real {
+    let r: [Real; 3] =
+        std::array::from_fn(|i| cov[(i, 0)] * v[0] + cov[(i, 1)] * v[1] + cov[(i, 2)] * v[2]);
+    (v[0] * r[0] + v[1] * r[1] + v[2] * r[2]).max(0.0).sqrt()
 }
 
 /// Whether an element's points cover the surface its extent claims: at least
@@ -266,15 +376,7 @@ fn weighted_fit<const D: usize>(
     local: &[(Real, Real, Real, Real)],
     row: fn(Real, Real) -> SVector<Real, D>,
 ) -> Option<HeightFit<D>> {
-    let mut normal_matrix = SMatrix::<Real, D, D>::zeros();
-    let mut rhs = SVector::<Real, D>::zeros();
-    for &(u, v, h, var) in local {
-        let x = row(u, v);
-        normal_matrix += x * x.transpose() / var;
-        rhs += x * (h / var);
-    }
-    let chol = normal_matrix.cholesky()?;
-    let coef = chol.solve(&rhs);
+    let (chol, coef) = solve_normal_equations(local, row)?;
     let residual: Real = local
         .iter()
         .map(|&(u, v, h, var)| (h - row(u, v).dot(&coef)).powi(2) / var)
@@ -284,6 +386,53 @@ fn weighted_fit<const D: usize>(
         cov: chol.inverse(),
         residual,
     })
+}
+
+/// [`weighted_fit`] with each point's residual from the fit and its variance.
+fn weighted_fit_residuals<const D: usize>(
+    local: &[(Real, Real, Real, Real)],
+    row: fn(Real, Real) -> SVector<Real, D>,
+) -> Option<(HeightFit<D>, Vec<(Real, Real)>)> {
+    let (chol, coef) = solve_normal_equations(local, row)?;
+    let residuals: Vec<(Real, Real)> = local
+        .iter()
+        .map(|&(u, v, h, var)| (h - row(u, v).dot(&coef), var))
+        .collect();
+    let residual: Real = residuals.iter().map(|&(r, var)| r.powi(2) / var).sum();
+    residual.is_finite().then(|| {
+        let fit = HeightFit {
+            coef,
+            cov: chol.inverse(),
+            residual,
+        };
+        (fit, residuals)
+    })
+}
+
+/// The Cholesky factor of the weighted normal matrix of `local`'s heights
+/// over `row` and the coefficients it solves for; `None` when the points do
+/// not determine them. (Inlined into each fit: the solve of the
+/// triangular factors then unrolls at the fit's size; called, the two took
+/// 7% of an element build.)
+#[allow(clippy::inline_always)] // measured: see above
+#[inline(always)]
+fn solve_normal_equations<const D: usize>(
+    local: &[(Real, Real, Real, Real)],
+    row: fn(Real, Real) -> SVector<Real, D>,
+) -> Option<(
+    nalgebra::Cholesky<Real, nalgebra::Const<D>>,
+    SVector<Real, D>,
+)> {
+    let mut normal_matrix = SMatrix::<Real, D, D>::zeros();
+    let mut rhs = SVector::<Real, D>::zeros();
+    for &(u, v, h, var) in local {
+        let x = row(u, v);
+        normal_matrix += x * x.transpose() / var;
+        rhs += x * (h / var);
+    }
+    let chol = normal_matrix.cholesky()?;
+    let coef = chol.solve(&rhs);
+    Some((chol, coef))
 }
 
 /// The largest standard deviation of a fitted plane's slope: beyond it the
@@ -342,7 +491,8 @@ fn tightest_rectangle_axes(local: &[(Real, Real, Real, Real)]) -> (Real, Real) {
 /// The convex hull of `pts` in counter-clockwise order (Andrew's monotone
 /// chain), without collinear points.
 fn convex_hull_2d(mut pts: Vec<(Real, Real)>) -> Vec<(Real, Real)> {
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    // (Unstable: points equal in this order are the same point.)
+    pts.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     pts.dedup();
     if pts.len() < 3 {
         return pts;
@@ -403,7 +553,7 @@ fn element(
     let range = |k: usize| -> [Real; 2] {
         let noise_var = idx
             .iter()
-            .map(|&i| directional_std_of(&sensor[i as usize], &tangents[k]).powi(2))
+            .map(|&i| directional_std(&sensor[i as usize], &tangents[k]).powi(2))
             .sum::<Real>()
             / n;
         let mut along: Vec<Real> = local
@@ -565,7 +715,7 @@ fn lateral_noise_corrected(
 /// Unlike the outermost points, it is not pushed out by the noise (by about
 /// `s sqrt(2 ln n)`). Sorts `along`.
 fn sampled_edges(along: &mut [Real], s: Real) -> [Real; 2] {
-    along.sort_by(Real::total_cmp);
+    along.sort_unstable_by(Real::total_cmp);
     let hi = upper_edge(along, s);
     along.reverse();
     for x in along.iter_mut() {
@@ -618,7 +768,7 @@ fn two_surfaces(values: &[(Real, Real)]) -> Option<Real> {
         return None;
     }
     let mut h: Vec<Real> = values.iter().map(|t| t.0).collect();
-    h.sort_by(Real::total_cmp);
+    h.sort_unstable_by(Real::total_cmp);
     let noise_var = values.iter().map(|t| t.1).sum::<Real>() / m as Real;
     let total: Real = h.iter().sum();
     let total_sq: Real = h.iter().map(|x| x * x).sum();
@@ -644,6 +794,64 @@ fn two_surfaces(values: &[(Real, Real)]) -> Option<Real> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cloud::PointCloud;
+    use crate::sample::NormalRng;
+    use crate::uncertainty::directional_std_of;
+
+    /// The written-out directional standard deviation is the library's,
+    /// bit for bit, on random covariances and directions.
+    #[test]
+    fn directional_std_is_directional_std_of_bit_for_bit() {
+        let mut rng = NormalRng::new(5);
+        for _ in 0..2000 {
+            let a = Matrix3::from_fn(|_, _| rng.normal() * 1e-3);
+            let cov = a * a.transpose();
+            let v = Vector3::new(rng.normal(), rng.normal(), rng.normal()).normalize();
+            let (got, want) = (directional_std(&cov, &v), directional_std_of(&cov, &v));
+            assert_eq!(got.to_bits(), want.to_bits(), "{cov} {v}");
+        }
+    }
+
+    /// [`element_of`] gives the element [`fit_element`] does, and `None`
+    /// where it splits: on the halves, quarters and unions of neighbouring
+    /// groups of a noisy box (faces, edges, corners and too-small groups).
+    #[test]
+    fn element_of_agrees_with_fit_element() {
+        let mut rng = NormalRng::new(7);
+        let sigma = 0.002;
+        let mut points = Vec::new();
+        for axis in 0..3 {
+            for side in [0.0, 1.0] {
+                for _ in 0..400 {
+                    let x: [Real; 3] = std::array::from_fn(|a| {
+                        let t = if a == axis { side } else { rng.uniform() };
+                        0.3 * t + sigma * rng.normal()
+                    });
+                    points.push(Point3::from(x));
+                }
+            }
+        }
+        let cloud = PointCloud::from_sigma(points, sigma).expect("finite points");
+        let (p, sensor, spacing) = (cloud.points(), cloud.sensor_covariances(), cloud.spacing());
+        let settings = ElementSettings::default();
+        let mut order: Vec<u32> = (0..p.len() as u32).collect();
+        order.sort_by(|&a, &b| p[a as usize].x.total_cmp(&p[b as usize].x));
+        let (mut elements, mut splits) = (0, 0);
+        for size in [4, 12, 40, 150, 600] {
+            for run in order.chunks(size) {
+                let fit = fit_element(p, sensor, spacing, run, 3, &settings);
+                match (fit, element_of(p, sensor, spacing, run, 3, &settings)) {
+                    (Fit::Element(a), Some(b)) => {
+                        assert_eq!(a, b);
+                        elements += 1;
+                    }
+                    (Fit::Split(_), None) => splits += 1,
+                    _ => panic!("the two disagree on a group of {}", run.len()),
+                }
+            }
+        }
+        assert!(elements > 0 && splits > 0, "{elements} {splits}");
+    }
 
     #[test]
     fn sampled_edges_take_the_noise_out_of_the_range() {
@@ -654,7 +862,7 @@ mod tests {
         // A dense uniform sampling of [-1, 2] with noise 0.05: the outermost
         // points lie about 0.05 sqrt(2 ln n) = 0.2 beyond the edges; the edges
         // are read within a fifth of that.
-        let mut rng = crate::sample::NormalRng::new(3);
+        let mut rng = NormalRng::new(3);
         let s = 0.05;
         let mut along: Vec<Real> = (0..4000)
             .map(|_| -1.0 + 3.0 * rng.uniform() + s * rng.normal())

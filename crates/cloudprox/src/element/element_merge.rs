@@ -12,6 +12,8 @@ use std::collections::HashSet;
 use rayon::prelude::*;
 
 use crate::bvh::{Bvh, BvhSettings, BvhWorkspace};
+use crate::element::element_fit::element_of;
+#[cfg(test)]
 use crate::element::element_fit::{fit_element, Fit};
 use crate::element::{ElementSettings, SurfaceElement};
 use crate::math::{Matrix3, Point3};
@@ -81,17 +83,22 @@ pub(crate) fn merge_neighbours(
             .map(|&(_, i, j)| (i as usize, j as usize))
             .peekable();
         while rest.peek().is_some() {
+            // (A union of fewer than `min_points` points is no element:
+            // such pairs are not fitted.)
             let batch: Vec<(usize, usize)> = rest
                 .by_ref()
-                .filter(|&(i, j)| !(touched[i] || touched[j] || failed.contains(&(ids[i], ids[j]))))
+                .filter(|&(i, j)| {
+                    !(touched[i] || touched[j] || failed.contains(&(ids[i], ids[j])))
+                        && groups[i].0.len() + groups[j].0.len() >= settings.min_points
+                })
                 .take(MERGE_BATCH)
                 .collect();
-            let fits: Vec<(Vec<u32>, Fit)> = batch
+            let fits: Vec<(Vec<u32>, Option<Box<SurfaceElement>>)> = batch
                 .par_iter()
                 .map(|&(i, j)| {
                     let mut union = groups[i].0.clone();
                     union.extend_from_slice(&groups[j].0);
-                    let fit = fit_element(points, sensor, spacing, &union, 0, settings);
+                    let fit = element_of(points, sensor, spacing, &union, 0, settings);
                     (union, fit)
                 })
                 .collect();
@@ -99,7 +106,7 @@ pub(crate) fn merge_neighbours(
                 if touched[i] || touched[j] {
                     continue;
                 }
-                if let Fit::Element(e) = fit {
+                if let Some(e) = fit {
                     groups[i] = (union, *e);
                     groups[j].0.clear();
                     ids[i] = next_id;

@@ -68,14 +68,7 @@ pub fn discretization_covariances(
     bvh: &Bvh,
     settings: &DiscretizationSettings,
 ) -> Result<Vec<Matrix3>> {
-    settings.validate()?;
-    if sensor.len() != points.len() {
-        return Err(Error::Shape {
-            what: "sensor covariances".into(),
-            expected: points.len(),
-            got: sensor.len(),
-        });
-    }
+    check_inputs(points, sensor, settings)?;
     if points.len() < 2 {
         return Ok(vec![Matrix3::zeros(); points.len()]);
     }
@@ -84,6 +77,57 @@ pub fn discretization_covariances(
         of_neighbourhood(points, neighbours, &sensor[i], settings)
     }))
 }
+
+impl DiscretizationSettings {
+    /// [`discretization_covariances`] with these settings and, from the
+    /// same neighbourhoods, every point's distance to its `nth` nearest
+    /// other point (the last of the k-NN pass of `min(nth, n - 1)`
+    /// neighbours: that distance does not depend on how ties are broken).
+    /// `None` for the distances when the neighbourhoods hold fewer than
+    /// `nth + 1` points (`k < nth`, or a cloud of one point).
+    pub(crate) fn covariances_and_nth_distance(
+        &self,
+        points: &[Point3],
+        sensor: &[Matrix3],
+        bvh: &Bvh,
+        nth: usize,
+    ) -> Result<(Vec<Matrix3>, Option<Vec<Real>>)> {
+        check_inputs(points, sensor, self)?;
+        if points.len() < 2 || self.k < nth {
+            let cov = discretization_covariances(points, sensor, bvh, self)?;
+            return Ok((cov, None));
+        }
+        let k = self.k.min(points.len() - 1);
+        let at = nth.min(points.len() - 1);
+        let both: Vec<(Matrix3, Real)> = knn_of_every_point(points, bvh, k, |i, neighbours| {
+            let cov = of_neighbourhood(points, neighbours, &sensor[i], self);
+            (cov, neighbours.get(at).map_or(0.0, |&(d2, _)| d2.sqrt()))
+        });
+        let (cov, nth_distance) = both.into_iter().unzip();
+        Ok((cov, Some(nth_distance)))
+    }
+}
+
+/// Validates the settings and the number of sensor covariances.
+fn check_inputs(
+    points: &[Point3],
+    sensor: &[Matrix3],
+    settings: &DiscretizationSettings,
+) -> Result<()> {
+    settings.validate()?;
+    if sensor.len() != points.len() {
+        return Err(Error::Shape {
+            what: "sensor covariances".into(),
+            expected: points.len(),
+            got: sensor.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Neighbourhoods up to this size keep their weights between the two passes
+/// of [`of_neighbourhood`] (larger ones compute them twice, the same values).
+const KEPT_WEIGHTS: usize = 32;
 
 /// One point's discretization covariance from its `neighbours` (itself
 /// included, as `(squared distance, index)` nearest first).
@@ -98,17 +142,23 @@ fn of_neighbourhood(
         return Matrix3::zeros();
     }
     let s = settings.weight_scale * d_k;
+    let weight = |d2: Real| (-d2 / (s * s)).exp();
+    let mut kept = [0.0; KEPT_WEIGHTS];
+    let keep = neighbours.len() <= KEPT_WEIGHTS;
     let mut wsum = 0.0;
     let mut mean = Vector3::zeros();
-    for &(d2, j) in neighbours {
-        let w = (-d2 / (s * s)).exp();
+    for (n, &(d2, j)) in neighbours.iter().enumerate() {
+        let w = weight(d2);
+        if keep {
+            kept[n] = w;
+        }
         wsum += w;
         mean += w * points[j as usize].coords;
     }
     mean /= wsum;
     let mut scatter = Matrix3::zeros();
-    for &(d2, j) in neighbours {
-        let w = (-d2 / (s * s)).exp();
+    for (n, &(d2, j)) in neighbours.iter().enumerate() {
+        let w = if keep { kept[n] } else { weight(d2) };
         let o = points[j as usize].coords - mean;
         scatter += w * o * o.transpose();
     }
