@@ -47,9 +47,9 @@ pub(crate) fn element_readings(
     for k in candidates {
         scan.tested += 1;
         let standing = frame.standing(els, k);
-        if standing == Standing::Deep && decisive.is_some() {
+        if let (Standing::Deep, Some(p)) = (standing, decisive) {
             let r = deep_reading(frame, els, k);
-            if decisive.is_some_and(|p| contact_probability(&[r]) >= p) {
+            if contact_probability(&[r]) >= p {
                 scan.readings.push(r);
                 scan.near.push((k, r.gap <= 0.0));
                 return scan;
