@@ -134,8 +134,7 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
     // At a reading's place the local misfit is read by the reading itself:
     // the field shrunk towards it (the best linear predictor of a random
     // effect of variance tau2 seen through a reading of variance s^2).
-    let at_reading = |i: usize| {
-        let (m, var) = field.at(coords[i]);
+    let at_reading = |i: usize, (m, var): (Real, Real)| {
         let s2 = samples[i].std * samples[i].std;
         let k = if tau2 > 0.0 { tau2 / (tau2 + s2) } else { 0.0 };
         FieldTerm {
@@ -154,9 +153,10 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
             .unwrap_or(0);
         terms.push(at(c, nearest));
     }
-    let scale = field.best_scale();
+    let scale = field.best().scale();
     for i in 0..n {
-        let below = r[i] - field.at(coords[i]).0;
+        let here = field.at(coords[i]);
+        let below = r[i] - here.0;
         let s = samples[i].std;
         if below / (s * scale.sqrt()) < -BELOW_FIELD_SDS || r[i] < -CROSSED_SDS * s {
             terms.push(FieldTerm {
@@ -165,7 +165,7 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
                 sample: i,
             });
         }
-        terms.push(at_reading(i));
+        terms.push(at_reading(i, here));
     }
     Some(terms)
 }
@@ -263,10 +263,7 @@ impl Averaged {
     /// deviations (`sqrt(2 dof)`), else 0 (readings that spread as their
     /// stated deviations say: the smooth field describes them).
     fn misfit_variance(&self, w0: &DVector<Real>) -> Real {
-        let best = (0..self.fits.len())
-            .max_by(|&i, &j| self.weights[i].total_cmp(&self.weights[j]))
-            .unwrap_or(0);
-        let f = &self.fits[best];
+        let f = self.best();
         let excess = f.chi2 - f.dof;
         if excess > MISFIT_SDS * (2.0 * f.dof).sqrt() {
             excess / w0.sum()
@@ -275,12 +272,12 @@ impl Averaged {
         }
     }
 
-    /// The variance scale (reduced `chi^2`, at least 1) of the best fit.
-    fn best_scale(&self) -> Real {
+    /// The fit of the largest Akaike weight.
+    fn best(&self) -> &Fit {
         let best = (0..self.fits.len())
             .max_by(|&i, &j| self.weights[i].total_cmp(&self.weights[j]))
             .unwrap_or(0);
-        self.fits[best].scale()
+        &self.fits[best]
     }
 
     /// Where the quadric field is lowest ([`Fit::lowest`]), when one was fitted.

@@ -165,6 +165,12 @@ impl LinkGeometry {
         })
     }
 
+    /// Whether [`LinkGeometry::field`] has been asked for (built, or found
+    /// impossible to build).
+    pub(crate) fn has_field(&self) -> bool {
+        self.field.get().is_some()
+    }
+
     /// The link's distance field, built on first use: cells of a 48th of
     /// the bounding box's diagonal (from 2 mm to 1 cm), exact within six
     /// cells of the surface. Its bounds let the exact-side query pass over elements and

@@ -569,10 +569,14 @@ fn build_fields(robot: &Robot) {
                 .filter(|o| o.cloud.is_none())
                 .map(|o| &o.geometry),
         )
+        .filter(|g| !g.has_field())
         .collect();
-    bodies.par_iter().for_each(|g| {
-        let _ = g.field();
-    });
+    // After the first query none is left: no work on the thread pool.
+    if !bodies.is_empty() {
+        bodies.par_iter().for_each(|g| {
+            let _ = g.field();
+        });
+    }
 }
 
 /// What stands for one body of the robot (a link, or an attached object) in

@@ -4,7 +4,7 @@ use super::frame::Frame;
 use super::readings::element_readings;
 use crate::cloud::PointCloud;
 use crate::math::{Point3, Pose};
-use crate::sample::add_noise;
+use crate::sample::{add_noise, lcg_uniform};
 use crate::shape::{Mesh, MeshDistance};
 use crate::Real;
 
@@ -19,6 +19,18 @@ fn plane(gap: Real) -> Vec<Point3> {
             Point3::new(u, v, -0.5 - gap)
         })
         .collect()
+}
+
+/// A pose at `radius` from the origin along a random direction, turned by
+/// a random rotation (of up to 3 rad about a random axis).
+fn turned_at(next: &mut impl FnMut() -> Real, radius: Real) -> Pose {
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    let dir = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+    let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+    Pose::from_parts(
+        Translation3::from(dir * radius),
+        UnitQuaternion::from_scaled_axis(axis * 3.0),
+    )
 }
 
 #[test]
@@ -97,13 +109,7 @@ fn the_hierarchy_finds_every_element_the_one_by_one_test_keeps() {
     let boxy = MeshDistance::new(&Mesh::cuboid(0.03, 0.02, 0.01).unwrap()).unwrap();
     let cloud = PointCloud::from_sigma(add_noise(&plane(0.0), 0.002, 3), 0.002).unwrap();
     let els = cloud.elements();
-    let mut rng = 7_u64;
-    let mut next = move || {
-        rng = rng
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (rng >> 11) as Real / (1_u64 << 53) as Real
-    };
+    let mut next = lcg_uniform(7);
     let mut found = 0;
     for _ in 0..200 {
         let t = Translation3::new(
@@ -141,7 +147,6 @@ fn decide_only_stops_at_a_decisive_element_with_the_full_querys_state() {
     use crate::query::exact_side::collide_exact_cloud;
     use crate::query::CollisionRequest;
     use crate::sample::sphere;
-    use nalgebra::{Translation3, UnitQuaternion, Vector3};
     let cube = MeshDistance::new(&Mesh::cuboid(0.05, 0.05, 0.05).unwrap()).unwrap();
     let shell = sphere(&Point3::origin(), 0.1, 3000);
     let cloud = PointCloud::from_sigma(add_noise(&shell, 0.001, 5), 0.001).unwrap();
@@ -150,24 +155,13 @@ fn decide_only_stops_at_a_decisive_element_with_the_full_querys_state() {
         decide_only: true,
         ..CollisionRequest::default()
     };
-    let mut rng = 11_u64;
-    let mut next = move || {
-        rng = rng
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (rng >> 11) as Real / (1_u64 << 53) as Real
-    };
+    let mut next = lcg_uniform(11);
     let (mut states, mut fewer) = ([0; 3], 0);
     for i in 0..100 {
         // The cube's centre at radius 0.25 (its farthest corner 6 cm out of
         // the shell) down to 0.04.
         let radius = 0.25 - 0.21 * Real::from(i) / 99.0;
-        let dir = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
-        let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-        let pose = Pose::from_parts(
-            Translation3::from(dir * radius),
-            UnitQuaternion::from_scaled_axis(axis * 3.0),
-        );
+        let pose = turned_at(&mut next, radius);
         let a = collide_exact_cloud(&pose, &cube, &Pose::identity(), &cloud, &full).unwrap();
         let d = collide_exact_cloud(&pose, &cube, &Pose::identity(), &cloud, &decide).unwrap();
         assert_eq!(
@@ -201,7 +195,6 @@ fn a_distance_field_changes_nothing_but_the_searches() {
     use crate::query::CollisionRequest;
     use crate::sample::sphere;
     use crate::shape::DistanceField;
-    use nalgebra::{Translation3, UnitQuaternion, Vector3};
     use std::sync::Arc;
     let cube = Arc::new(MeshDistance::new(&Mesh::cuboid(0.05, 0.05, 0.05).unwrap()).unwrap());
     let field = DistanceField::new(Arc::clone(&cube), 0.004, 0.024).unwrap();
@@ -209,21 +202,10 @@ fn a_distance_field_changes_nothing_but_the_searches() {
     let cloud = PointCloud::from_sigma(add_noise(&shell, 0.001, 9), 0.001).unwrap();
     let req = CollisionRequest::default();
     let half = 0.5 * req.prune_epsilon;
-    let mut rng = 3_u64;
-    let mut next = move || {
-        rng = rng
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (rng >> 11) as Real / (1_u64 << 53) as Real
-    };
+    let mut next = lcg_uniform(3);
     for i in 0..40 {
         let radius = 0.25 - 0.21 * Real::from(i) / 39.0;
-        let dir = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
-        let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-        let pose = Pose::from_parts(
-            Translation3::from(dir * radius),
-            UnitQuaternion::from_scaled_axis(axis * 3.0),
-        );
+        let pose = turned_at(&mut next, radius);
         let padding = if i % 3 == 0 { 0.003 } else { 0.0 };
         let query = |f: Option<&DistanceField>| {
             collide_exact_cloud_padded(&pose, (&cube, padding, f), &Pose::identity(), &cloud, &req)
