@@ -421,6 +421,13 @@ fn a_leg_through_a_floor_sized_slab_collides_in_every_draw() {
         // The patches said so, not the crossing read after them.
         assert_eq!(c.surface_crossings, 0, "draw {seed}");
         assert!(c.near_regions > 0, "draw {seed}");
+        // The floor's points beyond the noise's reach of the leg (half a
+        // metre from it, where the floor's elements reach) are no evidence.
+        let far = (0..b.len())
+            .filter(|&i| b.points()[i].coords.xy().norm() > 0.5)
+            .map(|i| r.probabilities_b.get(i))
+            .fold(0.0, f64::max);
+        assert_eq!(far, 0.0, "draw {seed}");
     }
 }
 
@@ -487,28 +494,94 @@ fn flat_faces_meeting_at_an_angle_cross_and_parallel_ones_never_do() {
     }
 }
 
+/// The box around `points` and the largest `sqrt(trace)` of `covs`.
+fn box_and_std(points: &[Point3], covs: &[Matrix3]) -> (Point3, Point3, f64) {
+    let mut lo = Point3::from([f64::INFINITY; 3]);
+    let mut hi = Point3::from([f64::NEG_INFINITY; 3]);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let std = covs.iter().map(|c| c.trace().sqrt()).fold(0.0, f64::max);
+    (lo, hi, std)
+}
+
+/// Eq. 3 of each point of a patch against its surface, or 0 where the point
+/// lies farther from the box around the other side's points than the two
+/// sides' noise can reach (brute force, in B's frame).
 #[test]
 fn per_point_probabilities_are_eq3_against_the_reported_surface() {
     let (a, b) = spheres(3000);
     let pb = sphere_pose(SIGMA);
-    let r = collide(&Pose::identity(), &a, &pb, &b, &elements()).unwrap();
+    let request = elements();
+    let r = collide(&Pose::identity(), &a, &pb, &b, &request).unwrap();
     assert_eq!(r.patches.len(), 1);
     let region = &r.patches[0];
     assert!(!region.indices_a.is_empty() && !region.indices_b.is_empty());
-    for &i in &region.indices_a {
-        let x = a.points()[i as usize];
-        let (f, g) = region.separator.value_and_gradient(&x);
-        let p = point_probability(f, &g, &a.covariances()[i as usize], 1.0);
-        assert!((p - r.probabilities_a.get(i as usize)).abs() < 1e-9);
-    }
-    for &i in &region.indices_b {
-        let x = pb * b.points()[i as usize];
-        let rot = pb.rotation.to_rotation_matrix();
-        let cov = rot.matrix() * b.covariances()[i as usize] * rot.matrix().transpose();
-        let (f, g) = region.separator.value_and_gradient(&x);
-        let p = point_probability(f, &g, &cov, -1.0);
-        assert!((p - r.probabilities_b.get(i as usize)).abs() < 1e-9);
-    }
+    let reach = -normal_quantile(0.5 * request.prune_epsilon);
+    let rot = *pb.rotation.to_rotation_matrix().matrix();
+    let side =
+        |cloud: &PointCloud, idx: &[u32], pose: &Pose, turn: &Matrix3| -> Vec<(Point3, Matrix3)> {
+            idx.iter()
+                .map(|&i| {
+                    let c = cloud.covariances()[i as usize];
+                    (
+                        pose * cloud.points()[i as usize],
+                        turn * c * turn.transpose(),
+                    )
+                })
+                .collect()
+        };
+    let sa = side(
+        &a,
+        &region.indices_a,
+        &Pose::identity(),
+        &Matrix3::identity(),
+    );
+    let sb = side(&b, &region.indices_b, &pb, &rot);
+    let split =
+        |s: &[(Point3, Matrix3)]| -> (Vec<Point3>, Vec<Matrix3>) { s.iter().copied().unzip() };
+    let (boxes_a, boxes_b) = (split(&sa), split(&sb));
+    let (box_a, box_b) = (
+        box_and_std(&boxes_a.0, &boxes_a.1),
+        box_and_std(&boxes_b.0, &boxes_b.1),
+    );
+    let mut counts = [0usize; 2];
+    let mut check = |own: &[(Point3, Matrix3)],
+                     idx: &[u32],
+                     other: &(Point3, Point3, f64),
+                     label: f64,
+                     got: &dyn Fn(usize) -> f64| {
+        for (&i, (x, cov)) in idx.iter().zip(own) {
+            let outside = (other.0 - x)
+                .sup(&(x - other.1))
+                .sup(&Vector3::zeros())
+                .norm();
+            let radius = reach * (cov.trace().sqrt() + other.2);
+            let want = if outside > radius {
+                counts[1] += 1;
+                0.0
+            } else {
+                counts[0] += 1;
+                let (f, g) = region.separator.value_and_gradient(x);
+                point_probability(f, &g, cov, label)
+            };
+            assert!(
+                (want - got(i as usize)).abs() < 1e-9,
+                "point {i}: {} vs {want}",
+                got(i as usize)
+            );
+        }
+    };
+    check(&sa, &region.indices_a, &box_b, 1.0, &|i| {
+        r.probabilities_a.get(i)
+    });
+    check(&sb, &region.indices_b, &box_a, -1.0, &|i| {
+        r.probabilities_b.get(i)
+    });
+    // Both rules are exercised: the spheres' patch elements reach past the
+    // other sphere's noise.
+    assert!(counts[0] > 0 && counts[1] > 0, "{counts:?}");
     // The region holds tens of samples, not thousands of points.
     assert!(r.stats.counters.points_classified < 400, "{:?}", r.stats);
     // Every point of the patch's elements is reported, none outside it.

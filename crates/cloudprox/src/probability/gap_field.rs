@@ -40,6 +40,12 @@ const CRITERION_PER_TERM: Real = 2.0;
 /// one-sided test at about 2 %.
 const MISFIT_SDS: Real = 2.0;
 
+/// How many of their standard deviations two readings' gaps must lie apart
+/// for the higher one to be left out of the field ([`contending`]): 2 each
+/// way, so that the readings left out lie above the lowest by more than
+/// about 2.8 standard deviations of their difference.
+const CONTENDING_SDS: Real = 2.0;
+
 /// Huber's tuning constant of the robust fit (in scaled standard deviations).
 const HUBER: Real = 2.0;
 
@@ -107,11 +113,69 @@ pub(crate) fn field_minimum(samples: &[GapSample]) -> Option<FieldTerm> {
 /// Every place [`field_probability`] reads: the fitted field where a
 /// quadric field is lowest, at each reading's place, and each reading that
 /// is read on its own; `None` without a fit.
+///
+/// Where no smooth field describes all the readings ([`MISFIT_SDS`]), the
+/// field is fitted again over the readings that contend for the closest
+/// place ([`contending`]): a gap that jumps (a piano's underside over a
+/// table's top and over its side faces) is no smooth field, and its part
+/// far above the closest place says nothing of whether the surfaces cross.
 fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
-    let n = samples.len();
-    if n < 3 || samples.iter().any(|s| !(s.std > 0.0 && s.std.is_finite())) {
+    if samples.len() < 3 || samples.iter().any(|s| !(s.std > 0.0 && s.std.is_finite())) {
         return None;
     }
+    let (terms, misfit) = fitted_terms(samples)?;
+    let kept = contending(samples);
+    if !misfit || kept.len() == samples.len() {
+        return Some(terms);
+    }
+    let own: Vec<GapSample> = kept.iter().map(|&i| samples[i]).collect();
+    let mut narrowed = if own.len() < 3 {
+        // One or two places can be the closest: each is read on its own.
+        (0..own.len())
+            .map(|i| FieldTerm {
+                gap: own[i].gap,
+                std: own[i].std,
+                sample: i,
+            })
+            .collect()
+    } else {
+        match fitted_terms(&own) {
+            Some((t, _)) => t,
+            None => return Some(terms),
+        }
+    };
+    for t in &mut narrowed {
+        t.sample = kept[t.sample];
+    }
+    Some(narrowed)
+}
+
+/// The readings that may lie where the two surfaces come closest: those
+/// whose gap, less [`CONTENDING_SDS`] of its standard deviations, is no
+/// larger than the smallest gap plus as many of its own (a reading above
+/// that is, with confidence, not at the closest place: a table's side
+/// faces below a piano's underside resting on its top). Their indices, in
+/// order.
+fn contending(samples: &[GapSample]) -> Vec<usize> {
+    // The least of n readings of one gap lies about Phi^-1(1 - 1/(n + 1))
+    // of their deviations below it: the ceiling is read from where the
+    // lowest reading's gap may be, not from its noise.
+    let n = samples.len() as Real;
+    let extreme = -crate::probability::normal_quantile(1.0 / (n + 1.0));
+    let ceiling = samples
+        .iter()
+        .map(|s| s.gap + (CONTENDING_SDS + extreme) * s.std)
+        .fold(Real::INFINITY, Real::min);
+    (0..samples.len())
+        .filter(|&i| samples[i].gap - CONTENDING_SDS * samples[i].std <= ceiling)
+        .collect()
+}
+
+/// [`field_terms`] of one smooth field over all of `samples` (at least
+/// three, each with a positive finite deviation), and whether they spread
+/// about it significantly more than their deviations ([`MISFIT_SDS`]).
+fn fitted_terms(samples: &[GapSample]) -> Option<(Vec<FieldTerm>, bool)> {
+    let n = samples.len();
     let coords = contact_coordinates(samples);
     let r = DVector::from_iterator(n, samples.iter().map(|s| s.gap));
     let w0 = DVector::from_iterator(n, samples.iter().map(|s| 1.0 / (s.std * s.std)));
@@ -167,7 +231,7 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
         }
         terms.push(at_reading(i, here));
     }
-    Some(terms)
+    Some((terms, tau2 > 0.0))
 }
 
 /// The readings' places in the contact's two widest directions (about their
@@ -475,6 +539,56 @@ mod tests {
             (p - crate::probability::normal_cdf(2.0)).abs() < 1e-9,
             "P {p}"
         );
+    }
+
+    /// The mean `P` over 200 noise draws (deviation `s`) of the readings
+    /// of a 9 x 9 grid at gap `offset` over its inner `inner` x `inner`
+    /// and `offset + jump` beyond (the whole grid, or the inner part alone).
+    fn mean_over_draws(offset: Real, jump: Real, inner_only: bool) -> Real {
+        let s = 1e-3;
+        let mut rng = crate::sample::NormalRng::new(7);
+        let total: Real = (0..200)
+            .map(|_| {
+                let r: Vec<GapSample> = grid(9, |_, _| offset, s)
+                    .into_iter()
+                    .map(|g| {
+                        let edge = (g.at.x - 0.04).abs().max((g.at.y - 0.04).abs());
+                        let beyond = if edge > 0.025 { jump } else { 0.0 };
+                        (
+                            edge,
+                            GapSample {
+                                gap: g.gap + beyond + s * rng.normal(),
+                                ..g
+                            },
+                        )
+                    })
+                    .filter(|(edge, _)| !inner_only || *edge < 0.025)
+                    .map(|(_, g)| g)
+                    .collect();
+                field_probability(&r).unwrap()
+            })
+            .sum();
+        total / 200.0
+    }
+
+    #[test]
+    fn a_flat_contact_beside_a_jump_reads_as_its_flat_part() {
+        // A piano's underside resting on a table (gap 0 over the inner 5 x 5
+        // of a 9 x 9 grid), read beyond the table's edge against its side
+        // faces, 10 deviations lower: no smooth field follows the jump, and
+        // the readings far above the contact say nothing of whether it
+        // crosses. Over noise draws, the contact reads as its flat part
+        // alone does, at touching and 1 deviation clear.
+        let s = 1e-3;
+        for offset in [0.0, s] {
+            let with_jump = mean_over_draws(offset, 10.0 * s, false);
+            let flat = mean_over_draws(offset, 0.0, true);
+            assert!(
+                (with_jump - flat).abs() < 0.05,
+                "gap {offset}: mean P {with_jump} beside the jump, {flat} without it"
+            );
+        }
+        assert!(mean_over_draws(s, 10.0 * s, false) < 0.25);
     }
 
     #[test]

@@ -526,9 +526,11 @@ fn collide_segmentation(
                 Some((ea, eb)) => {
                     let (oa, ob) = (unique_owners(ea, &ia), unique_owners(eb, &ib));
                     if per_point {
-                        point_probabilities(sep, &rel, ea, &oa, 1.0, &mut probabilities_a);
                         let id = Pose::identity();
-                        point_probabilities(sep, &id, eb, &ob, -1.0, &mut probabilities_b);
+                        let (side_a, side_b) = ((ea, &oa[..], &rel), (eb, &ob[..], &id));
+                        let (pa, pb) = (&mut probabilities_a, &mut probabilities_b);
+                        point_probabilities(sep, side_a, side_b, (1.0, reach), pa);
+                        point_probabilities(sep, side_b, side_a, (-1.0, reach), pb);
                     }
                     (element_points(ea, &oa), element_points(eb, &ob))
                 }

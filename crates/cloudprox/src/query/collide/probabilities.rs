@@ -2,7 +2,7 @@
 //! its trained surface, the paper model's surface probability, and which
 //! values count towards the pair's `P` (core points only).
 
-use crate::bvh::Neighbourhoods;
+use crate::bvh::{Aabb, Neighbourhoods};
 use crate::classify::Separator;
 use crate::element::SurfaceElements;
 use crate::math::{Matrix3, Point3, Pose};
@@ -12,25 +12,56 @@ use crate::probability::{
 use crate::uncertainty::directional_std_of;
 use crate::Real;
 
-/// Eq. 3 of each point of the elements `owners` of `elements` (moved by `pose`
-/// into the separator's frame) against `sep`, with label `label`; the larger
-/// of it and what `out` already holds (a point can be in several patches).
+/// One side of a patch for [`point_probabilities`]: its elements, the
+/// owners among them, and the pose that moves them into the separator's
+/// frame.
+pub(crate) type PatchSide<'a> = (&'a SurfaceElements, &'a [u32], &'a Pose);
+
+/// Eq. 3 of each point of the elements `owners` of `own` (moved by its
+/// pose into the separator's frame) against `sep`, with label `label`; the
+/// larger of it and what `out` already holds (a point can be in several
+/// patches).
+///
+/// A point farther from the other side's points (the box around the points
+/// of its elements `owners`) than the two sides' noise can reach (`reach`
+/// times the sum of their deviations) is left out: as the points model's
+/// context points, a surface that puts it on the wrong side misfits there
+/// (a floor element two metres across under a table's contact), which is no
+/// evidence of a collision.
 pub(crate) fn point_probabilities(
     sep: &Separator,
-    pose: &Pose,
-    elements: &SurfaceElements,
-    owners: &[u32],
-    label: Real,
+    own: PatchSide<'_>,
+    other: PatchSide<'_>,
+    (label, reach): (Real, Real),
     out: &mut [Real],
 ) {
+    let (elements, owners, pose) = own;
+    let (near, other_std) = members_box(other);
     // The surface is turned into the cloud's frame rather than every point
     // and covariance into the separator's.
     let form = sep.quadratic_form(pose);
     for (i, x, cov) in owners.iter().flat_map(|&e| elements.members(e)) {
+        let radius = reach * (cov.trace().max(0.0).sqrt() + other_std);
+        if near.distance_squared_to_point(&(pose * x)) > radius * radius {
+            continue;
+        }
         let (f, g) = form.value_and_gradient(x);
         let p = point_probability(f, &g, cov, label);
         out[i as usize] = out[i as usize].max(p);
     }
+}
+
+/// The box (separator's frame) around the points of one side's elements
+/// `owners`, and a bound on their deviations (the largest `sqrt(trace)` of
+/// their covariances).
+fn members_box((elements, owners, pose): PatchSide<'_>) -> (Aabb, Real) {
+    let mut b = Aabb::empty();
+    let mut std: Real = 0.0;
+    for (_, x, cov) in owners.iter().flat_map(|&e| elements.members(e)) {
+        b.take_point(&(pose * x));
+        std = std.max(cov.trace().max(0.0).sqrt());
+    }
+    (b, std)
 }
 
 /// The values of the `(point index, value)` pairs whose point is a core point.
