@@ -59,6 +59,7 @@ impl SurfaceElements {
             sample_owner,
             sample_is_point,
             hulls: std::sync::OnceLock::new(),
+            member_chunks: std::sync::OnceLock::new(),
         })
     }
 }

@@ -2,6 +2,7 @@
 
 use std::sync::OnceLock;
 
+use crate::bvh::Aabb;
 use crate::cloud::PointCloud;
 use crate::element::element_reach::ElementHulls;
 use crate::error::{Error, Result};
@@ -310,6 +311,24 @@ pub struct SurfaceElements {
     pub(crate) sample_is_point: Vec<bool>,
     /// The elements' hulls and a hierarchy over them, built on first use.
     pub(crate) hulls: OnceLock<ElementHulls>,
+    /// Boxes over runs of [`MEMBER_CHUNK`] consecutive points of `points`,
+    /// built on first use ([`SurfaceElements::members_near`]).
+    pub(crate) member_chunks: OnceLock<Vec<MemberChunk>>,
+}
+
+/// How many consecutive points of an element set one [`MemberChunk`] boxes.
+const MEMBER_CHUNK: usize = 32;
+
+/// A run of consecutive points of an element set (an element's points lie
+/// together, so a run lies on a small part of its surface): their box and a
+/// bound on their largest standard deviation (`sqrt(trace)` of their
+/// covariances).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MemberChunk {
+    /// The box around the run's points (the cloud's frame).
+    pub aabb: Aabb,
+    /// A bound on any of the run's points' largest standard deviation.
+    pub sigma: Real,
 }
 
 impl SurfaceElements {
@@ -337,13 +356,59 @@ impl SurfaceElements {
     /// Element `e`'s points: `(index, point, covariance)` each, the point and
     /// covariance read from the element's own contiguous copy.
     pub(crate) fn members(&self, e: u32) -> impl Iterator<Item = (u32, &Point3, &Matrix3)> {
-        let r = self.range(e);
+        self.run(self.range(e))
+    }
+
+    /// The points at positions `r` of [`indices`](Self::indices), as
+    /// [`SurfaceElements::members`].
+    fn run(&self, r: std::ops::Range<usize>) -> impl Iterator<Item = (u32, &Point3, &Matrix3)> {
         self.indices[r.clone()]
             .iter()
             .copied()
             .zip(&self.points[r.clone()])
             .zip(&self.covariances[r])
             .map(|((i, p), c)| (i, p, c))
+    }
+
+    /// Element `e`'s points as [`SurfaceElements::members`], passing over
+    /// the runs of them ([`MemberChunk`]) that `keep` refuses: a wide
+    /// element's points far from a small mesh are left without reading
+    /// each one.
+    pub(crate) fn members_near(
+        &self,
+        e: u32,
+        keep: impl Fn(&MemberChunk) -> bool,
+    ) -> impl Iterator<Item = (u32, &Point3, &Matrix3)> {
+        let r = self.range(e);
+        let chunks = self.member_chunks();
+        let first = r.start / MEMBER_CHUNK;
+        let last = r.end.div_ceil(MEMBER_CHUNK);
+        (first..last)
+            .filter(move |&k| keep(&chunks[k]))
+            .flat_map(move |k| {
+                self.run(r.start.max(k * MEMBER_CHUNK)..r.end.min((k + 1) * MEMBER_CHUNK))
+            })
+    }
+
+    /// The boxes over runs of [`MEMBER_CHUNK`] points, built on first use.
+    fn member_chunks(&self) -> &[MemberChunk] {
+        self.member_chunks.get_or_init(|| {
+            self.points
+                .chunks(MEMBER_CHUNK)
+                .zip(self.covariances.chunks(MEMBER_CHUNK))
+                .map(|(pts, covs)| {
+                    let mut aabb = Aabb::empty();
+                    for p in pts {
+                        aabb.take_point(p);
+                    }
+                    let sigma = covs
+                        .iter()
+                        .map(|c| c.trace().max(0.0).sqrt())
+                        .fold(0.0, Real::max);
+                    MemberChunk { aabb, sigma }
+                })
+                .collect()
+        })
     }
 
     /// The cloud of samples standing for the elements (five per multi-point
@@ -425,6 +490,41 @@ mod tests {
         e.footprint.iter().any(|p| {
             (Real::from(p.2) - u).powi(2) + (Real::from(p.3) - v).powi(2) <= e.spacing * e.spacing
         })
+    }
+
+    #[test]
+    fn members_near_are_the_members_whose_run_is_kept() {
+        // A noisy box's elements; the runs kept are those whose box meets a
+        // corner region: every member inside it is among those returned,
+        // and those returned are members, in order, each of a kept run.
+        let pts = crate::sample::box_surface(&Point3::origin(), &Vector3::new(0.3, 0.2, 0.1), 0.01);
+        let cloud = PointCloud::from_sigma(crate::sample::add_noise(&pts, 1e-3, 3), 1e-3).unwrap();
+        let els = cloud.elements();
+        let region = Aabb {
+            mins: Point3::new(0.1, 0.05, -0.2),
+            maxs: Point3::new(0.4, 0.3, 0.2),
+        };
+        let keep = |c: &MemberChunk| c.aabb.distance_squared(&region) == 0.0;
+        let (mut inside, mut skipped) = (0, 0);
+        for e in 0..els.elements().len() as u32 {
+            let all: Vec<u32> = els.members(e).map(|(i, _, _)| i).collect();
+            let near: Vec<u32> = els.members_near(e, keep).map(|(i, _, _)| i).collect();
+            let mut at = all.iter();
+            assert!(near.iter().all(|i| at.any(|j| j == i)), "element {e}");
+            for (i, p, _) in els.members(e) {
+                if region.distance_squared_to_point(p) == 0.0 {
+                    inside += 1;
+                    assert!(near.contains(&i), "element {e}: point {i} inside");
+                }
+            }
+            skipped += all.len() - near.len();
+            // Keeping every run gives every member.
+            assert_eq!(els.members_near(e, |_| true).count(), all.len());
+        }
+        assert!(
+            inside > 0 && skipped > 0,
+            "{inside} inside, {skipped} passed over"
+        );
     }
 
     #[test]

@@ -90,5 +90,5 @@ mod element_types;
 
 pub use element_fit::chi_square_quantile;
 pub(crate) use element_reach::{across_normal, hull_gap, surfaces_may_reach, Hull, HALF_SPACING};
-pub(crate) use element_types::height_row;
+pub(crate) use element_types::{height_row, MemberChunk};
 pub use element_types::{ElementSettings, FootprintPoint, SurfaceElement, SurfaceElements};

@@ -185,6 +185,13 @@ impl<'a> Frame<'a> {
         self.rotation.transpose() * v
     }
 
+    /// The axis-aligned box, in the cloud's frame, around the (padded)
+    /// mesh's bounding box: a point farther than `r` from it lies farther
+    /// than `r` from the mesh's box ([`Frame::beyond_box`]).
+    pub fn box_in_cloud(&self) -> Aabb {
+        self.bounds.transformed(&self.rel.inverse())
+    }
+
     /// Whether `x` (mesh frame) lies farther than `radius` from the mesh's
     /// bounding box, so farther than `radius` outside the mesh: a test of
     /// three coordinates before any search.

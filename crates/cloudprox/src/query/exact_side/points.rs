@@ -1,7 +1,7 @@
 //! Per-point probabilities against the exact surface (the paper's Eq. 3).
 
 use crate::cloud::PointCloud;
-use crate::element::SurfaceElements;
+use crate::element::{MemberChunk, SurfaceElements};
 use crate::error::Result;
 use crate::math::Point3;
 use crate::probability::point_probability;
@@ -18,8 +18,10 @@ use crate::Real;
 /// point's largest standard deviation) are read exactly; the others outside
 /// have `p < epsilon / 2`, stored as 0, and those inside deeper than their
 /// reach `p > 1 - epsilon / 2`, stored as 1 where they are passed over (below). A point farther than its
-/// reach from the mesh's bounding box is passed over first (a wide floor's
-/// element near a small link holds thousands of such points). An element's points lie
+/// reach from the mesh's bounding box is passed over first, a run of an
+/// element's points at a time where the run's box lies beyond the reach of
+/// all of them (a wide floor's element near a small link holds thousands of
+/// such points). An element's points lie
 /// together: each search is bounded by the previous point's closest point
 /// (the surface lies at most that far), and a point is passed over without
 /// one when the previous point's distance `d`, less the step between them,
@@ -36,9 +38,16 @@ pub(crate) fn point_probabilities(
 ) -> Result<PointProbabilities> {
     let sigma = cloud.sigma_max();
     let mut pairs: Vec<(u32, Real)> = Vec::new();
+    // A run of an element's points farther from the mesh's box than the
+    // noise of any of them reaches is passed over whole.
+    let mesh_box = frame.box_in_cloud();
+    let within = |c: &MemberChunk| {
+        let r = frame.reach * c.sigma;
+        c.aabb.distance_squared(&mesh_box) <= r * r
+    };
     for &(e, _) in near {
         let mut last: Option<(Point3, ClosestPoint)> = None;
-        for (i, p, cov) in els.members(e) {
+        for (i, p, cov) in els.members_near(e, within) {
             let x = frame.to_mesh(p);
             let radius = frame.reach * sigma[i as usize];
             if frame.beyond_box(&x, radius) {
