@@ -40,10 +40,9 @@ const CRITERION_PER_TERM: Real = 2.0;
 /// one-sided test at about 2 %.
 const MISFIT_SDS: Real = 2.0;
 
-/// How many of their standard deviations two readings' gaps must lie apart
-/// for the higher one to be left out of the field ([`contending`]): 2 each
-/// way, so that the readings left out lie above the lowest by more than
-/// about 2.8 standard deviations of their difference.
+/// How many of its standard deviations a reading's gap must lie above the
+/// least of the readings' upper bounds (each `g + (2 + e_n) s`, see
+/// [`contending`]) for it to be left out of a misfitting field: 2.
 const CONTENDING_SDS: Real = 2.0;
 
 /// Huber's tuning constant of the robust fit (in scaled standard deviations).
@@ -152,10 +151,10 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
 
 /// The readings that may lie where the two surfaces come closest: those
 /// whose gap, less [`CONTENDING_SDS`] of its standard deviations, is no
-/// larger than the smallest gap plus as many of its own (a reading above
-/// that is, with confidence, not at the closest place: a table's side
-/// faces below a piano's underside resting on its top). Their indices, in
-/// order.
+/// larger than the least upper bound `min_j (g_j + (CONTENDING_SDS + e_n)
+/// s_j)`, with `e_n = Phi^-1(1 - 1/(n + 1))` (a reading above it is, with
+/// confidence, not at the closest place: a table's side faces below a
+/// piano's underside resting on its top). Their indices, in order.
 fn contending(samples: &[GapSample]) -> Vec<usize> {
     // The least of n readings of one gap lies about Phi^-1(1 - 1/(n + 1))
     // of their deviations below it: the ceiling is read from where the
@@ -541,9 +540,10 @@ mod tests {
         );
     }
 
-    /// The mean `P` over 200 noise draws (deviation `s`) of the readings
-    /// of a 9 x 9 grid at gap `offset` over its inner `inner` x `inner`
-    /// and `offset + jump` beyond (the whole grid, or the inner part alone).
+    /// The mean `P` over 200 noise draws (deviation 1 mm) of the readings
+    /// of a 9 x 9 grid at gap `offset` over its inner 5 x 5 and `offset +
+    /// jump` beyond (the whole grid, or with `inner_only` the inner part
+    /// alone).
     fn mean_over_draws(offset: Real, jump: Real, inner_only: bool) -> Real {
         let s = 1e-3;
         let mut rng = crate::sample::NormalRng::new(7);
