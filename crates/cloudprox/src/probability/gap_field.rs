@@ -123,8 +123,11 @@ fn field_terms(samples: &[GapSample]) -> Option<Vec<FieldTerm>> {
         return None;
     }
     let (terms, misfit) = fitted_terms(samples)?;
+    if !misfit {
+        return Some(terms);
+    }
     let kept = contending(samples);
-    if !misfit || kept.len() == samples.len() {
+    if kept.len() == samples.len() {
         return Some(terms);
     }
     let own: Vec<GapSample> = kept.iter().map(|&i| samples[i]).collect();
