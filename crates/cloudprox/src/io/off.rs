@@ -38,16 +38,73 @@ fn is_off_keyword(keyword: &[u8]) -> bool {
 /// # Errors
 /// [`Error::Format`] naming the line and the problem.
 pub fn read_off_mesh(bytes: &[u8], name: &str) -> Result<MeshData> {
-    let err = |line: usize, problem: String| {
-        Error::format(name, FORMAT, format!("line {line}: {problem}"))
-    };
+    let err = |line: usize, problem: String| at(name, line, problem);
     // Non-blank lines, comments removed, as token lists.
     let mut rows = lines(bytes).filter_map(|(n, l)| {
         let t: Vec<&[u8]> = tokens(strip_comment(l)).collect();
         (!t.is_empty()).then_some((n, t))
     });
     let last_line = lines(bytes).last().map_or(1, |(n, _)| n);
+    let (nv, nf) = read_counts(name, &mut rows, last_line)?;
+    // A vertex line is at least 6 bytes ("0 0 0\n"): never trust the count further.
+    let mut vertices = Vec::with_capacity(nv.min(bytes.len() / 6));
+    for i in 0..nv {
+        let Some((line, t)) = rows.next() else {
+            return Err(err(
+                last_line,
+                format!(
+                    "the header promises {nv} vertices and {nf} faces, but the file ends after \
+                     {i} vertices"
+                ),
+            ));
+        };
+        vertices.push(read_vertex(name, line, i, &t)?);
+    }
+    let mut triangles = Vec::with_capacity(nf.min(bytes.len() / 8));
+    for f in 0..nf {
+        let Some((line, t)) = rows.next() else {
+            return Err(err(
+                last_line,
+                format!("the header promises {nf} faces, but the file ends after {f} faces"),
+            ));
+        };
+        let corners = read_face(name, line, f, &t, nv)?;
+        for i in 1..corners.len() - 1 {
+            triangles.push([corners[0], corners[i], corners[i + 1]]);
+        }
+    }
+    if let Some((line, t)) = rows.next() {
+        return Err(err(
+            line,
+            format!(
+                "unexpected {} after the {nf} faces the header promises",
+                quote(t[0])
+            ),
+        ));
+    }
+    if triangles.is_empty() {
+        return Err(Error::format(
+            name,
+            FORMAT,
+            "no faces (the header says 0 faces)",
+        ));
+    }
+    finish_mesh(name, FORMAT, vertices, triangles)
+}
 
+/// The error `problem` at `line` of the OFF file `name`.
+fn at(name: &str, line: usize, problem: impl std::fmt::Display) -> Error {
+    Error::format(name, FORMAT, format!("line {line}: {problem}"))
+}
+
+/// Reads the header keyword and the counts line (on the header's line or
+/// the next): the numbers of vertices and faces.
+fn read_counts<'a>(
+    name: &str,
+    rows: &mut impl Iterator<Item = (usize, Vec<&'a [u8]>)>,
+    last_line: usize,
+) -> Result<(usize, usize)> {
+    let err = |line: usize, problem: String| at(name, line, problem);
     let Some((line, header)) = rows.next() else {
         return Err(Error::format(
             name,
@@ -121,124 +178,83 @@ pub fn read_off_mesh(bytes: &[u8], name: &str) -> Result<MeshData> {
             format!("{nv} vertices: more than 2^32 - 1"),
         ));
     }
-    // A vertex line is at least 6 bytes ("0 0 0\n"): never trust the count further.
-    let mut vertices = Vec::with_capacity(nv.min(bytes.len() / 6));
-    for i in 0..nv {
-        let Some((line, t)) = rows.next() else {
-            return Err(err(
-                last_line,
-                format!(
-                    "the header promises {nv} vertices and {nf} faces, but the file ends after \
-                     {i} vertices"
-                ),
-            ));
-        };
-        if t.len() < 3 {
-            return Err(err(
-                line,
-                format!("vertex {i} needs 3 coordinates, found {} values", t.len()),
-            ));
-        }
-        let mut xyz = [0.0; 3];
-        for k in 0..3 {
-            xyz[k] = match parse_f64(t[k]) {
-                Some(x) if x.is_finite() => x,
-                Some(_) => {
-                    return Err(err(
-                        line,
-                        format!("vertex {i} has a non-finite coordinate {}", quote(t[k])),
-                    ))
-                }
-                None => {
-                    return Err(err(
-                        line,
-                        format!("vertex {i}: malformed number {}", quote(t[k])),
-                    ))
-                }
-            };
-        }
-        vertices.push(Point3::new(xyz[0], xyz[1], xyz[2]));
-    }
-    let mut triangles = Vec::with_capacity(nf.min(bytes.len() / 8));
-    for f in 0..nf {
-        let Some((line, t)) = rows.next() else {
-            return Err(err(
-                last_line,
-                format!("the header promises {nf} faces, but the file ends after {f} faces"),
-            ));
-        };
-        let k = parse_i64(t[0])
-            .and_then(|v| usize::try_from(v).ok())
-            .ok_or_else(|| {
-                err(
-                    line,
-                    format!(
-                        "face {f}: bad vertex count {}: expected a non-negative integer",
-                        quote(t[0])
-                    ),
-                )
-            })?;
-        if k < 3 {
-            return Err(err(
-                line,
-                format!("face {f} has {k} vertices; a face needs at least 3"),
-            ));
-        }
-        if t.len() - 1 < k {
-            return Err(err(
-                line,
-                format!(
-                    "face {f} announces {k} vertices but the line has only {} indices",
-                    t.len() - 1
-                ),
-            ));
-        }
-        let mut corners = Vec::with_capacity(k);
-        for tok in &t[1..=k] {
-            let index = parse_i64(tok).ok_or_else(|| {
-                err(
-                    line,
-                    format!("face {f}: malformed vertex index {}", quote(tok)),
-                )
-            })?;
-            match u32::try_from(index) {
-                Ok(i) if (i as usize) < nv => corners.push(i),
-                _ => {
-                    return Err(err(
-                        line,
-                        format!(
-                            "face {f}: vertex index {index} out of range ({})",
-                            if nv == 0 {
-                                "the file has no vertices".to_string()
-                            } else {
-                                format!("0 to {}", nv - 1)
-                            }
-                        ),
-                    ))
-                }
-            }
-        }
-        for i in 1..k - 1 {
-            triangles.push([corners[0], corners[i], corners[i + 1]]);
-        }
-    }
-    if let Some((line, t)) = rows.next() {
-        return Err(err(
-            line,
-            format!(
-                "unexpected {} after the {nf} faces the header promises",
-                quote(t[0])
-            ),
-        ));
-    }
-    if triangles.is_empty() {
-        return Err(Error::format(
+    Ok((nv, nf))
+}
+
+/// Vertex `i`, read from the tokens `t` of `line`: three finite coordinates
+/// (anything after them, a colour or a normal, is left).
+fn read_vertex(name: &str, line: usize, i: usize, t: &[&[u8]]) -> Result<Point3> {
+    if t.len() < 3 {
+        return Err(at(
             name,
-            FORMAT,
-            "no faces (the header says 0 faces)",
+            line,
+            format!("vertex {i} needs 3 coordinates, found {} values", t.len()),
         ));
     }
-    finish_mesh(name, FORMAT, vertices, triangles)
+    let mut xyz = [0.0; 3];
+    for k in 0..3 {
+        xyz[k] = match parse_f64(t[k]) {
+            Some(x) if x.is_finite() => x,
+            Some(_) => {
+                return Err(at(
+                    name,
+                    line,
+                    format!("vertex {i} has a non-finite coordinate {}", quote(t[k])),
+                ))
+            }
+            None => {
+                return Err(at(
+                    name,
+                    line,
+                    format!("vertex {i}: malformed number {}", quote(t[k])),
+                ))
+            }
+        };
+    }
+    Ok(Point3::new(xyz[0], xyz[1], xyz[2]))
+}
+
+/// Face `f`'s vertex indices (at least 3, each below `nv`), read from the
+/// tokens `t` of `line` (anything after them, a colour, is left).
+fn read_face(name: &str, line: usize, f: usize, t: &[&[u8]], nv: usize) -> Result<Vec<u32>> {
+    let err = |problem: String| at(name, line, problem);
+    let k = parse_i64(t[0])
+        .and_then(|v| usize::try_from(v).ok())
+        .ok_or_else(|| {
+            err(format!(
+                "face {f}: bad vertex count {}: expected a non-negative integer",
+                quote(t[0])
+            ))
+        })?;
+    if k < 3 {
+        return Err(err(format!(
+            "face {f} has {k} vertices; a face needs at least 3"
+        )));
+    }
+    if t.len() - 1 < k {
+        return Err(err(format!(
+            "face {f} announces {k} vertices but the line has only {} indices",
+            t.len() - 1
+        )));
+    }
+    t[1..=k]
+        .iter()
+        .map(|tok| {
+            let index = parse_i64(tok)
+                .ok_or_else(|| err(format!("face {f}: malformed vertex index {}", quote(tok))))?;
+            match u32::try_from(index) {
+                Ok(i) if (i as usize) < nv => Ok(i),
+                _ => Err(err(format!(
+                    "face {f}: vertex index {index} out of range ({})",
+                    if nv == 0 {
+                        "the file has no vertices".to_string()
+                    } else {
+                        format!("0 to {}", nv - 1)
+                    }
+                ))),
+            }
+        })
+        .collect()
 }
 
 /// Encodes a mesh as OFF: vertex coordinates written so they read back to

@@ -90,14 +90,7 @@ fn parse_usize(name: &str, line_no: usize, key: &str, w: &str) -> Result<usize> 
 #[allow(clippy::too_many_lines)]
 fn parse_header(bytes: &[u8], name: &str) -> Result<Header> {
     let mut cur = ByteCursor::new(bytes, name, FORMAT);
-    let mut names: Option<Vec<String>> = None;
-    let mut sizes: Option<Vec<usize>> = None;
-    let mut types: Option<Vec<u8>> = None;
-    let mut counts: Option<Vec<usize>> = None;
-    let mut width = None;
-    let mut height = None;
-    let mut points = None;
-    let mut viewpoint = None;
+    let mut keys = HeaderKeys::default();
     let mut line_no = 0;
     let mut seen_keyword = false;
     let data = loop {
@@ -126,161 +119,248 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header> {
         if key.starts_with('#') {
             continue;
         }
-        let args = &words[1..];
+        let at = HeaderLine {
+            name,
+            line_no,
+            line,
+            seen_keyword,
+        };
+        if let Some(data) = keys.read(&at, key, &words[1..])? {
+            break data;
+        }
+        seen_keyword = true;
+    };
+    let fields = keys.fields(name)?;
+    let (width, height, points) = dimensions(name, keys.width, keys.height, keys.points)?;
+    Ok(Header {
+        fields,
+        width,
+        height,
+        points,
+        viewpoint: keys.viewpoint,
+        data,
+        start: cur.position(),
+        first_line: line_no + 1,
+    })
+}
+
+/// Where in a PCD header a line is, for its errors.
+struct HeaderLine<'a> {
+    name: &'a str,
+    line_no: usize,
+    line: &'a str,
+    /// Whether a keyword came before (else an unknown one is a wrong magic).
+    seen_keyword: bool,
+}
+
+impl HeaderLine<'_> {
+    /// The error `message` at this line.
+    fn error(&self, message: impl std::fmt::Display) -> Error {
+        err(
+            self.name,
+            format!("header line {}: {message}", self.line_no),
+        )
+    }
+
+    /// A count or size read from `word` after `key`.
+    fn usize(&self, key: &str, word: &str) -> Result<usize> {
+        parse_usize(self.name, self.line_no, key, word)
+    }
+}
+
+/// The values of a PCD header's keyword lines read so far.
+#[derive(Default)]
+struct HeaderKeys {
+    names: Option<Vec<String>>,
+    sizes: Option<Vec<usize>>,
+    types: Option<Vec<u8>>,
+    counts: Option<Vec<usize>>,
+    width: Option<usize>,
+    height: Option<usize>,
+    points: Option<usize>,
+    viewpoint: Option<[f64; 7]>,
+}
+
+impl HeaderKeys {
+    /// Reads one keyword line (`key` and its `args`): the data encoding at
+    /// the `DATA` line that ends the header, `None` before it.
+    fn read(&mut self, at: &HeaderLine<'_>, key: &str, args: &[&str]) -> Result<Option<Data>> {
         let expect_n = |n: usize| -> Result<()> {
             if args.len() == n {
                 Ok(())
             } else {
-                Err(err(
-                    name,
-                    format!(
-                        "header line {line_no}: {key} needs {n} value(s), found {}: '{line}'",
-                        args.len()
-                    ),
-                ))
+                Err(at.error(format!(
+                    "{key} needs {n} value(s), found {}: '{}'",
+                    args.len(),
+                    at.line
+                )))
             }
         };
+        let usizes =
+            |key: &str| -> Result<Vec<usize>> { args.iter().map(|w| at.usize(key, w)).collect() };
         match key {
             "VERSION" => {}
             "FIELDS" | "COLUMNS" => {
                 if args.is_empty() {
-                    return Err(err(name, format!("header line {line_no}: FIELDS is empty")));
+                    return Err(at.error("FIELDS is empty"));
                 }
-                names = Some(args.iter().map(|s| (*s).to_string()).collect());
+                self.names = Some(args.iter().map(|s| (*s).to_string()).collect());
             }
-            "SIZE" => {
-                sizes = Some(
-                    args.iter()
-                        .map(|w| parse_usize(name, line_no, "SIZE", w))
-                        .collect::<Result<_>>()?,
-                );
-            }
-            "TYPE" => {
-                types = Some(
-                    args.iter()
-                        .map(|w| match *w {
-                            "F" | "I" | "U" | "f" | "i" | "u" => {
-                                Ok(w.as_bytes()[0].to_ascii_uppercase())
-                            }
-                            _ => Err(err(
-                                name,
-                                format!(
-                                    "header line {line_no}: TYPE must be F, I or U, found '{}'",
-                                    show(w.as_bytes())
-                                ),
-                            )),
-                        })
-                        .collect::<Result<_>>()?,
-                );
-            }
-            "COUNT" => {
-                counts = Some(
-                    args.iter()
-                        .map(|w| parse_usize(name, line_no, "COUNT", w))
-                        .collect::<Result<_>>()?,
-                );
-            }
-            "WIDTH" => {
+            "SIZE" => self.sizes = Some(usizes("SIZE")?),
+            "TYPE" => self.types = Some(field_types(at, args)?),
+            "COUNT" => self.counts = Some(usizes("COUNT")?),
+            "WIDTH" | "HEIGHT" | "POINTS" => {
                 expect_n(1)?;
-                width = Some(parse_usize(name, line_no, "WIDTH", args[0])?);
-            }
-            "HEIGHT" => {
-                expect_n(1)?;
-                height = Some(parse_usize(name, line_no, "HEIGHT", args[0])?);
-            }
-            "POINTS" => {
-                expect_n(1)?;
-                points = Some(parse_usize(name, line_no, "POINTS", args[0])?);
+                let v = Some(at.usize(key, args[0])?);
+                match key {
+                    "WIDTH" => self.width = v,
+                    "HEIGHT" => self.height = v,
+                    _ => self.points = v,
+                }
             }
             "VIEWPOINT" => {
                 expect_n(7)?;
-                let mut v = [0.0; 7];
-                for (slot, w) in v.iter_mut().zip(args) {
-                    *slot = parse_f64(w.as_bytes())
-                        .filter(|x| x.is_finite())
-                        .ok_or_else(|| {
-                            err(
-                                name,
-                                format!("header line {line_no}: VIEWPOINT value '{}' is not a finite number", show(w.as_bytes())),
-                            )
-                        })?;
-                }
-                viewpoint = Some(v);
+                self.viewpoint = Some(viewpoint(at, args)?);
             }
             "DATA" => {
                 expect_n(1)?;
-                break match args[0] {
-                    "ascii" => Data::Ascii,
-                    "binary" => Data::Binary,
-                    "binary_compressed" => Data::Compressed,
-                    other => {
-                        return Err(err(
-                            name,
-                            format!("header line {line_no}: unknown DATA '{}' (expected ascii, binary or binary_compressed)", show(other.as_bytes())),
-                        ))
-                    }
-                };
+                return data_encoding(at, args[0]).map(Some);
             }
-            other => {
+            other => return Err(unknown_keyword(at, other)),
+        }
+        Ok(None)
+    }
+
+    /// The fields the header's FIELDS, SIZE, TYPE and COUNT lines describe,
+    /// checked against each other.
+    fn fields(&self, name: &str) -> Result<Vec<Field>> {
+        let names = self
+            .names
+            .as_ref()
+            .ok_or_else(|| err(name, "header has no FIELDS line"))?;
+        let n = names.len();
+        let sizes = self
+            .sizes
+            .as_ref()
+            .ok_or_else(|| err(name, "header has no SIZE line"))?;
+        let types = self
+            .types
+            .as_ref()
+            .ok_or_else(|| err(name, "header has no TYPE line"))?;
+        let counts = self.counts.clone().unwrap_or_else(|| vec![1; n]);
+        for (key, len) in [
+            ("SIZE", sizes.len()),
+            ("TYPE", types.len()),
+            ("COUNT", counts.len()),
+        ] {
+            if len != n {
                 return Err(err(
                     name,
-                    if seen_keyword {
-                        format!(
-                            "header line {line_no}: unknown keyword '{}'",
-                            show(other.as_bytes())
-                        )
-                    } else {
-                        format!("wrong magic: line {line_no} starts with '{}', not a PCD header keyword (VERSION, FIELDS, ...)", show(other.as_bytes()))
-                    },
-                ))
+                    format!("{key} has {len} values but FIELDS names {n} fields"),
+                ));
             }
         }
-        seen_keyword = true;
+        (0..n)
+            .map(|i| field(name, &names[i], sizes[i], types[i], counts[i]))
+            .collect()
+    }
+}
+
+/// One field of a PCD header, its size checked against its type.
+fn field(file: &str, name: &str, size: usize, kind: u8, count: usize) -> Result<Field> {
+    let ok = match kind {
+        b'F' => matches!(size, 4 | 8),
+        _ => matches!(size, 1 | 2 | 4 | 8),
     };
-    let names = names.ok_or_else(|| err(name, "header has no FIELDS line"))?;
-    let n = names.len();
-    let sizes = sizes.ok_or_else(|| err(name, "header has no SIZE line"))?;
-    let types = types.ok_or_else(|| err(name, "header has no TYPE line"))?;
-    let counts = counts.unwrap_or_else(|| vec![1; n]);
-    for (key, len) in [
-        ("SIZE", sizes.len()),
-        ("TYPE", types.len()),
-        ("COUNT", counts.len()),
-    ] {
-        if len != n {
-            return Err(err(
-                name,
-                format!("{key} has {len} values but FIELDS names {n} fields"),
-            ));
-        }
+    if !ok {
+        return Err(err(
+            file,
+            format!(
+                "field '{name}' has TYPE {} with SIZE {size} (F needs 4 or 8, I and U need 1, 2, 4 or 8)",
+                kind as char
+            ),
+        ));
     }
-    let mut fields = Vec::with_capacity(n);
-    for i in 0..n {
-        let (size, kind, count) = (sizes[i], types[i], counts[i]);
-        let ok = match kind {
-            b'F' => matches!(size, 4 | 8),
-            _ => matches!(size, 1 | 2 | 4 | 8),
-        };
-        if !ok {
-            return Err(err(
-                name,
-                format!(
-                    "field '{}' has TYPE {} with SIZE {size} (F needs 4 or 8, I and U need 1, 2, 4 or 8)",
-                    names[i], kind as char
-                ),
-            ));
-        }
-        if count == 0 {
-            return Err(err(name, format!("field '{}' has COUNT 0", names[i])));
-        }
-        fields.push(Field {
-            name: names[i].clone(),
-            size,
-            kind,
-            count,
-        });
+    if count == 0 {
+        return Err(err(file, format!("field '{name}' has COUNT 0")));
     }
-    let (width, height, points) = match (width, height, points) {
+    Ok(Field {
+        name: name.to_string(),
+        size,
+        kind,
+        count,
+    })
+}
+
+/// A TYPE line's field types (`F`, `I` or `U`, either case).
+fn field_types(at: &HeaderLine<'_>, args: &[&str]) -> Result<Vec<u8>> {
+    args.iter()
+        .map(|w| match *w {
+            "F" | "I" | "U" | "f" | "i" | "u" => Ok(w.as_bytes()[0].to_ascii_uppercase()),
+            _ => Err(at.error(format!(
+                "TYPE must be F, I or U, found '{}'",
+                show(w.as_bytes())
+            ))),
+        })
+        .collect()
+}
+
+/// A VIEWPOINT line's seven finite values.
+fn viewpoint(at: &HeaderLine<'_>, args: &[&str]) -> Result<[f64; 7]> {
+    let mut v = [0.0; 7];
+    for (slot, w) in v.iter_mut().zip(args) {
+        *slot = parse_f64(w.as_bytes())
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| {
+                at.error(format!(
+                    "VIEWPOINT value '{}' is not a finite number",
+                    show(w.as_bytes())
+                ))
+            })?;
+    }
+    Ok(v)
+}
+
+/// A DATA line's encoding.
+fn data_encoding(at: &HeaderLine<'_>, word: &str) -> Result<Data> {
+    match word {
+        "ascii" => Ok(Data::Ascii),
+        "binary" => Ok(Data::Binary),
+        "binary_compressed" => Ok(Data::Compressed),
+        other => Err(at.error(format!(
+            "unknown DATA '{}' (expected ascii, binary or binary_compressed)",
+            show(other.as_bytes())
+        ))),
+    }
+}
+
+/// The error for a line starting with `key`, which no PCD header has: a
+/// wrong magic when no keyword came before.
+fn unknown_keyword(at: &HeaderLine<'_>, key: &str) -> Error {
+    if at.seen_keyword {
+        at.error(format!("unknown keyword '{}'", show(key.as_bytes())))
+    } else {
+        err(
+            at.name,
+            format!(
+                "wrong magic: line {} starts with '{}', not a PCD header keyword (VERSION, FIELDS, ...)",
+                at.line_no,
+                show(key.as_bytes())
+            ),
+        )
+    }
+}
+
+/// The cloud's `(width, height, points)` from its WIDTH, HEIGHT and POINTS
+/// lines: WIDTH with HEIGHT 1 by default, POINTS their product; POINTS alone
+/// is an unorganized cloud.
+fn dimensions(
+    name: &str,
+    width: Option<usize>,
+    height: Option<usize>,
+    points: Option<usize>,
+) -> Result<(usize, usize, usize)> {
+    match (width, height, points) {
         (Some(w), h, p) => {
             let h = h.unwrap_or(1);
             let wh = w
@@ -293,22 +373,12 @@ fn parse_header(bytes: &[u8], name: &str) -> Result<Header> {
                     format!("POINTS {p} is not WIDTH {w} x HEIGHT {h} = {wh}"),
                 ));
             }
-            (w, h, p)
+            Ok((w, h, p))
         }
-        (None, None, Some(p)) => (p, 1, p),
-        (None, Some(_), _) => return Err(err(name, "header has HEIGHT but no WIDTH line")),
-        (None, None, None) => return Err(err(name, "header has neither WIDTH nor POINTS")),
-    };
-    Ok(Header {
-        fields,
-        width,
-        height,
-        points,
-        viewpoint,
-        data,
-        start: cur.position(),
-        first_line: line_no + 1,
-    })
+        (None, None, Some(p)) => Ok((p, 1, p)),
+        (None, Some(_), _) => Err(err(name, "header has HEIGHT but no WIDTH line")),
+        (None, None, None) => Err(err(name, "header has neither WIDTH nor POINTS")),
+    }
 }
 
 /// Reads one binary value as f64.

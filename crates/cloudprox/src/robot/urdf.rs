@@ -159,6 +159,83 @@ fn geometry_mesh(res: &Resolver<'_>, link: &str, g: &urdf_rs::Geometry) -> Resul
     }
 }
 
+/// A joint's unit axis (zero for a fixed joint).
+fn joint_axis(res: &Resolver<'_>, j: &urdf_rs::Joint, kind: JointKind) -> Result<Vector3> {
+    if kind == JointKind::Fixed {
+        return Ok(Vector3::zeros());
+    }
+    let axis = Vector3::new(j.axis.xyz[0], j.axis.xyz[1], j.axis.xyz[2]);
+    let n = axis.norm();
+    if !(n.is_finite() && n > 0.0) {
+        return Err(res.format_error(format!(
+            "joint '{}': <axis xyz> must be a finite non-zero vector, got {:?}",
+            j.name,
+            axis.as_slice()
+        )));
+    }
+    Ok(axis / n)
+}
+
+/// A joint's position limits: none for a continuous joint, zero for a fixed
+/// one, its `<limit>` (required, an interval) otherwise.
+fn joint_limits(res: &Resolver<'_>, j: &urdf_rs::Joint, kind: JointKind) -> Result<[Real; 2]> {
+    let l = &j.limit;
+    match kind {
+        JointKind::Fixed => Ok([0.0, 0.0]),
+        JointKind::Continuous => Ok([Real::NEG_INFINITY, Real::INFINITY]),
+        JointKind::Revolute | JointKind::Prismatic => {
+            if l.lower == 0.0 && l.upper == 0.0 && l.velocity == 0.0 && l.effort == 0.0 {
+                return Err(res.format_error(format!(
+                    "{} joint '{}' has no <limit> (URDF requires one)",
+                    kind.name(),
+                    j.name
+                )));
+            }
+            if !(l.lower.is_finite() && l.upper.is_finite() && l.lower <= l.upper) {
+                return Err(res.format_error(format!(
+                    "joint '{}': limits [{}, {}] are not an interval",
+                    j.name, l.lower, l.upper
+                )));
+            }
+            Ok([l.lower, l.upper])
+        }
+    }
+}
+
+/// The joints in tree order (breadth first from the `root` link); an error
+/// naming the joints the root does not reach.
+fn tree_order(
+    res: &Resolver<'_>,
+    links: &[Link],
+    joints: &[Joint],
+    root: usize,
+) -> Result<Vec<usize>> {
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
+    for (i, j) in joints.iter().enumerate() {
+        children[j.parent].push(i);
+    }
+    let mut order = Vec::with_capacity(joints.len());
+    let mut queue = std::collections::VecDeque::from([root]);
+    while let Some(l) = queue.pop_front() {
+        for &j in &children[l] {
+            order.push(j);
+            queue.push_back(joints[j].child);
+        }
+    }
+    if order.len() != joints.len() {
+        let stray: Vec<&str> = (0..joints.len())
+            .filter(|j| !order.contains(j))
+            .map(|j| joints[j].name.as_str())
+            .collect();
+        return Err(res.format_error(format!(
+            "joints not reachable from the root link '{}' (a cycle): {}",
+            links[root].name,
+            stray.join(", ")
+        )));
+    }
+    Ok(order)
+}
+
 fn link_geometry(res: &Resolver<'_>, link: &urdf_rs::Link) -> Result<Option<LinkGeometry>> {
     if link.collision.is_empty() {
         return Ok(None);
@@ -280,41 +357,8 @@ impl Robot {
             let origin = pose_of(&j.origin).ok_or_else(|| {
                 res.format_error(format!("joint '{}': non-finite <origin>", j.name))
             })?;
-            let axis = Vector3::new(j.axis.xyz[0], j.axis.xyz[1], j.axis.xyz[2]);
-            let axis = if kind == JointKind::Fixed {
-                Vector3::zeros()
-            } else {
-                let n = axis.norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(res.format_error(format!(
-                        "joint '{}': <axis xyz> must be a finite non-zero vector, got {:?}",
-                        j.name,
-                        axis.as_slice()
-                    )));
-                }
-                axis / n
-            };
-            let l = &j.limit;
-            let limits = match kind {
-                JointKind::Fixed => [0.0, 0.0],
-                JointKind::Continuous => [Real::NEG_INFINITY, Real::INFINITY],
-                JointKind::Revolute | JointKind::Prismatic => {
-                    if l.lower == 0.0 && l.upper == 0.0 && l.velocity == 0.0 && l.effort == 0.0 {
-                        return Err(res.format_error(format!(
-                            "{} joint '{}' has no <limit> (URDF requires one)",
-                            kind.name(),
-                            j.name
-                        )));
-                    }
-                    if !(l.lower.is_finite() && l.upper.is_finite() && l.lower <= l.upper) {
-                        return Err(res.format_error(format!(
-                            "joint '{}': limits [{}, {}] are not an interval",
-                            j.name, l.lower, l.upper
-                        )));
-                    }
-                    [l.lower, l.upper]
-                }
-            };
+            let axis = joint_axis(&res, j, kind)?;
+            let limits = joint_limits(&res, j, kind)?;
             let dof = if kind != JointKind::Fixed && j.mimic.is_none() {
                 dof_joints.push(i);
                 Some(dof_joints.len() - 1)
@@ -350,30 +394,7 @@ impl Robot {
             )));
         }
         let root = roots[0];
-        // Joints in tree order (breadth first from the root).
-        let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
-        for (i, j) in joints.iter().enumerate() {
-            children[j.parent].push(i);
-        }
-        let mut order = Vec::with_capacity(joints.len());
-        let mut queue = std::collections::VecDeque::from([root]);
-        while let Some(l) = queue.pop_front() {
-            for &j in &children[l] {
-                order.push(j);
-                queue.push_back(joints[j].child);
-            }
-        }
-        if order.len() != joints.len() {
-            let stray: Vec<&str> = (0..joints.len())
-                .filter(|j| !order.contains(j))
-                .map(|j| joints[j].name.as_str())
-                .collect();
-            return Err(res.format_error(format!(
-                "joints not reachable from the root link '{}' (a cycle): {}",
-                links[root].name,
-                stray.join(", ")
-            )));
-        }
+        let order = tree_order(&res, &links, &joints, root)?;
         let mut robot = Robot {
             name: parsed.name.clone(),
             links,
