@@ -85,129 +85,13 @@ struct EdgeUse {
 impl Repaired {
     /// Welds, re-orients and counts.
     pub(crate) fn new(mesh: &Mesh) -> Self {
-        // Weld vertices with equal coordinates.
-        let mut ids: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.vertices().len());
-        let mut positions = Vec::with_capacity(mesh.vertices().len());
-        let remap: Vec<u32> = mesh
-            .vertices()
-            .iter()
-            .map(|v| {
-                *ids.entry([key(v.x), key(v.y), key(v.z)])
-                    .or_insert_with(|| {
-                        positions.push(Point3::new(v.x + 0.0, v.y + 0.0, v.z + 0.0));
-                        (positions.len() - 1) as u32
-                    })
-            })
-            .collect();
-        let mut faces: Vec<[u32; 3]> = mesh
-            .faces()
-            .iter()
-            .map(|f| {
-                [
-                    remap[f[0] as usize],
-                    remap[f[1] as usize],
-                    remap[f[2] as usize],
-                ]
-            })
-            .collect();
-        let n = faces.len();
-        let repeats = |f: &[u32; 3]| f[0] == f[1] || f[1] == f[2] || f[0] == f[2];
-        let degenerate: Vec<bool> = faces
-            .iter()
-            .map(|f| {
-                if repeats(f) {
-                    return true;
-                }
-                let [a, b, c] = f.map(|i| positions[i as usize]);
-                let longest = (b - a)
-                    .norm_squared()
-                    .max((c - b).norm_squared())
-                    .max((a - c).norm_squared());
-                (b - a).cross(&(c - a)).norm() <= DEGENERATE * longest
-            })
-            .collect();
-
-        // Adjacency across edges shared by exactly two faces.
-        let uses = edge_uses(&faces, &repeats);
-        let mut neighbors = vec![[NONE; 3]; n];
-        let mut mates: Vec<[(u32, u8); 3]> = vec![[(NONE, 0); 3]; n];
-        for group in groups(&uses) {
-            if let [u, v] = group {
-                if u.face != v.face {
-                    neighbors[u.face as usize][u.local as usize] = v.face;
-                    neighbors[v.face as usize][v.local as usize] = u.face;
-                    mates[u.face as usize][u.local as usize] = (v.face, v.local);
-                    mates[v.face as usize][v.local as usize] = (u.face, u.local);
-                }
-            }
-        }
-        let forward = |f: u32, k: u8| {
-            let face = &faces[f as usize];
-            face[k as usize] < face[(k as usize + 1) % 3]
-        };
-
-        // Orient each shell consistently: breadth first across shared edges.
-        let mut flip = vec![false; n];
-        let mut shell = vec![NONE; n];
-        let mut shells = 0u32;
-        for start in 0..n {
-            if shell[start] != NONE || repeats(&faces[start]) {
-                continue;
-            }
-            shell[start] = shells;
-            let mut queue = vec![start as u32];
-            while let Some(f) = queue.pop() {
-                for k in 0..3u8 {
-                    let (g, kg) = mates[f as usize][k as usize];
-                    if g == NONE || shell[g as usize] != NONE {
-                        continue;
-                    }
-                    // Consistent when the two faces run the edge in opposite
-                    // directions once flipped.
-                    let along_f = forward(f, k) ^ flip[f as usize];
-                    flip[g as usize] = forward(g, kg) ^ !along_f;
-                    shell[g as usize] = shells;
-                    queue.push(g);
-                }
-            }
-            shells += 1;
-        }
-
-        // Turn shells that face inwards (negative volume about their centroid).
-        let mut sums = vec![(Vector3::zeros(), 0usize); shells as usize];
-        for (f, face) in faces.iter().enumerate() {
-            if shell[f] != NONE {
-                let s = &mut sums[shell[f] as usize];
-                for &v in face {
-                    s.0 += positions[v as usize].coords;
-                }
-                s.1 += 3;
-            }
-        }
-        let centroids: Vec<Vector3> = sums.iter().map(|(s, k)| s / (*k).max(1) as Real).collect();
-        let mut volume = vec![0.0 as Real; shells as usize];
-        let mut extent = vec![0.0 as Real; shells as usize];
-        for (f, face) in faces.iter().enumerate() {
-            if shell[f] == NONE {
-                continue;
-            }
-            let s = shell[f] as usize;
-            let c = centroids[s];
-            let [a, b, d] = face.map(|i| positions[i as usize].coords - c);
-            let v = a.dot(&b.cross(&d)) / 6.0;
-            volume[s] += if flip[f] { -v } else { v };
-            extent[s] = extent[s].max(a.norm()).max(b.norm()).max(d.norm());
-        }
-        for f in 0..n {
-            if shell[f] != NONE {
-                let s = shell[f] as usize;
-                if volume[s] < -1e-12 * extent[s].powi(3) {
-                    flip[f] = !flip[f];
-                }
-            }
-        }
+        let (positions, mut faces) = weld(mesh);
+        let degenerate = degenerate_faces(&faces, &positions);
+        let (mut neighbors, mates) = adjacency(&faces);
+        let (mut flip, shell, shells) = orient_shells(&faces, &mates);
+        turn_inward_shells(&faces, &positions, &shell, shells, &mut flip);
         let mut reoriented = 0;
-        for f in 0..n {
+        for f in 0..faces.len() {
             if flip[f] {
                 reoriented += 1;
                 let [a, b, c] = faces[f];
@@ -217,34 +101,13 @@ impl Repaired {
                 neighbors[f] = [nb[2], nb[1], nb[0]];
             }
         }
-
-        // Count the edges of the repaired faces.
-        let uses = edge_uses(&faces, &repeats);
-        let mut boundary = Vec::new();
-        let mut non_manifold = 0;
-        let mut closed = true;
-        for group in groups(&uses) {
-            let fwd = group.iter().filter(|u| u.forward).count();
-            let bwd = group.len() - fwd;
-            if group.len() > 2 {
-                non_manifold += 1;
-            }
-            if fwd != 1 || bwd != 1 {
-                closed = false;
-            }
-            let (lo, hi) = (group[0].lo, group[0].hi);
-            let edge = if fwd > bwd { [lo, hi] } else { [hi, lo] };
-            for _ in 0..fwd.abs_diff(bwd) {
-                boundary.push(edge);
-            }
-        }
-        let degenerate_faces = degenerate.iter().filter(|&&d| d).count();
+        let (boundary, non_manifold, closed) = count_edges(&faces);
         let summary = MeshTopology {
             vertices: positions.len(),
             shells: shells as usize,
             boundary_edges: boundary.len(),
             non_manifold_edges: non_manifold,
-            degenerate_faces,
+            degenerate_faces: degenerate.iter().filter(|&&d| d).count(),
             reoriented_faces: reoriented,
             closed: closed && faces.iter().all(|f| !repeats(f)),
             self_intersecting: None,
@@ -293,6 +156,185 @@ impl Repaired {
         out.sort_unstable();
         out
     }
+}
+
+/// Whether a face repeats a vertex.
+fn repeats(f: &[u32; 3]) -> bool {
+    f[0] == f[1] || f[1] == f[2] || f[0] == f[2]
+}
+
+/// The mesh with vertices of equal coordinates welded: the distinct
+/// positions and the faces over them.
+fn weld(mesh: &Mesh) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut ids: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.vertices().len());
+    let mut positions = Vec::with_capacity(mesh.vertices().len());
+    let remap: Vec<u32> = mesh
+        .vertices()
+        .iter()
+        .map(|v| {
+            *ids.entry([key(v.x), key(v.y), key(v.z)])
+                .or_insert_with(|| {
+                    positions.push(Point3::new(v.x + 0.0, v.y + 0.0, v.z + 0.0));
+                    (positions.len() - 1) as u32
+                })
+        })
+        .collect();
+    let faces = mesh
+        .faces()
+        .iter()
+        .map(|f| f.map(|i| remap[i as usize]))
+        .collect();
+    (positions, faces)
+}
+
+/// Per face, whether it is degenerate: a repeated vertex, or an area at most
+/// `DEGENERATE` times its longest edge squared.
+fn degenerate_faces(faces: &[[u32; 3]], positions: &[Point3]) -> Vec<bool> {
+    faces
+        .iter()
+        .map(|f| {
+            if repeats(f) {
+                return true;
+            }
+            let [a, b, c] = f.map(|i| positions[i as usize]);
+            let longest = (b - a)
+                .norm_squared()
+                .max((c - b).norm_squared())
+                .max((a - c).norm_squared());
+            (b - a).cross(&(c - a)).norm() <= DEGENERATE * longest
+        })
+        .collect()
+}
+
+/// Per face and edge, the face across it and that face's local edge
+/// (`NONE` unless exactly two faces share the edge).
+type Adjacency = (Vec<[u32; 3]>, Vec<[(u32, u8); 3]>);
+
+/// The faces' adjacency across edges shared by exactly two faces: the
+/// neighbour across each edge, and with it the neighbour's local edge.
+fn adjacency(faces: &[[u32; 3]]) -> Adjacency {
+    let n = faces.len();
+    let uses = edge_uses(faces, &repeats);
+    let mut neighbors = vec![[NONE; 3]; n];
+    let mut mates: Vec<[(u32, u8); 3]> = vec![[(NONE, 0); 3]; n];
+    for group in groups(&uses) {
+        if let [u, v] = group {
+            if u.face != v.face {
+                neighbors[u.face as usize][u.local as usize] = v.face;
+                neighbors[v.face as usize][v.local as usize] = u.face;
+                mates[u.face as usize][u.local as usize] = (v.face, v.local);
+                mates[v.face as usize][v.local as usize] = (u.face, u.local);
+            }
+        }
+    }
+    (neighbors, mates)
+}
+
+/// Each shell oriented consistently, breadth first across shared edges: per
+/// face whether to flip it and its shell (`NONE` for a face repeating a
+/// vertex), and the number of shells.
+fn orient_shells(faces: &[[u32; 3]], mates: &[[(u32, u8); 3]]) -> (Vec<bool>, Vec<u32>, u32) {
+    let n = faces.len();
+    let forward = |f: u32, k: u8| {
+        let face = &faces[f as usize];
+        face[k as usize] < face[(k as usize + 1) % 3]
+    };
+    let mut flip = vec![false; n];
+    let mut shell = vec![NONE; n];
+    let mut shells = 0u32;
+    for start in 0..n {
+        if shell[start] != NONE || repeats(&faces[start]) {
+            continue;
+        }
+        shell[start] = shells;
+        let mut queue = vec![start as u32];
+        while let Some(f) = queue.pop() {
+            for k in 0..3u8 {
+                let (g, kg) = mates[f as usize][k as usize];
+                if g == NONE || shell[g as usize] != NONE {
+                    continue;
+                }
+                // Consistent when the two faces run the edge in opposite
+                // directions once flipped.
+                let along_f = forward(f, k) ^ flip[f as usize];
+                flip[g as usize] = forward(g, kg) ^ !along_f;
+                shell[g as usize] = shells;
+                queue.push(g);
+            }
+        }
+        shells += 1;
+    }
+    (flip, shell, shells)
+}
+
+/// Turns the shells that face inwards (a negative volume about their
+/// centroid, with the flips so far).
+fn turn_inward_shells(
+    faces: &[[u32; 3]],
+    positions: &[Point3],
+    shell: &[u32],
+    shells: u32,
+    flip: &mut [bool],
+) {
+    let mut sums = vec![(Vector3::zeros(), 0usize); shells as usize];
+    for (f, face) in faces.iter().enumerate() {
+        if shell[f] != NONE {
+            let s = &mut sums[shell[f] as usize];
+            for &v in face {
+                s.0 += positions[v as usize].coords;
+            }
+            s.1 += 3;
+        }
+    }
+    let centroids: Vec<Vector3> = sums.iter().map(|(s, k)| s / (*k).max(1) as Real).collect();
+    let mut volume = vec![0.0 as Real; shells as usize];
+    let mut extent = vec![0.0 as Real; shells as usize];
+    for (f, face) in faces.iter().enumerate() {
+        if shell[f] == NONE {
+            continue;
+        }
+        let s = shell[f] as usize;
+        let c = centroids[s];
+        let [a, b, d] = face.map(|i| positions[i as usize].coords - c);
+        let v = a.dot(&b.cross(&d)) / 6.0;
+        volume[s] += if flip[f] { -v } else { v };
+        extent[s] = extent[s].max(a.norm()).max(b.norm()).max(d.norm());
+    }
+    for f in 0..faces.len() {
+        if shell[f] != NONE {
+            let s = shell[f] as usize;
+            if volume[s] < -1e-12 * extent[s].powi(3) {
+                flip[f] = !flip[f];
+            }
+        }
+    }
+}
+
+/// The edges of the repaired faces: the boundary edges (each as many times
+/// as its uses fail to pair, in the direction of the surplus), the number of
+/// edges shared by more than two faces, and whether every edge is used once
+/// each way.
+fn count_edges(faces: &[[u32; 3]]) -> (Vec<[u32; 2]>, usize, bool) {
+    let uses = edge_uses(faces, &repeats);
+    let mut boundary = Vec::new();
+    let mut non_manifold = 0;
+    let mut closed = true;
+    for group in groups(&uses) {
+        let fwd = group.iter().filter(|u| u.forward).count();
+        let bwd = group.len() - fwd;
+        if group.len() > 2 {
+            non_manifold += 1;
+        }
+        if fwd != 1 || bwd != 1 {
+            closed = false;
+        }
+        let (lo, hi) = (group[0].lo, group[0].hi);
+        let edge = if fwd > bwd { [lo, hi] } else { [hi, lo] };
+        for _ in 0..fwd.abs_diff(bwd) {
+            boundary.push(edge);
+        }
+    }
+    (boundary, non_manifold, closed)
 }
 
 /// Every edge use of the faces that do not repeat a vertex, sorted by edge.
